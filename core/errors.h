@@ -1,0 +1,72 @@
+// Typed exceptions thrown by meshquilt. Every public function documents which it throws.
+#pragma once
+
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace mq {
+
+// Base of every meshquilt error; what() is a single line suitable for the CLI.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Malformed files, NaN, impossible parameters: the caller's input is wrong.
+class InvalidInput : public Error {
+ public:
+  using Error::Error;
+};
+
+// A mesh lacks a topological property the algorithm needs (manifoldness, closedness, ...).
+class TopologyError : public Error {
+ public:
+  using Error::Error;
+};
+
+// A numerical solve failed (factorisation, non-convergence).
+class SolverFailure : public Error {
+ public:
+  using Error::Error;
+};
+
+// The OpenCL platform/device reported an error.
+class DeviceError : public Error {
+ public:
+  using Error::Error;
+};
+
+// An internal invariant was violated: a bug in meshquilt, not in the input.
+class InternalError : public Error {
+ public:
+  using Error::Error;
+};
+
+namespace detail {
+template <typename... Args>
+std::string concat(const Args&... args) {
+  std::ostringstream os;
+  (os << ... << args);
+  return os.str();
+}
+}  // namespace detail
+
+}  // namespace mq
+
+// Throws ErrorType with the message, prefixed by the source location in debug-friendly form.
+#define MQ_THROW(ErrorType, ...) throw ErrorType(::mq::detail::concat(__VA_ARGS__))
+
+// Safety check that throws ErrorType(message) when cond is false.
+#define MQ_CHECK(cond, ErrorType, ...)     \
+  do {                                     \
+    if (!(cond)) MQ_THROW(ErrorType, __VA_ARGS__); \
+  } while (0)
+
+// Internal invariant; names file and line since it indicates a bug.
+#define MQ_ASSERT(cond)                                                                    \
+  do {                                                                                     \
+    if (!(cond))                                                                           \
+      throw ::mq::InternalError(::mq::detail::concat(__FILE__, ":", __LINE__,              \
+                                                     ": internal check failed: ", #cond)); \
+  } while (0)

@@ -1,0 +1,252 @@
+#include "core/mesh_topology.h"
+
+#include <algorithm>
+#include <array>
+#include <numeric>
+
+#include "core/errors.h"
+
+namespace mq {
+
+namespace {
+
+Adjacency build_adjacency(int n, std::vector<std::pair<int, int>>& pairs, bool unique) {
+  std::sort(pairs.begin(), pairs.end());
+  if (unique) pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  Adjacency adj;
+  adj.offsets.assign(n + 1, 0);
+  adj.indices.reserve(pairs.size());
+  for (const auto& [a, b] : pairs) {
+    ++adj.offsets[a + 1];
+    adj.indices.push_back(b);
+  }
+  for (int i = 0; i < n; ++i) adj.offsets[i + 1] += adj.offsets[i];
+  return adj;
+}
+
+void check_indices(const MatrixX3i& F, int num_vertices) {
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      MQ_CHECK(F(f, k) >= 0 && F(f, k) < num_vertices, InvalidInput, "face ", f,
+               " references vertex ", F(f, k), " but the mesh has ", num_vertices, " vertices");
+}
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+EdgeTopology edge_topology(const MatrixX3i& F, int num_vertices) {
+  check_indices(F, num_vertices);
+  const int nf = static_cast<int>(F.rows());
+  // (min vertex, max vertex, half-edge id) sorted groups identical edges together.
+  std::vector<std::array<int, 3>> half(3 * static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      half[3 * f + k] = {std::min(a, b), std::max(a, b), 3 * f + k};
+    }
+  std::sort(half.begin(), half.end());
+  EdgeTopology topo;
+  topo.FE.resize(nf, 3);
+  std::vector<std::pair<int, int>> edge_face;
+  edge_face.reserve(half.size());
+  std::vector<std::array<int, 2>> edges;
+  for (size_t i = 0; i < half.size(); ++i) {
+    if (i == 0 || half[i][0] != half[i - 1][0] || half[i][1] != half[i - 1][1])
+      edges.push_back({half[i][0], half[i][1]});
+    const int e = static_cast<int>(edges.size()) - 1;
+    topo.FE(half[i][2] / 3, half[i][2] % 3) = e;
+    edge_face.emplace_back(e, half[i][2] / 3);
+  }
+  topo.E.resize(static_cast<Eigen::Index>(edges.size()), 2);
+  for (size_t e = 0; e < edges.size(); ++e) {
+    topo.E(e, 0) = edges[e][0];
+    topo.E(e, 1) = edges[e][1];
+  }
+  topo.edge_faces = build_adjacency(static_cast<int>(edges.size()), edge_face, false);
+  return topo;
+}
+
+Adjacency vertex_adjacency(const MatrixX3i& F, int num_vertices) {
+  check_indices(F, num_vertices);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(6 * static_cast<size_t>(F.rows()));
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (a == b) continue;
+      pairs.emplace_back(a, b);
+      pairs.emplace_back(b, a);
+    }
+  return build_adjacency(num_vertices, pairs, true);
+}
+
+Adjacency vertex_faces(const MatrixX3i& F, int num_vertices) {
+  check_indices(F, num_vertices);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(3 * static_cast<size_t>(F.rows()));
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) pairs.emplace_back(F(f, k), f);
+  return build_adjacency(num_vertices, pairs, true);
+}
+
+MatrixX3i face_adjacency(const EdgeTopology& topo) {
+  MatrixX3i TT(topo.FE.rows(), 3);
+  for (int f = 0; f < topo.FE.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int e = topo.FE(f, k);
+      TT(f, k) = -1;
+      if (topo.edge_faces.degree(e) != 2) continue;
+      const int* fs = topo.edge_faces.begin(e);
+      TT(f, k) = fs[0] == f ? fs[1] : fs[0];
+    }
+  return TT;
+}
+
+int connected_components(const MatrixX3i& F, int num_vertices, std::vector<int>& face_component) {
+  check_indices(F, num_vertices);
+  UnionFind uf(num_vertices);
+  for (int f = 0; f < F.rows(); ++f) {
+    uf.unite(F(f, 0), F(f, 1));
+    uf.unite(F(f, 0), F(f, 2));
+  }
+  std::vector<int> root_id(num_vertices, -1);
+  face_component.assign(F.rows(), -1);
+  int count = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const int r = uf.find(F(f, 0));
+    if (root_id[r] < 0) root_id[r] = count++;
+    face_component[f] = root_id[r];
+  }
+  return count;
+}
+
+std::vector<std::vector<int>> component_faces(const std::vector<int>& face_component,
+                                              int num_components) {
+  std::vector<std::vector<int>> groups(num_components);
+  for (size_t f = 0; f < face_component.size(); ++f)
+    groups[face_component[f]].push_back(static_cast<int>(f));
+  return groups;
+}
+
+TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces,
+                      std::vector<int>* vertex_map) {
+  std::vector<int> new_index(mesh.V.rows(), -1);
+  std::vector<int> old_index;
+  TriMesh out;
+  out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.F(faces[i], k);
+      if (new_index[v] < 0) {
+        new_index[v] = static_cast<int>(old_index.size());
+        old_index.push_back(v);
+      }
+      out.F(i, k) = new_index[v];
+    }
+  out.V.resize(static_cast<Eigen::Index>(old_index.size()), 3);
+  for (size_t i = 0; i < old_index.size(); ++i) out.V.row(i) = mesh.V.row(old_index[i]);
+  if (mesh.N.rows() == mesh.V.rows() && mesh.N.rows() > 0) {
+    out.N.resize(out.V.rows(), 3);
+    for (size_t i = 0; i < old_index.size(); ++i) out.N.row(i) = mesh.N.row(old_index[i]);
+  }
+  if (vertex_map) *vertex_map = std::move(old_index);
+  return out;
+}
+
+void append_mesh(TriMesh& a, const TriMesh& b) {
+  const bool normals = a.N.rows() == a.V.rows() && b.N.rows() == b.V.rows() &&
+                       (a.V.rows() > 0 || b.V.rows() > 0);
+  const Eigen::Index nv = a.V.rows(), nf = a.F.rows();
+  a.V.conservativeResize(nv + b.V.rows(), 3);
+  a.V.bottomRows(b.V.rows()) = b.V;
+  a.F.conservativeResize(nf + b.F.rows(), 3);
+  a.F.bottomRows(b.F.rows()) = b.F.array() + static_cast<int>(nv);
+  if (normals) {
+    a.N.conservativeResize(nv + b.N.rows(), 3);
+    a.N.bottomRows(b.N.rows()) = b.N;
+  } else {
+    a.N.resize(0, 3);
+  }
+}
+
+void remove_unreferenced_vertices(TriMesh& mesh) {
+  std::vector<int> new_index(mesh.V.rows(), -1);
+  int count = 0;
+  std::vector<int> used(mesh.V.rows(), 0);
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[mesh.F(f, k)] = 1;
+  for (size_t v = 0; v < used.size(); ++v) new_index[v] = used[v] ? count++ : -1;
+  MatrixX3d V(count, 3);
+  MatrixX3d N(mesh.N.rows() == mesh.V.rows() ? count : 0, 3);
+  for (int v = 0; v < mesh.V.rows(); ++v) {
+    if (new_index[v] < 0) continue;
+    V.row(new_index[v]) = mesh.V.row(v);
+    if (N.rows()) N.row(new_index[v]) = mesh.N.row(v);
+  }
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) mesh.F(f, k) = new_index[mesh.F(f, k)];
+  mesh.V = std::move(V);
+  mesh.N = std::move(N);
+}
+
+TopologyReport topology_report(const TriMesh& mesh) {
+  TopologyReport r;
+  const int nv = mesh.num_vertices();
+  const EdgeTopology topo = edge_topology(mesh.F, nv);
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    if (topo.is_boundary(e)) ++r.num_boundary_edges;
+    if (topo.is_non_manifold(e)) ++r.num_non_manifold_edges;
+  }
+  std::vector<int> fc;
+  r.num_components = connected_components(mesh.F, nv, fc);
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+    const bool repeated = a == b || b == c || a == c;
+    const Vector3d n = (mesh.V.row(b) - mesh.V.row(a)).cross(mesh.V.row(c) - mesh.V.row(a));
+    if (repeated || n.squaredNorm() == 0.0) ++r.num_degenerate_faces;
+  }
+  // A vertex is manifold when its incident faces, linked through shared manifold edges that
+  // contain the vertex, form a single fan.
+  const Adjacency vf = vertex_faces(mesh.F, nv);
+  const MatrixX3i TT = face_adjacency(topo);
+  std::vector<int> mark(mesh.F.rows(), -1);
+  std::vector<int> stack;
+  for (int v = 0; v < nv; ++v) {
+    if (vf.degree(v) == 0) continue;
+    int fans = 0;
+    for (const int* it = vf.begin(v); it != vf.end(v); ++it) {
+      if (mark[*it] == v) continue;
+      ++fans;
+      stack.assign(1, *it);
+      mark[*it] = v;
+      while (!stack.empty()) {
+        const int f = stack.back();
+        stack.pop_back();
+        for (int k = 0; k < 3; ++k) {
+          const int g = TT(f, k);
+          if (g < 0 || mark[g] == v) continue;
+          if (mesh.F(f, k) != v && mesh.F(f, (k + 1) % 3) != v) continue;
+          mark[g] = v;
+          stack.push_back(g);
+        }
+      }
+    }
+    if (fans > 1) ++r.num_non_manifold_vertices;
+  }
+  return r;
+}
+
+}  // namespace mq

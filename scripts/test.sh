@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Builds meshquilt (Release, then AddressSanitizer + UBSan) and runs every test in both.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install_deps.sh
+jobs=$(nproc)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$jobs"
+ctest --test-dir build --output-on-failure -j"$jobs"
+if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHQUILT_SANITIZE=ON \
+        -DMESHQUILT_BUILD_BENCH=OFF
+  cmake --build build-asan -j"$jobs"
+  # PoCL's compiler and the ICD loader keep allocations alive past exit; leaks are not checked.
+  ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE slow
+fi

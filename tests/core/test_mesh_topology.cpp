@@ -1,0 +1,100 @@
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_topology.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+TEST(MeshTopology, CubeIsClosedManifoldSingleComponent) {
+  const TriMesh cube = test::unit_cube();
+  const TopologyReport r = topology_report(cube);
+  EXPECT_EQ(r.num_components, 1);
+  EXPECT_EQ(r.num_boundary_edges, 0);
+  EXPECT_EQ(r.num_non_manifold_edges, 0);
+  EXPECT_EQ(r.num_non_manifold_vertices, 0);
+  EXPECT_TRUE(r.closed());
+  const EdgeTopology topo = edge_topology(cube.F, cube.num_vertices());
+  EXPECT_EQ(topo.num_edges(), 18);  // Euler: V - E + F = 2
+  EXPECT_NEAR(surface_area(cube.V, cube.F), 6.0, 1e-12);
+}
+
+TEST(MeshTopology, CubeNormalsPointOutward) {
+  const TriMesh cube = test::unit_cube();
+  const MatrixX3d FN = face_normals(cube.V, cube.F);
+  for (int f = 0; f < cube.num_faces(); ++f) {
+    const Vector3d centroid = (cube.V.row(cube.F(f, 0)) + cube.V.row(cube.F(f, 1)) +
+                               cube.V.row(cube.F(f, 2))) / 3.0;
+    EXPECT_GT(FN.row(f).dot(centroid - Vector3d(0.5, 0.5, 0.5)), 0.0) << "face " << f;
+  }
+  const MatrixX3d VN = vertex_normals(cube.V, cube.F);
+  for (int v = 0; v < 8; ++v) EXPECT_NEAR(VN.row(v).norm(), 1.0, 1e-12);
+}
+
+TEST(MeshTopology, GridBoundaryAndAdjacency) {
+  const TriMesh g = test::plane_grid(2.0, 1.0, 4, 2);
+  const TopologyReport r = topology_report(g);
+  EXPECT_EQ(r.num_boundary_edges, 2 * (4 + 2));
+  EXPECT_FALSE(r.closed());
+  EXPECT_TRUE(r.manifold());
+  const Adjacency adj = vertex_adjacency(g.F, g.num_vertices());
+  EXPECT_EQ(adj.degree(0), 3);  // corner with the diagonal
+  EXPECT_EQ(adj.degree(6), 6);  // interior vertex
+  const MatrixX3i TT = face_adjacency(edge_topology(g.F, g.num_vertices()));
+  int boundary = 0;
+  for (int f = 0; f < TT.rows(); ++f)
+    for (int k = 0; k < 3; ++k) boundary += TT(f, k) < 0;
+  EXPECT_EQ(boundary, 12);
+}
+
+TEST(MeshTopology, ComponentsExtractAndAppend) {
+  TriMesh two = test::torus(2.0, 0.5, 12, 6);
+  TriMesh other = test::unit_cube();
+  append_mesh(two, other);
+  std::vector<int> fc;
+  ASSERT_EQ(connected_components(two.F, two.num_vertices(), fc), 2);
+  const auto groups = component_faces(fc, 2);
+  EXPECT_EQ(groups[0].size(), 144u);
+  EXPECT_EQ(groups[1].size(), 12u);
+  const TriMesh cube = extract_faces(two, groups[1]);
+  EXPECT_EQ(cube.num_vertices(), 8);
+  EXPECT_TRUE(topology_report(cube).closed());
+  const TopologyReport torus_report = topology_report(extract_faces(two, groups[0]));
+  EXPECT_TRUE(torus_report.closed());
+  EXPECT_TRUE(torus_report.manifold());
+}
+
+TEST(MeshTopology, NonManifoldEdgeAndVertexDetected) {
+  TriMesh m;
+  m.V.resize(7, 3);
+  m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 2, 1, 0, 2, -1, 0;
+  // Three triangles on edge (0,1): non-manifold edge; two more fans meeting at vertex 1.
+  m.F.resize(5, 3);
+  m.F << 0, 1, 2, 1, 0, 3, 0, 1, 4, 1, 5, 6, 1, 6, 5;
+  const TopologyReport r = topology_report(m);
+  EXPECT_EQ(r.num_non_manifold_edges, 1);
+  EXPECT_GE(r.num_non_manifold_vertices, 1);
+  EXPECT_FALSE(r.manifold());
+}
+
+TEST(MeshTopology, OutOfRangeIndexThrows) {
+  TriMesh m = test::unit_cube();
+  m.F(3, 1) = 99;
+  EXPECT_THROW(topology_report(m), InvalidInput);
+}
+
+TEST(MeshTopology, RemoveUnreferencedKeepsOrder) {
+  TriMesh m = test::unit_cube();
+  m.V.conservativeResize(10, 3);
+  m.V.row(8) << 5, 5, 5;
+  m.V.row(9) << 6, 6, 6;
+  m.F.array() += 0;
+  remove_unreferenced_vertices(m);
+  EXPECT_EQ(m.num_vertices(), 8);
+  EXPECT_TRUE(topology_report(m).closed());
+}
+
+}  // namespace
+}  // namespace mq

@@ -1,0 +1,73 @@
+#include "tests/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace mq::test {
+
+std::string shared_data(const std::string& relative) {
+  return std::string(MESHQUILT_SHARED_DATA) + "/" + relative;
+}
+
+std::string temp_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = "meshquilt_test";
+  if (info) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  for (char& c : name)
+    if (c == '/') c = '_';
+  const auto dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+TriMesh unit_cube() {
+  TriMesh m;
+  m.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) m.V.row(i) << (i & 1), (i >> 1) & 1, (i >> 2) & 1;
+  m.F.resize(12, 3);
+  m.F << 0, 2, 1, 1, 2, 3,  // z = 0, normal -z
+      4, 5, 6, 5, 7, 6,     // z = 1, normal +z
+      0, 1, 4, 1, 5, 4,     // y = 0, normal -y
+      2, 6, 3, 3, 6, 7,     // y = 1, normal +y
+      0, 4, 2, 2, 4, 6,     // x = 0, normal -x
+      1, 3, 5, 3, 7, 5;     // x = 1, normal +x
+  return m;
+}
+
+TriMesh torus(double R, double r, int n, int m) {
+  TriMesh t;
+  t.V.resize(n * m, 3);
+  t.F.resize(2 * n * m, 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double u = 2 * M_PI * i / n, v = 2 * M_PI * j / m;
+      t.V.row(i * m + j) << (R + r * std::cos(v)) * std::cos(u),
+          (R + r * std::cos(v)) * std::sin(u), r * std::sin(v);
+      const int a = i * m + j, b = ((i + 1) % n) * m + j, c = ((i + 1) % n) * m + (j + 1) % m,
+                d = i * m + (j + 1) % m;
+      t.F.row(2 * (i * m + j)) << a, b, c;
+      t.F.row(2 * (i * m + j) + 1) << a, c, d;
+    }
+  return t;
+}
+
+TriMesh plane_grid(double w, double h, int nx, int ny) {
+  TriMesh g;
+  g.V.resize((nx + 1) * (ny + 1), 3);
+  g.F.resize(2 * nx * ny, 3);
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) g.V.row(j * (nx + 1) + i) << w * i / nx, h * j / ny, 0.0;
+  int f = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+      g.F.row(f++) << a, b, c;
+      g.F.row(f++) << a, c, d;
+    }
+  return g;
+}
+
+}  // namespace mq::test

@@ -1,0 +1,25 @@
+// Shared helpers for the test programs: data paths and small procedural fixtures.
+#pragma once
+
+#include <string>
+
+#include "core/mesh.h"
+
+namespace mq::test {
+
+// Absolute path of a file in ../shared/data (e.g. "base/bunny_igl_7k.off").
+std::string shared_data(const std::string& relative);
+
+// A fresh, empty temporary directory unique to the calling test.
+std::string temp_dir();
+
+// Closed, outward-oriented unit cube [0,1]^3: 8 vertices, 12 faces.
+TriMesh unit_cube();
+
+// Closed torus around the z axis: major radius R, minor radius r, n x m quads split in two.
+TriMesh torus(double R, double r, int n, int m);
+
+// Open regular grid in the z = 0 plane over [0,w]x[0,h], nx by ny quads split in two.
+TriMesh plane_grid(double w, double h, int nx, int ny);
+
+}  // namespace mq::test
