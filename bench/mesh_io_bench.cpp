@@ -1,0 +1,77 @@
+// Read and write throughput of the mesh file formats on a 1M-face regular grid.
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "core/mesh_io.h"
+
+namespace {
+
+// Open grid in the z = 0 plane with nx by ny quads split in two, slightly perturbed so that
+// coordinates use all significant digits as scanned meshes do.
+mq::TriMesh grid(int nx, int ny) {
+  mq::TriMesh g;
+  g.V.resize((nx + 1) * (ny + 1), 3);
+  g.F.resize(2 * nx * ny, 3);
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i)
+      g.V.row(j * (nx + 1) + i) << i / 3.0, j / 7.0, 0.001 * ((i * 7919 + j * 104729) % 1000) / 3.0;
+  int f = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 2, d = a + nx + 1;
+      g.F.row(f++) << a, b, c;
+      g.F.row(f++) << a, c, d;
+    }
+  return g;
+}
+
+const char* kNames[] = {"bench.obj", "bench.off", "bench.ply", "bench_ascii.ply"};
+
+std::string bench_path(int format) {
+  return (std::filesystem::temp_directory_path() /
+          ("meshquilt_bench_" + std::to_string(::getpid()) + "_" + kNames[format]))
+      .string();
+}
+
+mq::WriteOptions options_for(int format) {
+  mq::WriteOptions o;
+  o.binary = format != 3;
+  return o;
+}
+
+void BM_WriteMesh(benchmark::State& state) {
+  const int format = static_cast<int>(state.range(0));
+  const mq::TriMesh mesh = grid(708, 708);
+  const std::string path = bench_path(format);
+  for (auto _ : state) mq::write_mesh(path, mesh, options_for(format));
+  state.counters["faces"] = mesh.num_faces();
+  state.counters["MB"] = std::filesystem::file_size(path) / 1e6;
+  state.SetLabel(kNames[format]);
+  std::filesystem::remove(path);
+}
+
+void BM_ReadMesh(benchmark::State& state) {
+  const int format = static_cast<int>(state.range(0));
+  const mq::TriMesh mesh = grid(708, 708);
+  const std::string path = bench_path(format);
+  mq::write_mesh(path, mesh, options_for(format));
+  int faces = 0;
+  for (auto _ : state) {
+    const mq::TriMesh m = mq::read_mesh(path);
+    faces = m.num_faces();
+    benchmark::DoNotOptimize(m.V.data());
+  }
+  state.counters["faces"] = faces;
+  state.SetLabel(kNames[format]);
+  std::filesystem::remove(path);
+}
+
+BENCHMARK(BM_WriteMesh)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ReadMesh)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
