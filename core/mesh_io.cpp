@@ -921,7 +921,7 @@ TriMesh read_mesh(const std::string& path) {
     case MeshFormat::Ply:
       return read_ply(path, data);
   }
-  MQ_ASSERT(false);
+  throw InternalError(path + ": unhandled mesh format");
 }
 
 void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions& options) {
