@@ -5,6 +5,7 @@
 
 #include "core/errors.h"
 #include "core/mesh_intersections.h"
+#include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 #include "tests/test_support.h"
 
@@ -117,6 +118,26 @@ TEST(MeshIntersections, BadInputThrows) {
   F << 0, 1, 2;
   V(1, 1) = std::nan("");
   EXPECT_THROW(intersecting_face_pairs(V, F), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mq
+
+namespace mq {
+namespace {
+
+TEST(MeshIntersections, RealChainMailRingsDoNotIntersect) {
+  const TriMesh mail = read_mesh(test::shared_data("swatch/chainmail3d_48rings_49k.obj"));
+  std::vector<int> fc;
+  EXPECT_EQ(connected_components(mail.F, mail.num_vertices(), fc), 48);
+  EXPECT_TRUE(intersecting_face_pairs(mail.V, mail.F).empty());
+  // Sanity check that the test can fail on this mesh: shift one ring onto its neighbour.
+  const auto groups = component_faces(fc, 48);
+  TriMesh one = extract_faces(mail, groups[0]);
+  TriMesh two = extract_faces(mail, groups[1]);
+  const Vector3d shift = (two.V.colwise().mean() - one.V.colwise().mean()).transpose();
+  one.V.rowwise() += shift.transpose();  // concentric rings of equal size must clash
+  EXPECT_TRUE(meshes_intersect(one, two));
 }
 
 }  // namespace
