@@ -55,7 +55,7 @@ struct AppleOptions {
   double mean_radius = 1.0;        // mean apple radius
   double radius_variation = 0.25;  // radii uniform in mean_radius * [1 - v, 1 + v], v in [0, 0.9]
   uint64_t seed = 1;
-  int resolution = 16;  // segments around an apple (>= 6); 384 faces per apple at 16
+  int resolution = 16;  // segments around an apple (>= 6); 352 faces per apple at 16
 };
 
 // One layer of apples resting on z = 0: each a closed surface of revolution with dimples at the
