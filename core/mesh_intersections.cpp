@@ -1,0 +1,283 @@
+#include "core/mesh_intersections.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/errors.h"
+#include "core/mesh_topology.h"
+
+namespace mq {
+namespace {
+
+int sign(double x) { return (x > 0) - (x < 0); }
+
+// Sign of det[b-a, c-a, d-a]: positive when d lies on the side of plane abc that its
+// counter-clockwise normal points to.
+int orient3d(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& d) {
+  return sign((b - a).cross(c - a).dot(d - a));
+}
+
+int orient2d(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+  return sign((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x()));
+}
+
+// Is c, known collinear with segment ab, within its bounding box (hence on the segment)?
+bool on_segment(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+  return std::min(a.x(), b.x()) <= c.x() && c.x() <= std::max(a.x(), b.x()) &&
+         std::min(a.y(), b.y()) <= c.y() && c.y() <= std::max(a.y(), b.y());
+}
+
+bool segments_intersect_2d(const Vector2d& p1, const Vector2d& p2, const Vector2d& q1,
+                           const Vector2d& q2) {
+  const int d1 = orient2d(p1, p2, q1), d2 = orient2d(p1, p2, q2);
+  const int d3 = orient2d(q1, q2, p1), d4 = orient2d(q1, q2, p2);
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  return (d1 == 0 && on_segment(p1, p2, q1)) || (d2 == 0 && on_segment(p1, p2, q2)) ||
+         (d3 == 0 && on_segment(q1, q2, p1)) || (d4 == 0 && on_segment(q1, q2, p2));
+}
+
+// Closed point-in-triangle test; the triangle may have either orientation.
+bool point_in_triangle_2d(const Vector2d& p, const Vector2d& a, const Vector2d& b,
+                          const Vector2d& c) {
+  const int s1 = orient2d(a, b, p), s2 = orient2d(b, c, p), s3 = orient2d(c, a, p);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3<0, has_pos = s1> 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+// Index of the axis dropped when projecting onto the plane with normal n.
+int dominant_axis(const Vector3d& n) {
+  int k = 0;
+  n.cwiseAbs().maxCoeff(&k);
+  return k;
+}
+
+Vector2d project(const Vector3d& p, int drop) {
+  return drop == 0   ? Vector2d(p.y(), p.z())
+         : drop == 1 ? Vector2d(p.z(), p.x())
+                     : Vector2d(p.x(), p.y());
+}
+
+// Plane normal for the coplanar tests: of the first triangle, or the second if it is degenerate.
+int coplanar_axis(const Vector3d& a0, const Vector3d& a1, const Vector3d& a2, const Vector3d& b0,
+                  const Vector3d& b1, const Vector3d& b2) {
+  Vector3d n = (a1 - a0).cross(a2 - a0);
+  if (n.squaredNorm() == 0) n = (b1 - b0).cross(b2 - b0);
+  return dominant_axis(n);
+}
+
+bool coplanar_triangles_intersect(const std::array<Vector2d, 3>& a,
+                                  const std::array<Vector2d, 3>& b) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (segments_intersect_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3])) return true;
+  return point_in_triangle_2d(a[0], b[0], b[1], b[2]) ||
+         point_in_triangle_2d(b[0], a[0], a[1], a[2]);
+}
+
+// Closed segment pq against closed triangle abc.
+bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vector3d& a,
+                                const Vector3d& b, const Vector3d& c) {
+  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+  if (op * oq > 0) return false;
+  if (op == 0 && oq == 0) {  // segment in the triangle's plane
+    const int k = dominant_axis((b - a).cross(c - a));
+    const Vector2d p2 = project(p, k), q2 = project(q, k);
+    const Vector2d a2 = project(a, k), b2 = project(b, k), c2 = project(c, k);
+    return point_in_triangle_2d(p2, a2, b2, c2) || segments_intersect_2d(p2, q2, a2, b2) ||
+           segments_intersect_2d(p2, q2, b2, c2) || segments_intersect_2d(p2, q2, c2, a2);
+  }
+  // The segment meets the plane in one point; it is in the triangle iff the line pq passes
+  // on the same side of all three edges.
+  const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3<0, has_pos = s1> 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+// Face pair test with combinatorial sharing taken into account (see IntersectionOptions).
+bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
+  std::array<int, 3> shared_f{}, shared_g{};
+  int num_shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (F(f, i) == F(g, j)) {
+        shared_f[num_shared] = i;
+        shared_g[num_shared] = j;
+        ++num_shared;
+      }
+  const auto P = [&](int face, int k) -> Vector3d { return V.row(F(face, k)).transpose(); };
+  if (num_shared == 0)
+    return triangles_intersect(P(f, 0), P(f, 1), P(f, 2), P(g, 0), P(g, 1), P(g, 2));
+  if (num_shared >= 3) return true;  // duplicated face
+  if (num_shared == 2) {
+    // Non-coplanar faces sharing an edge meet only along it; coplanar ones overlap iff
+    // their opposite vertices lie on the same side of the edge (a fold-over).
+    const int u = shared_f[0], v = shared_f[1];
+    const int a = 3 - u - v, b = 3 - shared_g[0] - shared_g[1];
+    if (orient3d(P(f, u), P(f, v), P(f, a), P(g, b)) != 0) return false;
+    const int k = dominant_axis((P(f, 1) - P(f, 0)).cross(P(f, 2) - P(f, 0)));
+    const Vector2d u2 = project(P(f, u), k), v2 = project(P(f, v), k);
+    return orient2d(u2, v2, project(P(f, a), k)) * orient2d(u2, v2, project(P(g, b), k)) > 0;
+  }
+  // One shared vertex s: the (convex) intersection contains s, and it contains more iff the
+  // edge opposite s of one face meets the other face.
+  const int fa = (shared_f[0] + 1) % 3, fb = (shared_f[0] + 2) % 3;
+  const int ga = (shared_g[0] + 1) % 3, gb = (shared_g[0] + 2) % 3;
+  return segment_triangle_intersect(P(f, fa), P(f, fb), P(g, 0), P(g, 1), P(g, 2)) ||
+         segment_triangle_intersect(P(g, ga), P(g, gb), P(f, 0), P(f, 1), P(f, 2));
+}
+
+// Shared implementation: when label is given, only pairs with different labels are tested.
+std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i& F,
+                                            const std::vector<int>* label, bool stop_at_first) {
+  const int nf = static_cast<int>(F.rows());
+  std::vector<std::pair<int, int>> result;
+  if (nf == 0) return result;
+  MQ_CHECK(V.allFinite(), InvalidInput, "intersection test: vertex positions are not finite");
+  MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+
+  // Face bounding boxes.
+  MatrixX3d lo(nf, 3), hi(nf, 3);
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
+    for (int f = r.begin(); f != r.end(); ++f) {
+      lo.row(f) = V.row(F(f, 0)).cwiseMin(V.row(F(f, 1))).cwiseMin(V.row(F(f, 2)));
+      hi.row(f) = V.row(F(f, 0)).cwiseMax(V.row(F(f, 1))).cwiseMax(V.row(F(f, 2)));
+    }
+  });
+  const Vector3d gmin = lo.colwise().minCoeff().transpose();
+  const Vector3d gext = (hi.colwise().maxCoeff().transpose() - gmin);
+
+  // Cell size: the mean face box size, enlarged if the grid would have too many cells.
+  double h = (hi - lo).rowwise().maxCoeff().mean();
+  if (!(h > 0)) h = std::max(gext.maxCoeff(), 1.0);
+  const double max_cells = 4.0 * nf + 64.0;
+  std::array<int, 3> n{};
+  for (;;) {
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      n[k] = std::max(1, static_cast<int>(std::ceil(gext[k] / h)));
+      cells *= n[k];
+    }
+    if (cells <= max_cells) break;
+    h *= 1.25;
+  }
+  const auto cell_coord = [&](double x, int k) {
+    return std::clamp(static_cast<int>(std::floor((x - gmin[k]) / h)), 0, n[k] - 1);
+  };
+  const auto cell_range = [&](int f, std::array<int, 3>& c0, std::array<int, 3>& c1) {
+    for (int k = 0; k < 3; ++k) {
+      c0[k] = cell_coord(lo(f, k), k);
+      c1[k] = cell_coord(hi(f, k), k);
+    }
+  };
+  const auto cell_index = [&](int i, int j, int k) { return (k * n[1] + j) * n[0] + i; };
+
+  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order).
+  const int num_cells = n[0] * n[1] * n[2];
+  std::vector<int> offsets(num_cells + 1, 0);
+  for (int f = 0; f < nf; ++f) {
+    std::array<int, 3> c0, c1;
+    cell_range(f, c0, c1);
+    for (int k = c0[2]; k <= c1[2]; ++k)
+      for (int j = c0[1]; j <= c1[1]; ++j)
+        for (int i = c0[0]; i <= c1[0]; ++i) ++offsets[cell_index(i, j, k) + 1];
+  }
+  for (int c = 0; c < num_cells; ++c) offsets[c + 1] += offsets[c];
+  std::vector<int> members(offsets.back());
+  {
+    std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
+    for (int f = 0; f < nf; ++f) {
+      std::array<int, 3> c0, c1;
+      cell_range(f, c0, c1);
+      for (int k = c0[2]; k <= c1[2]; ++k)
+        for (int j = c0[1]; j <= c1[1]; ++j)
+          for (int i = c0[0]; i <= c1[0]; ++i) members[cursor[cell_index(i, j, k)]++] = f;
+    }
+  }
+
+  // Narrow phase per face f against later faces g; a pair is tested only in the cell holding
+  // the min corner of the intersection of the two boxes, so it is tested once.
+  std::vector<std::vector<int>> hits(nf);
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
+    for (int f = r.begin(); f != r.end(); ++f) {
+      std::array<int, 3> c0, c1;
+      cell_range(f, c0, c1);
+      for (int k = c0[2]; k <= c1[2]; ++k)
+        for (int j = c0[1]; j <= c1[1]; ++j)
+          for (int i = c0[0]; i <= c1[0]; ++i) {
+            const int c = cell_index(i, j, k);
+            for (int m = offsets[c]; m < offsets[c + 1]; ++m) {
+              const int g = members[m];
+              if (g <= f) continue;
+              if (label && (*label)[f] == (*label)[g]) continue;
+              bool overlap = true, home = true;
+              for (int a = 0; a < 3 && overlap; ++a) {
+                overlap = lo(f, a) <= hi(g, a) && lo(g, a) <= hi(f, a);
+                const int home_coord = cell_coord(std::max(lo(f, a), lo(g, a)), a);
+                home = home && home_coord == (a == 0 ? i : a == 1 ? j : k);
+              }
+              if (!overlap || !home) continue;
+              if (faces_intersect(V, F, f, g)) hits[f].push_back(g);
+            }
+          }
+      std::sort(hits[f].begin(), hits[f].end());
+    }
+  });
+  for (int f = 0; f < nf; ++f) {
+    for (int g : hits[f]) result.emplace_back(f, g);
+    if (stop_at_first && !result.empty()) break;
+  }
+  return result;
+}
+
+}  // namespace
+
+bool triangles_intersect(const Vector3d& a0, const Vector3d& a1, const Vector3d& a2,
+                         const Vector3d& b0, const Vector3d& b1, const Vector3d& b2) {
+  // Separating planes: all of one triangle strictly on one side of the other's plane.
+  const int da0 = orient3d(b0, b1, b2, a0), da1 = orient3d(b0, b1, b2, a1),
+            da2 = orient3d(b0, b1, b2, a2);
+  if ((da0 > 0 && da1 > 0 && da2 > 0) || (da0 < 0 && da1 < 0 && da2 < 0)) return false;
+  const int db0 = orient3d(a0, a1, a2, b0), db1 = orient3d(a0, a1, a2, b1),
+            db2 = orient3d(a0, a1, a2, b2);
+  if ((db0 > 0 && db1 > 0 && db2 > 0) || (db0 < 0 && db1 < 0 && db2 < 0)) return false;
+  if ((da0 == 0 && da1 == 0 && da2 == 0) || (db0 == 0 && db1 == 0 && db2 == 0)) {
+    const int k = coplanar_axis(a0, a1, a2, b0, b1, b2);
+    return coplanar_triangles_intersect({project(a0, k), project(a1, k), project(a2, k)},
+                                        {project(b0, k), project(b1, k), project(b2, k)});
+  }
+  // Non-coplanar: both meet the line of the two planes in an interval; the intervals overlap
+  // iff an endpoint of one, which lies on an edge of its triangle, is inside the other.
+  return segment_triangle_intersect(a0, a1, b0, b1, b2) ||
+         segment_triangle_intersect(a1, a2, b0, b1, b2) ||
+         segment_triangle_intersect(a2, a0, b0, b1, b2) ||
+         segment_triangle_intersect(b0, b1, a0, a1, a2) ||
+         segment_triangle_intersect(b1, b2, a0, a1, a2) ||
+         segment_triangle_intersect(b2, b0, a0, a1, a2);
+}
+
+std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
+                                                         const IntersectionOptions& options) {
+  if (!options.between_components_only) return find_pairs(V, F, nullptr, false);
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+  std::vector<int> component;
+  connected_components(F, static_cast<int>(V.rows()), component);
+  return find_pairs(V, F, &component, false);
+}
+
+bool meshes_intersect(const TriMesh& A, const TriMesh& B) {
+  TriMesh both;
+  both.V = A.V;
+  both.F = A.F;
+  append_mesh(both, B);
+  std::vector<int> label(both.F.rows(), 1);
+  std::fill(label.begin(), label.begin() + A.F.rows(), 0);
+  return !find_pairs(both.V, both.F, &label, true).empty();
+}
+
+}  // namespace mq

@@ -1,0 +1,144 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+#include "core/errors.h"
+#include "core/mesh_intersections.h"
+#include "core/mesh_io.h"
+#include "core/mesh_topology.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+TriMesh transformed(TriMesh m, const Eigen::Matrix3d& R, const Vector3d& t) {
+  for (int v = 0; v < m.num_vertices(); ++v) m.V.row(v) = (R * m.V.row(v).transpose() + t);
+  return m;
+}
+
+TEST(TriangleIntersection, BasicConfigurations) {
+  const Vector3d a0(0, 0, 0), a1(1, 0, 0), a2(0, 1, 0);
+  // Piercing.
+  EXPECT_TRUE(triangles_intersect(a0, a1, a2, {0.2, 0.2, -1}, {0.3, 0.2, 1}, {0.2, 0.3, 1}));
+  // Above the plane.
+  EXPECT_FALSE(triangles_intersect(a0, a1, a2, {0, 0, 0.1}, {1, 0, 0.1}, {0, 1, 0.2}));
+  // Crossing the plane outside the triangle.
+  EXPECT_FALSE(triangles_intersect(a0, a1, a2, {2, 2, -1}, {3, 2, 1}, {2, 3, 1}));
+  // Touching at a vertex counts.
+  EXPECT_TRUE(triangles_intersect(a0, a1, a2, {1, 0, 0}, {2, 0, 1}, {2, 1, 1}));
+  // Coplanar overlapping, coplanar disjoint, coplanar one inside the other.
+  EXPECT_TRUE(triangles_intersect(a0, a1, a2, {0.5, 0.5, 0}, {-0.5, 0.2, 0}, {0.3, -0.5, 0}));
+  EXPECT_FALSE(triangles_intersect(a0, a1, a2, {1, 1, 0}, {2, 1, 0}, {1, 2, 0}));
+  EXPECT_TRUE(triangles_intersect(a0, a1, a2, {0.1, 0.1, 0}, {0.2, 0.1, 0}, {0.1, 0.2, 0}));
+  // Symmetric in its arguments.
+  EXPECT_TRUE(triangles_intersect({0.1, 0.1, 0}, {0.2, 0.1, 0}, {0.1, 0.2, 0}, a0, a1, a2));
+}
+
+TEST(MeshIntersections, LinkedToriDoNotIntersectOverlappingDo) {
+  const TriMesh a = test::torus(2.0, 0.4, 48, 12);
+  // A chain link: rotated into the xz plane and shifted by R along x, through a's hole.
+  const Eigen::Matrix3d Rx = Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitX()).toRotationMatrix();
+  const TriMesh linked = transformed(a, Rx, Vector3d(2.0, 0, 0));
+  EXPECT_FALSE(meshes_intersect(a, linked));
+  // Same orientation, overlapping in the plane: the tubes cross.
+  const TriMesh overlapping = transformed(a, Eigen::Matrix3d::Identity(), Vector3d(2.0, 0, 0));
+  EXPECT_TRUE(meshes_intersect(a, overlapping));
+  // A linked torus pushed sideways so its tube cuts through a's tube.
+  const TriMesh cutting = transformed(a, Rx, Vector3d(3.9, 0, 0));
+  EXPECT_TRUE(meshes_intersect(a, cutting));
+
+  TriMesh chain = a;
+  append_mesh(chain, linked);
+  EXPECT_TRUE(intersecting_face_pairs(chain.V, chain.F).empty());
+  TriMesh clash = a;
+  append_mesh(clash, overlapping);
+  const auto pairs = intersecting_face_pairs(clash.V, clash.F);
+  ASSERT_FALSE(pairs.empty());
+  EXPECT_TRUE(std::is_sorted(pairs.begin(), pairs.end()));
+  for (const auto& [f, g] : pairs) {
+    EXPECT_LT(f, a.num_faces());  // every pair joins the two tori
+    EXPECT_GE(g, a.num_faces());
+  }
+}
+
+TEST(MeshIntersections, ClosedMeshHasNoSelfIntersectionsAcrossSharedEdges) {
+  // With all pairs tested, faces sharing an edge or a vertex must not be reported.
+  const TriMesh t = test::torus(2.0, 0.5, 24, 12);
+  IntersectionOptions all;
+  all.between_components_only = false;
+  EXPECT_TRUE(intersecting_face_pairs(t.V, t.F, all).empty());
+  const TriMesh g = test::plane_grid(1.0, 1.0, 8, 8);  // flat: shared edges are coplanar
+  EXPECT_TRUE(intersecting_face_pairs(g.V, g.F, all).empty());
+}
+
+TEST(MeshIntersections, SharedEdgeFoldAndCoplanarOverlapReported) {
+  MatrixX3d V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0, 0.5, 0.5, 0;
+  MatrixX3i F(2, 3);
+  F << 0, 1, 2, 1, 0, 3;  // share edge 0-1, opposite sides: fine
+  IntersectionOptions all;
+  all.between_components_only = false;
+  EXPECT_TRUE(intersecting_face_pairs(V, F, all).empty());
+  F << 0, 1, 2, 1, 0, 4;  // vertex 4 folds back onto the first face
+  const auto fold = intersecting_face_pairs(V, F, all);
+  ASSERT_EQ(fold.size(), 1u);
+  EXPECT_EQ(fold[0], std::make_pair(0, 1));
+
+  // Two separate coplanar overlapping triangles (different components).
+  MatrixX3d W(6, 3);
+  W << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.2, 0, 1.2, 0.2, 0, 0.2, 1.2, 0;
+  MatrixX3i G(2, 3);
+  G << 0, 1, 2, 3, 4, 5;
+  const auto pairs = intersecting_face_pairs(W, G);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0], std::make_pair(0, 1));
+}
+
+TEST(MeshIntersections, SharedVertexPiercingReported) {
+  // Two faces share vertex 0 and the second cuts through the first beyond it.
+  MatrixX3d V(5, 3);
+  V << 0, 0, 0, 2, 0, 0, 0, 2, 0, 1, 1, -1, 1, 1, 1;
+  MatrixX3i F(2, 3);
+  F << 0, 1, 2, 0, 3, 4;
+  IntersectionOptions all;
+  all.between_components_only = false;
+  EXPECT_EQ(intersecting_face_pairs(V, F, all).size(), 1u);
+  V.row(3) << -1, -1, -1;  // now the second face meets the first only at vertex 0
+  V.row(4) << -1, -1, 1;
+  EXPECT_TRUE(intersecting_face_pairs(V, F, all).empty());
+}
+
+TEST(MeshIntersections, BadInputThrows) {
+  MatrixX3d V(3, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  MatrixX3i F(1, 3);
+  F << 0, 1, 3;
+  EXPECT_THROW(intersecting_face_pairs(V, F), InvalidInput);
+  F << 0, 1, 2;
+  V(1, 1) = std::nan("");
+  EXPECT_THROW(intersecting_face_pairs(V, F), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mq
+
+namespace mq {
+namespace {
+
+TEST(MeshIntersections, RealChainMailRingsDoNotIntersect) {
+  const TriMesh mail = read_mesh(test::shared_data("swatch/chainmail3d_48rings_49k.obj"));
+  std::vector<int> fc;
+  EXPECT_EQ(connected_components(mail.F, mail.num_vertices(), fc), 48);
+  EXPECT_TRUE(intersecting_face_pairs(mail.V, mail.F).empty());
+  // Sanity check that the test can fail on this mesh: shift one ring onto its neighbour.
+  const auto groups = component_faces(fc, 48);
+  TriMesh one = extract_faces(mail, groups[0]);
+  TriMesh two = extract_faces(mail, groups[1]);
+  const Vector3d shift = (two.V.colwise().mean() - one.V.colwise().mean()).transpose();
+  one.V.rowwise() += shift.transpose();  // concentric rings of equal size must clash
+  EXPECT_TRUE(meshes_intersect(one, two));
+}
+
+}  // namespace
+}  // namespace mq
