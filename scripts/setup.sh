@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Fresh Debian 12 machine: installs what is missing, builds in Release, runs the default job.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install_deps.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$(nproc)"
+mkdir -p out
+mq=build/meshquilt
+# The default job: a generated 4-in-1 chain mail swatch quilted over a plane, and a picture.
+$mq swatch chainmail -o out/chainmail_swatch.obj
+$mq info out/chainmail_swatch.obj
+$mq plane --swatch out/chainmail_swatch.obj --size 30 30 -o out/chainmail_plane.obj \
+  --stats out/chainmail_plane.json
+$mq info out/chainmail_plane.obj
+$mq render out/chainmail_plane.obj -o out/chainmail_plane.png
+echo "setup: done; results in out/ (chainmail_plane.obj, .json, .png)"
