@@ -24,7 +24,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGolden = 0.6180339887498949;  // 1/phi: successive multiples spread evenly
 constexpr double kFill = 0.8;                   // fraction of the image the object spans
-constexpr double kCreaseDeg = 50;               // normals are not averaged across sharper creases
+constexpr double kCreaseDeg = 75;               // normals are not averaged across sharper creases
 
 struct DeviceDeleter {
   void operator()(RTCDevice d) const { rtcReleaseDevice(d); }
@@ -265,7 +265,7 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
            static_cast<int>(err), ")");
 
   const Camera cam = frame_camera(P, referenced, o, radius);
-  const Vector3d key = (-0.5 * cam.right + 0.75 * cam.up - 0.45 * cam.forward).normalized();
+  const Vector3d key = (-0.65 * cam.right + 0.7 * cam.up - 0.3 * cam.forward).normalized();
   const Vector3d head = -cam.forward;
   const Vector3d bg_lin(srgb_to_linear(o.background[0] / 255.0),
                         srgb_to_linear(o.background[1] / 255.0),
@@ -320,18 +320,29 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
     if (ng.squaredNorm() == 0) ng = -dir;
     Vector3d n = (1 - u - v) * CN.row(3 * f) + u * CN.row(3 * f + 1) + v * CN.row(3 * f + 2);
     n = n.squaredNorm() > 1e-12 ? Vector3d(n.normalized()) : ng;
-    if (ng.dot(dir) > 0) {  // back face: shade the side we see
-      ng = -ng;
-      n = -n;
-    }
+    const double side = ng.dot(dir) > 0 ? -1.0 : 1.0;  // back face: shade the side we see
+    ng *= side;
+    n *= side;
     const double key_dot = std::max(0.0, n.dot(key));
-    // Where the true surface faces away from the light the smooth normal still fades out;
-    // only test occlusion where the light can reach the geometry.
-    const double key_vis = key_dot > 0 && ng.dot(key) > 0 && in_shadow(p, ng) ? 0.0 : 1.0;
+    // Shadow rays start from p lifted onto the smooth surface the corner normals describe
+    // (Hanika 2021, "Hacking the shadow terminator"), so the facets of a curved surface do not
+    // shadow each other near the terminator. Where the true surface faces away from the light
+    // the smooth normal fades the light out by itself, so occlusion is tested only where the
+    // light can reach the geometry.
+    double key_vis = 1;
+    if (key_dot > 0 && ng.dot(key) > 0) {
+      Vector3d origin = p;
+      const double b[3] = {1 - u - v, u, v};
+      for (int k = 0; k < 3; ++k) {
+        const Vector3d nk = side * CN.row(3 * f + k);
+        origin -= b[k] * std::min(0.0, (p - P.row(F(f, k)).transpose()).dot(nk)) * nk;
+      }
+      key_vis = in_shadow(origin, ng) ? 0.0 : 1.0;
+    }
     const double head_dot = std::max(0.0, n.dot(head));
-    const double rim = 0.22 * std::pow(1 - std::max(0.0, n.dot(-dir)), 3);
+    const double rim = 0.12 * std::pow(1 - std::max(0.0, n.dot(-dir)), 3);
     const Vector3d& a = albedo[face_component[f]];
-    return a * (0.10 + 0.70 * key_dot * key_vis + 0.35 * head_dot) + Vector3d::Constant(rim);
+    return a * (0.05 + 0.85 * key_dot * key_vis + 0.22 * head_dot) + Vector3d::Constant(rim);
   };
 
   Image image;

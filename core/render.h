@@ -38,7 +38,7 @@ struct Image {
 // a soft rim term, hard shadows from the key light, two-sided (back faces use the flipped
 // normal, so inverted meshes look right). Elements whose faces are coherently oriented are
 // smooth shaded with area-weighted normals that do not average across creases sharper than
-// 50 degrees; other elements are flat shaded. Rows are rendered in parallel (TBB); the bytes
+// 75 degrees; other elements are flat shaded. Rows are rendered in parallel (TBB); the bytes
 // are identical whatever the thread count.
 //   mesh  V #V by 3, F #F by 3 (N is ignored)
 // Throws InvalidInput for an empty mesh, a non-finite coordinate, an out-of-range index or an
