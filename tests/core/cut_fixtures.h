@@ -1,7 +1,9 @@
 // Procedural fixtures shared by the element cut and stitch tests.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 #include <vector>
@@ -45,17 +47,28 @@ inline TriMesh tube(double x0, double x1, int nx, int nt, double r, double phase
   return m;
 }
 
-// Brute-force Dist(v, other) for every vertex of mesh.
+// Dist(v, other) for every vertex of V, by exhaustive search with bounding-sphere culling.
 inline Eigen::VectorXd distance_to_mesh(const MatrixX3d& V, const TriMesh& other) {
+  const Eigen::Index nf = other.F.rows();
+  std::vector<Vector3d> a(nf), b(nf), c(nf), center(nf);
+  std::vector<double> radius(nf);
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    a[f] = other.V.row(other.F(f, 0)).transpose();
+    b[f] = other.V.row(other.F(f, 1)).transpose();
+    c[f] = other.V.row(other.F(f, 2)).transpose();
+    center[f] = (a[f] + b[f] + c[f]) / 3.0;
+    radius[f] =
+        std::max({(a[f] - center[f]).norm(), (b[f] - center[f]).norm(), (c[f] - center[f]).norm()});
+  }
   Eigen::VectorXd d(V.rows());
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    double best = std::numeric_limits<double>::infinity();
     const Vector3d p = V.row(v).transpose();
-    for (Eigen::Index f = 0; f < other.F.rows(); ++f)
-      best = std::min(
-          best, point_triangle_squared_distance<double>(p, other.V.row(other.F(f, 0)).transpose(),
-                                                        other.V.row(other.F(f, 1)).transpose(),
-                                                        other.V.row(other.F(f, 2)).transpose()));
+    double best = std::numeric_limits<double>::infinity();
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      const double lower = std::max(0.0, (p - center[f]).norm() - radius[f]);
+      if (lower * lower >= best) continue;
+      best = std::min(best, point_triangle_squared_distance<double>(p, a[f], b[f], c[f]));
+    }
     d(v) = std::sqrt(best);
   }
   return d;

@@ -200,6 +200,10 @@ TEST(ElementStitch, RefusesLoopsTooFarApartOrMissing) {
   const TriMesh b_full = test::tube(-0.1, 1.0, 20, 14, 0.3, 0.1, true);
   const TriMesh A = cut_against(a_full, b_full, -0.1, 0.0);
   TriMesh B = cut_against(b_full, a_full, 0.1, 0.0);
+  // A B part that is flipped winds the same way as A at the seam: not compatible.
+  TriMesh flipped = B;
+  flipped.F.col(1).swap(flipped.F.col(2));
+  EXPECT_FALSE(stitch_cut_elements(A, flipped).has_value());
   StitchOptions options;
   options.max_loop_distance = 0.5;
   EXPECT_TRUE(stitch_cut_elements(A, B, options).has_value());
@@ -208,10 +212,6 @@ TEST(ElementStitch, RefusesLoopsTooFarApartOrMissing) {
   // A closed B has no seam loop.
   EXPECT_FALSE(stitch_cut_elements(A, b_full).has_value());
   EXPECT_FALSE(stitch_cut_elements(A, TriMesh{}).has_value());
-  // A B part that is flipped winds the same way as A at the seam: not compatible.
-  TriMesh flipped = cut_against(b_full, a_full, 0.1, 0.0);
-  flipped.F.col(1).swap(flipped.F.col(2));
-  EXPECT_FALSE(stitch_cut_elements(A, flipped).has_value());
 }
 
 TEST(ElementStitch, RejectsBadInput) {
