@@ -113,7 +113,7 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
                                                 const StitchOptions& options) {
   MQ_CHECK(A.V.allFinite() && B.V.allFinite(), InvalidInput,
            "stitch_cut_elements: a vertex has a non-finite coordinate");
-  MQ_CHECK(!(options.max_loop_distance < 0), InvalidInput,
+  MQ_CHECK(options.max_loop_distance >= 0, InvalidInput,
            "stitch_cut_elements: max_loop_distance is negative or NaN");
   StitchResult result;
   result.mesh = A;

@@ -220,6 +220,8 @@ TEST(ElementStitch, RejectsBadInput) {
   StitchOptions bad;
   bad.max_loop_distance = -1;
   EXPECT_THROW(stitch_cut_elements(A, B, bad), InvalidInput);
+  bad.max_loop_distance = std::nan("");
+  EXPECT_THROW(stitch_cut_elements(A, B, bad), InvalidInput);
   A.V(0, 0) = std::nan("");
   EXPECT_THROW(stitch_cut_elements(A, B), InvalidInput);
   A = test::tube(0, 1, 3, 6, 0.3, 0, false);
