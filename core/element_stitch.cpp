@@ -1,0 +1,155 @@
+#include "core/element_stitch.h"
+
+#include <algorithm>
+
+#include "core/boundary_loops.h"
+#include "core/errors.h"
+#include "core/mesh_topology.h"
+
+namespace mq {
+
+namespace {
+
+struct Loop {
+  std::vector<int> vertices;  // in merged-mesh numbering, following the faces' orientation
+  Vector3d centroid = Vector3d::Zero();
+  Vector3d vector_area = Vector3d::Zero();  // its direction gives the winding sense
+};
+
+std::vector<Loop> describe_loops(const MatrixX3d& V, const MatrixX3i& F, int offset) {
+  std::vector<Loop> loops;
+  for (std::vector<int>& raw : boundary_loops(F, static_cast<int>(V.rows()))) {
+    Loop loop;
+    for (int& v : raw) {
+      loop.centroid += V.row(v).transpose();
+      v += offset;
+    }
+    loop.centroid /= static_cast<double>(raw.size());
+    for (size_t i = 0; i < raw.size(); ++i) {
+      const Vector3d p = V.row(raw[i] - offset).transpose() - loop.centroid;
+      const Vector3d q = V.row(raw[(i + 1) % raw.size()] - offset).transpose() - loop.centroid;
+      loop.vector_area += 0.5 * p.cross(q);
+    }
+    loop.vertices = std::move(raw);
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// The two sides of a seam wind in opposite senses when both parts are oriented alike.
+bool compatible(const Loop& a, const Loop& b) { return a.vector_area.dot(b.vector_area) <= 0; }
+
+// Index of the loop of `others` whose centroid is nearest to `loop` (the first on ties), or -1.
+int nearest_loop(const Loop& loop, const std::vector<Loop>& others) {
+  int best = -1;
+  double best_d = 0;
+  for (size_t i = 0; i < others.size(); ++i) {
+    const double d = (loop.centroid - others[i].centroid).squaredNorm();
+    if (best < 0 || d < best_d) {
+      best = static_cast<int>(i);
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+Vector3d row(const MatrixX3d& V, int i) { return V.row(i).transpose(); }
+
+// Zipper strip between loop a (walked backwards) and loop b (walked forwards), appended to F.
+void bridge(const MatrixX3d& V, const std::vector<int>& a, const std::vector<int>& b,
+            std::vector<Eigen::Vector3i>& faces) {
+  const int n = static_cast<int>(a.size()), m = static_cast<int>(b.size());
+  int p = 0, q = 0;
+  double best = -1;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double d = (row(V, a[i]) - row(V, b[j])).squaredNorm();
+      if (best < 0 || d < best) {
+        best = d;
+        p = i;
+        q = j;
+      }
+    }
+  for (int done_a = 0, done_b = 0; done_a < n || done_b < m;) {
+    const int ap = a[p], a_prev = a[(p + n - 1) % n], bq = b[q], b_next = b[(q + 1) % m];
+    bool advance_a = done_b == m;
+    if (done_a < n && done_b < m)
+      advance_a = (row(V, a_prev) - row(V, bq)).squaredNorm() <=
+                  (row(V, ap) - row(V, b_next)).squaredNorm();
+    if (advance_a) {
+      faces.emplace_back(ap, a_prev, bq);  // uses a_prev -> ap reversed
+      p = (p + n - 1) % n;
+      ++done_a;
+    } else {
+      faces.emplace_back(ap, b_next, bq);  // uses bq -> b_next reversed
+      q = (q + 1) % m;
+      ++done_b;
+    }
+  }
+}
+
+// Closest point to x on the closed polyline through `loop`.
+Vector3d closest_on_loop(const MatrixX3d& V, const std::vector<int>& loop, const Vector3d& x) {
+  Vector3d best = row(V, loop[0]);
+  double best_d = (best - x).squaredNorm();
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const Vector3d p = row(V, loop[i]), q = row(V, loop[(i + 1) % loop.size()]);
+    const Vector3d d = q - p;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((x - p).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const Vector3d c = p + t * d;
+    const double dist = (c - x).squaredNorm();
+    if (dist < best_d) {
+      best_d = dist;
+      best = c;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh& B,
+                                                const StitchOptions& options) {
+  MQ_CHECK(A.V.allFinite() && B.V.allFinite(), InvalidInput,
+           "stitch_cut_elements: a vertex has a non-finite coordinate");
+  MQ_CHECK(options.max_loop_distance >= 0, InvalidInput,
+           "stitch_cut_elements: max_loop_distance is negative or NaN");
+  StitchResult result;
+  result.mesh = A;
+  append_mesh(result.mesh, B);
+  const MatrixX3d& V = result.mesh.V;
+  const std::vector<Loop> loops_a = describe_loops(A.V, A.F, 0);
+  const std::vector<Loop> loops_b = describe_loops(B.V, B.F, A.num_vertices());
+
+  std::vector<Eigen::Vector3i> bridge_faces;
+  for (size_t i = 0; i < loops_a.size(); ++i) {
+    const int j = nearest_loop(loops_a[i], loops_b);
+    if (j < 0 || nearest_loop(loops_b[j], loops_a) != static_cast<int>(i)) continue;
+    if (!compatible(loops_a[i], loops_b[j])) continue;
+    if (!((loops_a[i].centroid - loops_b[j].centroid).norm() <= options.max_loop_distance))
+      continue;
+    const Loop& la = loops_a[i];
+    const Loop& lb = loops_b[j];
+    bridge(V, la.vertices, lb.vertices, bridge_faces);
+    for (int v : la.vertices)
+      result.constraints.push_back(LinearConstraint::point(
+          v, 0.5 * (row(V, v) + closest_on_loop(V, lb.vertices, row(V, v)))));
+    for (int v : lb.vertices)
+      result.constraints.push_back(LinearConstraint::point(
+          v, 0.5 * (row(V, v) + closest_on_loop(V, la.vertices, row(V, v)))));
+    ++result.bridged_loops;
+  }
+  if (result.bridged_loops == 0) return std::nullopt;
+
+  MatrixX3i& F = result.mesh.F;
+  const Eigen::Index old_rows = F.rows();
+  F.conservativeResize(old_rows + static_cast<Eigen::Index>(bridge_faces.size()), 3);
+  for (size_t k = 0; k < bridge_faces.size(); ++k)
+    F.row(old_rows + static_cast<Eigen::Index>(k)) = bridge_faces[k].transpose();
+  std::vector<int> face_component;
+  if (connected_components(F, result.mesh.num_vertices(), face_component) != 1) return std::nullopt;
+  return result;
+}
+
+}  // namespace mq
