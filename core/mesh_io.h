@@ -1,0 +1,60 @@
+// Reading and writing triangle meshes in OBJ, PLY and OFF.
+//
+// Files are read whole into memory and parsed by hand (std::from_chars) and written through a
+// large buffer (std::to_chars), so meshes with millions of faces load and save in seconds.
+#pragma once
+
+#include <string>
+
+#include "core/mesh.h"
+
+namespace mq {
+
+enum class MeshFormat { Obj, Ply, Off };
+
+// Format from the file extension (.obj .ply .off, case-insensitive).
+// Throws InvalidInput naming the file for any other extension.
+MeshFormat mesh_format_from_path(const std::string& path);
+
+// Reads a triangle mesh from an OBJ, PLY or OFF file (format chosen by extension).
+//
+// Polygons with more than three corners are fan-triangulated (0,i,i+1). OBJ faces may use the
+// "v", "v/vt", "v//vn" and "v/vt/vn" forms and negative (relative) indices; other OBJ
+// statements (vt, g, o, usemtl, l, ...) are ignored. OFF accepts the OFF/COFF/NOFF/CNOFF/STOFF
+// headers and '#' comments. PLY accepts ascii, binary_little_endian and binary_big_endian, any
+// order of vertex properties (x y z as any scalar type), face lists with any integer count and
+// index types, and skips unknown properties and elements.
+//
+// Returns V (#V by 3), F (#F by 3, 0-based) and N (#V by 3) when the file carries complete
+// per-vertex normals (PLY nx ny nz, NOFF normals, or OBJ vn referenced consistently by every
+// corner of every vertex); otherwise N is empty. Unreferenced vertices are kept.
+//
+// Throws InvalidInput "FILE:LINE: problem" (for binary PLY "FILE: <element> N: problem") for a
+// missing or unreadable file, an empty file or one with no faces, an unknown format, truncated
+// data, a bad or out-of-range index, a face with fewer than 3 vertices, a NaN/Inf coordinate, a
+// malformed number, or unsupported PLY content.
+TriMesh read_mesh(const std::string& path);
+
+struct WriteOptions {
+  // PLY only: binary little-endian (true) or ASCII (false).
+  bool binary = true;
+  // Write per-vertex normals (OBJ vn, PLY nx ny nz, NOFF). Uses mesh.N when it is #V by 3,
+  // otherwise area-weighted vertex normals computed from V and F.
+  bool write_normals = false;
+  // Significant digits for coordinates in text formats; 17 round-trips doubles exactly.
+  // A value <= 0 writes the shortest text that round-trips exactly.
+  int precision = 9;
+};
+
+// Writes mesh to path in the format given by its extension. Output bytes depend only on the mesh
+// and options. PLY coordinates are stored as double.
+//
+// The data go to a temporary file in the same directory which is then renamed over path, so a
+// failed or interrupted write never leaves a partial file at path (an existing file is kept).
+//
+// Preconditions: V finite; F entries in [0, #V); N, when used, finite and #V by 3.
+// Throws InvalidInput for an unknown extension or a violated precondition; Error naming the file
+// for an I/O failure (unwritable directory, disk full).
+void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions& options = {});
+
+}  // namespace mq
