@@ -20,9 +20,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Eq. (1) for one point-face pair, given the squared distance. Kept in one place (and mirrored
 // in kernels/translation_cost.cl) so that every path evaluates it identically.
-inline double face_cost(double dist2, const Vector3d& n, const double* fn, double lambda) {
+inline double normal_factor(const Vector3d& n, const double* fn) {
   const double dx = n(0) - fn[0], dy = n(1) - fn[1], dz = n(2) - fn[2];
-  return (1.0 + lambda * std::sqrt(dist2)) * (1.0 + std::sqrt(dx * dx + dy * dy + dz * dz));
+  return 1.0 + std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+inline double face_cost(double dist2, const Vector3d& n, const double* fn, double lambda) {
+  return (1.0 + lambda * std::sqrt(dist2)) * normal_factor(n, fn);
 }
 
 inline double triangle_dist2(const Vector3d& q, const double* t) {
@@ -139,6 +142,23 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
           cell_faces_[count[(z * dims_(1) + y) * dims_(0) + x]++] = static_cast<int>(f);
   }
 
+  cell_cones_.assign(4 * std::size_t(num_cells), 0.0);
+  for (int c = 0; c < num_cells; ++c) {
+    Vector3d mean = Vector3d::Zero();
+    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j)
+      mean += Vector3d(&face_normals_[3 * cell_faces_[j]]);
+    const double len = mean.norm();
+    const Vector3d dir = len > 1e-12 ? Vector3d(mean / len) : Vector3d::Zero();
+    double r = 0.0;
+    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j)
+      r = std::max(r, (Vector3d(&face_normals_[3 * cell_faces_[j]]) - dir).norm());
+    // Slightly enlarged so that rounding never makes the bound exceed a face's true factor.
+    cell_cones_[4 * c + 0] = dir(0);
+    cell_cones_[4 * c + 1] = dir(1);
+    cell_cones_[4 * c + 2] = dir(2);
+    cell_cones_[4 * c + 3] = r * (1 + 1e-12) + 1e-12;
+  }
+
   std::uint64_t fp = 14695981039346656037ull;
   fnv1a(fp, origin_.data(), sizeof(double) * 3);
   fnv1a(fp, &cell_size_, sizeof(double));
@@ -147,6 +167,7 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
   fnv1a(fp, face_normals_.data(), sizeof(double) * face_normals_.size());
   fnv1a(fp, cell_start_.data(), sizeof(int) * cell_start_.size());
   fnv1a(fp, cell_faces_.data(), sizeof(int) * cell_faces_.size());
+  fnv1a(fp, cell_cones_.data(), sizeof(double) * cell_cones_.size());
   fingerprint_ = fp;
 }
 
@@ -191,13 +212,20 @@ double SwatchDistanceGrid::min_face_cost(const Vector3d& q, const Vector3d& n,
           const int z = shell ? zi : zs[zi];
           if (z < 0 || z >= dims_(2)) continue;
           const double gz = gap(2, z);
-          const double cell_lb = std::sqrt(gx * gx + gy * gy + gz * gz) - slack;
-          if (1.0 + lambda * cell_lb * h >= best) continue;
+          const double dist_factor =
+              1.0 + lambda * (std::sqrt(gx * gx + gy * gy + gz * gz) - slack) * h;
+          if (dist_factor >= best) continue;
           const int cell = (z * dims_(1) + y) * dims_(0) + x;
+          const double* cone = &cell_cones_[4 * cell];
+          const double cx = n(0) - cone[0], cy = n(1) - cone[1], cz = n(2) - cone[2];
+          const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
+          if (dist_factor * (1.0 + std::max(0.0, cone_lb)) >= best) continue;
           for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j) {
             const int f = cell_faces_[j];
+            const double nf = normal_factor(n, &face_normals_[3 * f]);
+            if (dist_factor * nf >= best) continue;
             const double d2 = triangle_dist2(q, &triangles_[9 * f]);
-            best = std::min(best, face_cost(d2, n, &face_normals_[3 * f], lambda));
+            best = std::min(best, (1.0 + lambda * std::sqrt(d2)) * nf);  // face_cost
           }
         }
       }

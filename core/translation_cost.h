@@ -44,7 +44,9 @@ class SwatchDistanceGrid {
   // min over faces f of (1 + lambda * Dist(q, f)) * (1 + |n - n(f)|): Eq. (2) for the
   // query point q = v - t. Exact: cells are visited ring by ring around q's cell and the
   // search stops once a ring's distance lower bound d satisfies 1 + lambda * d >= best,
-  // which no face beyond can beat because the normal factor is >= 1.
+  // which no face beyond can beat because the normal factor is >= 1. Within the rings a cell
+  // is skipped when its distance bound times its normal-cone bound cannot beat best, and a
+  // face when the cell's distance bound times the face's exact normal factor cannot.
   double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda) const;
 
   int num_faces() const { return num_faces_; }
@@ -60,6 +62,9 @@ class SwatchDistanceGrid {
   // #cells + 1: faces of cell c are cell_faces()[cell_start()[c] .. cell_start()[c + 1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
   const std::vector<int>& cell_faces() const { return cell_faces_; }
+  // #cells * 4: per cell a direction c and radius r with |n(f) - c| <= r for its faces, so
+  // |n - n(f)| >= |n - c| - r bounds the normal factor of the whole cell.
+  const std::vector<double>& cell_normal_cones() const { return cell_cones_; }
   // A 64-bit hash of all the arrays above: equal grids have equal fingerprints, so device-side
   // copies can be cached by it.
   std::uint64_t fingerprint() const { return fingerprint_; }
@@ -73,6 +78,7 @@ class SwatchDistanceGrid {
   std::vector<double> face_normals_;
   std::vector<int> cell_start_;
   std::vector<int> cell_faces_;
+  std::vector<double> cell_cones_;
   std::uint64_t fingerprint_ = 0;
 };
 

@@ -56,6 +56,7 @@ const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
   d.face_normals = make_buffer(ctx, grid.face_normals().data(), grid.face_normals().size());
   d.cell_start = make_buffer(ctx, grid.cell_start().data(), grid.cell_start().size());
   d.cell_faces = make_buffer(ctx, grid.cell_faces().data(), grid.cell_faces().size());
+  d.cell_cones = make_buffer(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
   return grids_.emplace(grid.fingerprint(), std::move(d)).first->second;
 }
 
@@ -86,16 +87,17 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
   set_arg(k, 4, dg.face_normals.get());
   set_arg(k, 5, dg.cell_start.get());
   set_arg(k, 6, dg.cell_faces.get());
-  set_arg(k, 7, grid.origin()(0));
-  set_arg(k, 8, grid.origin()(1));
-  set_arg(k, 9, grid.origin()(2));
-  set_arg(k, 10, grid.cell_size());
-  set_arg(k, 11, cl_int(grid.dims()(0)));
-  set_arg(k, 12, cl_int(grid.dims()(1)));
-  set_arg(k, 13, cl_int(grid.dims()(2)));
-  set_arg(k, 14, problem.lambda);
-  set_arg(k, 15, cl_int(P));
-  set_arg(k, 16, out.get());
+  set_arg(k, 7, dg.cell_cones.get());
+  set_arg(k, 8, grid.origin()(0));
+  set_arg(k, 9, grid.origin()(1));
+  set_arg(k, 10, grid.origin()(2));
+  set_arg(k, 11, grid.cell_size());
+  set_arg(k, 12, cl_int(grid.dims()(0)));
+  set_arg(k, 13, cl_int(grid.dims()(1)));
+  set_arg(k, 14, cl_int(grid.dims()(2)));
+  set_arg(k, 15, problem.lambda);
+  set_arg(k, 16, cl_int(P));
+  set_arg(k, 17, out.get());
 
   std::vector<double> minima(P * chunk);
   for (std::size_t t0 = 0; t0 < T; t0 += chunk) {

@@ -34,7 +34,7 @@ class TranslationCostOpenCL final : public TranslationCostEvaluator {
 
  private:
   struct DeviceGrid {
-    cl::Buffer triangles, face_normals, cell_start, cell_faces;
+    cl::Buffer triangles, face_normals, cell_start, cell_faces, cell_cones;
   };
   const DeviceGrid& upload(const SwatchDistanceGrid& grid);
 

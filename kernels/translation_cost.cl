@@ -68,6 +68,7 @@ __kernel void translation_cost_minima(
     __global const real* face_normals,  // #F * 3
     __global const int* cell_start,     // #cells + 1
     __global const int* cell_faces,
+    __global const real* cell_cones,    // #cells * 4: normal cone (direction, radius)
     const real origin_x, const real origin_y, const real origin_z, const real h,
     const int nx, const int ny, const int nz, const real lambda, const int num_points,
     __global real* out) {                // #T * #P
@@ -106,18 +107,21 @@ __kernel void translation_cost_minima(
           const int z = shell ? zi : (zi == 0 ? c[2] - k : c[2] + k);
           if (z < 0 || z >= nz) continue;
           const real gz = cell_gap(g[2], z);
-          const real cell_lb = sqrt(gx * gx + gy * gy + gz * gz) - slack;
-          if (1 + lambda * cell_lb * h >= best) continue;
+          const real dist_factor = 1 + lambda * (sqrt(gx * gx + gy * gy + gz * gz) - slack) * h;
+          if (dist_factor >= best) continue;
           const int cell = (z * ny + y) * nx + x;
+          const real3 dc = n - vload3(0, cell_cones + 4 * cell);
+          const real cone_lb = sqrt(dc.x * dc.x + dc.y * dc.y + dc.z * dc.z) - cell_cones[4 * cell + 3];
+          if (dist_factor * (1 + fmax((real)0, cone_lb)) >= best) continue;
           for (int j = cell_start[cell]; j < cell_start[cell + 1]; ++j) {
             const int f = cell_faces[j];
+            const real3 dn = n - vload3(f, face_normals);
+            const real nf = 1 + sqrt(dn.x * dn.x + dn.y * dn.y + dn.z * dn.z);
+            if (dist_factor * nf >= best) continue;
             const real d2 = triangle_dist2(q, vload3(3 * f, triangles),
                                            vload3(3 * f + 1, triangles),
                                            vload3(3 * f + 2, triangles));
-            const real3 dn = n - vload3(f, face_normals);
-            const real cost = (1 + lambda * sqrt(d2)) *
-                              (1 + sqrt(dn.x * dn.x + dn.y * dn.y + dn.z * dn.z));
-            best = fmin(best, cost);
+            best = fmin(best, (1 + lambda * sqrt(d2)) * nf);
           }
         }
       }
