@@ -1,0 +1,102 @@
+// Translation cost (paper section 2.4, Eqs. 1-3): OpenCL kernel vs TBB path vs brute force.
+// Realistic size: ~2,000 output points x 400 offsets against the 11,828-face chain-link swatch.
+// items_per_second counts (point, offset) pairs, so the three rates compare directly even
+// though brute force runs on a reduced problem.
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <random>
+
+#include "core/geometry_measures.h"
+#include "core/mesh_io.h"
+#include "core/translation_cost.h"
+#include "host/opencl_runtime.h"
+#include "host/translation_cost_opencl.h"
+
+namespace mq {
+namespace {
+
+struct Fixture {
+  TriMesh swatch;
+  TranslationCostProblem problem;
+};
+
+// Output points: every stride-th swatch vertex, jittered and moved; offsets: a 20 x 20 grid of
+// whole-cell translations around the true shift (t_z = 0).
+Fixture make_fixture(int stride, int offsets_per_axis) {
+  Fixture fx;
+  fx.swatch = read_mesh(std::string(MESHQUILT_SHARED_DATA) + "/swatch/chainlink_half_12k.obj");
+  const MatrixX3d N = vertex_normals(fx.swatch.V, fx.swatch.F);
+  const double h = mean_edge_length(fx.swatch.V, fx.swatch.F);
+  std::mt19937_64 rng(42);
+  auto jitter = [&] { return (double(rng() >> 11) * 0x1.0p-53 - 0.5) * 0.4 * h; };
+  const int P = (fx.swatch.num_vertices() + stride - 1) / stride;
+  const Vector3d shift(3 * h, 2 * h, 0);
+  TranslationCostProblem& pb = fx.problem;
+  pb.points.resize(P, 3);
+  pb.point_normals.resize(P, 3);
+  for (int i = 0; i < P; ++i) {
+    pb.points.row(i) = fx.swatch.V.row(i * stride) + shift.transpose() +
+                       Eigen::RowVector3d(jitter(), jitter(), jitter());
+    pb.point_normals.row(i) = N.row(i * stride);
+  }
+  const int n = offsets_per_axis;
+  pb.offsets.resize(n * n, 3);
+  for (int i = 0; i < n * n; ++i)
+    pb.offsets.row(i) = shift + Vector3d(h * (i % n - n / 2), h * (i / n - n / 2), 0);
+  return fx;
+}
+
+void set_counters(benchmark::State& state, const TranslationCostProblem& pb, int faces) {
+  const double pairs = double(pb.points.rows()) * double(pb.offsets.rows());
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * pairs));
+  state.counters["points"] = double(pb.points.rows());
+  state.counters["offsets"] = double(pb.offsets.rows());
+  state.counters["faces"] = faces;
+}
+
+void BM_TranslationCostOpenCL(benchmark::State& state) {
+  if (!cl::Runtime::available()) {
+    state.SkipWithError("no OpenCL platform");
+    return;
+  }
+  const Fixture fx = make_fixture(3, 20);
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>());
+  benchmark::DoNotOptimize(ocl.evaluate(grid, fx.problem));  // build + upload outside timing
+  for (auto _ : state) benchmark::DoNotOptimize(ocl.evaluate(grid, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostOpenCL)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TranslationCostTbb(benchmark::State& state) {
+  const Fixture fx = make_fixture(3, 20);
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  for (auto _ : state) benchmark::DoNotOptimize(cpu.evaluate(grid, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostTbb)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TranslationCostBruteForceReduced(benchmark::State& state) {
+  const Fixture fx = make_fixture(30, 4);  // ~200 points x 16 offsets
+  for (auto _ : state)
+    benchmark::DoNotOptimize(translation_cost_brute_force(fx.swatch.V, fx.swatch.F, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostBruteForceReduced)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_SwatchDistanceGridBuild(benchmark::State& state) {
+  const Fixture fx = make_fixture(60, 1);
+  for (auto _ : state) {
+    SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+    benchmark::DoNotOptimize(grid.fingerprint());
+  }
+  state.counters["faces"] = fx.swatch.num_faces();
+}
+BENCHMARK(BM_SwatchDistanceGridBuild)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace mq
+
+BENCHMARK_MAIN();

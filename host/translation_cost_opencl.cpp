@@ -1,0 +1,121 @@
+#include "host/translation_cost_opencl.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "core/errors.h"
+#include "host/opencl_check.h"
+#include "kernels/translation_cost_cl.h"
+
+namespace mq {
+
+namespace {
+
+// Grids kept on the device at once; beyond this the cache is flushed.
+constexpr std::size_t kMaxCachedGrids = 4;
+// Bound on #P * (offsets per launch), i.e. on the minima buffer (8 bytes each).
+constexpr std::size_t kMaxMinimaPerLaunch = std::size_t(1) << 23;
+
+template <typename T>
+cl::Buffer make_buffer(cl_context context, const T* data, std::size_t count) {
+  cl_int err = CL_SUCCESS;
+  // OpenCL rejects zero-sized buffers; a one-element buffer is never read in that case.
+  const std::size_t bytes = sizeof(T) * std::max<std::size_t>(count, 1);
+  cl::Buffer b(clCreateBuffer(context, CL_MEM_READ_ONLY | (count ? CL_MEM_COPY_HOST_PTR : 0), bytes,
+                              count ? const_cast<T*>(data) : nullptr, &err));
+  MQ_CL_CHECK(err);
+  return b;
+}
+
+template <typename T>
+void set_arg(cl_kernel kernel, cl_uint index, const T& value) {
+  MQ_CL_CHECK(clSetKernelArg(kernel, index, sizeof(T), &value));
+}
+
+}  // namespace
+
+TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime)
+    : runtime_(std::move(runtime)) {
+  MQ_CHECK(runtime_, InvalidInput, "TranslationCostOpenCL: null runtime");
+  MQ_CHECK(runtime_->has_fp64(), DeviceError, "OpenCL device \"", runtime_->device_name(),
+           "\" lacks cl_khr_fp64 (double precision), required by the translation-cost kernel");
+  const cl_program program = runtime_->programs().get(kernels::translation_cost_source, "");
+  cl_int err = CL_SUCCESS;
+  kernel_ = cl::Kernel(clCreateKernel(program, "translation_cost_minima", &err));
+  MQ_CL_CHECK(err);
+}
+
+const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
+    const SwatchDistanceGrid& grid) {
+  auto it = grids_.find(grid.fingerprint());
+  if (it != grids_.end()) return it->second;
+  if (grids_.size() >= kMaxCachedGrids) grids_.clear();
+  const cl_context ctx = runtime_->context();
+  DeviceGrid d;
+  d.triangles = make_buffer(ctx, grid.triangles().data(), grid.triangles().size());
+  d.face_normals = make_buffer(ctx, grid.face_normals().data(), grid.face_normals().size());
+  d.cell_start = make_buffer(ctx, grid.cell_start().data(), grid.cell_start().size());
+  d.cell_faces = make_buffer(ctx, grid.cell_faces().data(), grid.cell_faces().size());
+  d.cell_cones = make_buffer(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
+  return grids_.emplace(grid.fingerprint(), std::move(d)).first->second;
+}
+
+Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
+                                                const TranslationCostProblem& problem) {
+  validate_translation_cost_problem(problem);
+  const std::size_t P = static_cast<std::size_t>(problem.points.rows());
+  const std::size_t T = static_cast<std::size_t>(problem.offsets.rows());
+  Eigen::VectorXd E = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(T));
+  if (P == 0 || T == 0) return E;
+  MQ_CHECK(P <= kMaxMinimaPerLaunch, InvalidInput, "translation cost: too many points (", P, ")");
+
+  const DeviceGrid& dg = upload(grid);
+  const cl_context ctx = runtime_->context();
+  const cl_command_queue queue = runtime_->queue();
+  const cl::Buffer points = make_buffer(ctx, problem.points.data(), problem.points.size());
+  const cl::Buffer normals =
+      make_buffer(ctx, problem.point_normals.data(), problem.point_normals.size());
+  const std::size_t chunk = std::min(T, std::max<std::size_t>(1, kMaxMinimaPerLaunch / P));
+  cl_int err = CL_SUCCESS;
+  cl::Buffer out(clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, sizeof(double) * P * chunk, nullptr, &err));
+  MQ_CL_CHECK(err);
+
+  const cl_kernel k = kernel_.get();
+  set_arg(k, 0, points.get());
+  set_arg(k, 1, normals.get());
+  set_arg(k, 3, dg.triangles.get());
+  set_arg(k, 4, dg.face_normals.get());
+  set_arg(k, 5, dg.cell_start.get());
+  set_arg(k, 6, dg.cell_faces.get());
+  set_arg(k, 7, dg.cell_cones.get());
+  set_arg(k, 8, grid.origin()(0));
+  set_arg(k, 9, grid.origin()(1));
+  set_arg(k, 10, grid.origin()(2));
+  set_arg(k, 11, grid.cell_size());
+  set_arg(k, 12, cl_int(grid.dims()(0)));
+  set_arg(k, 13, cl_int(grid.dims()(1)));
+  set_arg(k, 14, cl_int(grid.dims()(2)));
+  set_arg(k, 15, problem.lambda);
+  set_arg(k, 16, cl_int(P));
+  set_arg(k, 17, out.get());
+
+  std::vector<double> minima(P * chunk);
+  for (std::size_t t0 = 0; t0 < T; t0 += chunk) {
+    const std::size_t nt = std::min(chunk, T - t0);
+    const cl::Buffer offsets = make_buffer(ctx, problem.offsets.data() + 3 * t0, 3 * nt);
+    set_arg(k, 2, offsets.get());
+    const std::size_t global[2] = {P, nt};
+    MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 2, nullptr, global, nullptr, 0, nullptr, nullptr));
+    MQ_CL_CHECK(clEnqueueReadBuffer(queue, out.get(), CL_TRUE, 0, sizeof(double) * P * nt,
+                                    minima.data(), 0, nullptr, nullptr));
+    // Eq. (3), in point order as on the CPU.
+    for (std::size_t t = 0; t < nt; ++t) {
+      double s = 0.0;
+      for (std::size_t p = 0; p < P; ++p) s += minima[t * P + p];
+      E(static_cast<Eigen::Index>(t0 + t)) = s;
+    }
+  }
+  return E;
+}
+
+}  // namespace mq

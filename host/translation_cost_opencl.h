@@ -1,0 +1,47 @@
+// OpenCL path of the translation cost (paper section 2.4, Eqs. (1)-(3)); see
+// core/translation_cost.h for the maths and kernels/translation_cost.cl for the kernel.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "core/translation_cost.h"
+#include "host/opencl_handles.h"
+#include "host/opencl_runtime.h"
+
+namespace mq {
+
+// Evaluates all offsets in one 2D launch (points x offsets, split into chunks only to bound the
+// per-(point, offset) minima buffer); the host sums each offset in point order, so results are
+// deterministic and use the same summation order as the CPU path. Runs in double precision;
+// per-offset costs agree with the CPU path to rounding (FP_CONTRACT is off in the kernel; on
+// PoCL's CPU device they came out bitwise identical).
+// Swatch grids are uploaded once and cached by their fingerprint (a few grids at a time).
+class TranslationCostOpenCL final : public TranslationCostEvaluator {
+ public:
+  // Builds the kernel through the runtime's program cache. Throws DeviceError when the device
+  // lacks cl_khr_fp64 or the build fails; InvalidInput when runtime is null.
+  explicit TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime);
+
+  Eigen::VectorXd evaluate(const SwatchDistanceGrid& grid,
+                           const TranslationCostProblem& problem) override;
+  std::string name() const override { return "opencl"; }
+
+  const cl::Runtime& runtime() const { return *runtime_; }
+  // Number of swatch grids currently held on the device.
+  std::size_t num_cached_grids() const { return grids_.size(); }
+
+ private:
+  struct DeviceGrid {
+    cl::Buffer triangles, face_normals, cell_start, cell_faces, cell_cones;
+  };
+  const DeviceGrid& upload(const SwatchDistanceGrid& grid);
+
+  std::shared_ptr<cl::Runtime> runtime_;
+  cl::Kernel kernel_;
+  std::map<std::uint64_t, DeviceGrid> grids_;
+};
+
+}  // namespace mq
