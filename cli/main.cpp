@@ -1,2 +1,72 @@
+// meshquilt: geometric texture synthesis by mesh quilting (Zhou et al. 2006).
 #include <cstdio>
-int main() { std::puts("meshquilt"); return 0; }
+#include <cstring>
+#include <exception>
+#include <new>
+#include <string>
+
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "core/errors.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: meshquilt COMMAND [options]\n"
+    "\n"
+    "Covers surfaces with 3D geometric texture by mesh quilting (Zhou et al. 2006).\n"
+    "\n"
+    "commands:\n"
+    "  plane    grow a swatch into a seamless L x W layer\n"
+    "  swatch   generate a sample swatch (chainmail, weave, apples, ivy)\n"
+    "  info     print counts, bounding box and topology of a mesh file\n"
+    "  render   render a mesh to a PNG preview\n"
+    "\n"
+    "Run 'meshquilt COMMAND --help' for the options of a command.\n";
+
+struct Command {
+  const char* name;
+  int (*run)(int, char**, int);
+};
+
+constexpr Command kCommands[] = {
+    {"info", mq::cli::run_info},
+    {"swatch", mq::cli::run_swatch},
+    {"render", mq::cli::run_render},
+    {"plane", mq::cli::run_plane},
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::puts("meshquilt 0.1.0");
+    return 0;
+  }
+  for (const Command& c : kCommands) {
+    if (std::strcmp(argv[1], c.name) != 0) continue;
+    try {
+      return c.run(argc, argv, 2);
+    } catch (const mq::cli::UsageError& e) {
+      std::fprintf(stderr, "meshquilt %s: %s (see 'meshquilt %s --help')\n", c.name, e.what(),
+                   c.name);
+      return 2;
+    } catch (const mq::Error& e) {
+      std::fprintf(stderr, "meshquilt %s: error: %s\n", c.name, e.what());
+      return 1;
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "meshquilt %s: error: out of memory\n", c.name);
+      return 1;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "meshquilt %s: internal error: %s\n", c.name, e.what());
+      return 3;
+    }
+  }
+  std::fprintf(stderr, "meshquilt: unknown command '%s'\n\n%s", argv[1], kUsage);
+  return 2;
+}

@@ -99,23 +99,6 @@ ActiveTerms validate_constraint(const LinearConstraint& c, size_t index,
 
 }  // namespace
 
-LinearConstraint LinearConstraint::point(int v, const Vector3d& target) {
-  LinearConstraint c;
-  c.vertices = {{v, -1, -1}};
-  c.weights = {{1.0, 0.0, 0.0}};
-  c.target = target;
-  return c;
-}
-
-LinearConstraint LinearConstraint::barycentric(int a, int b, int c, const Vector3d& w,
-                                               const Vector3d& target) {
-  LinearConstraint out;
-  out.vertices = {{a, b, c}};
-  out.weights = {{w.x(), w.y(), w.z()}};
-  out.target = target;
-  return out;
-}
-
 SpMat uniform_laplacian(const MatrixX3i& F, int num_vertices) {
   MQ_CHECK(num_vertices >= 0, InvalidInput, "negative vertex count ", num_vertices);
   const Adjacency adj = vertex_adjacency(F, num_vertices);  // checks the indices

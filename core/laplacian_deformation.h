@@ -6,26 +6,13 @@
 #include <array>
 #include <vector>
 
+#include "core/linear_constraint.h"
 #include "core/mesh.h"
 
 namespace mq {
 
-// One positional constraint on an affine combination of up to three vertices of the element:
-// sum_k weights[k] * w_{vertices[k]} should equal target. Unused slots have vertex -1 and weight
-// 0. Eq. (5) uses a single vertex with weight 1; Eq. (6) uses the three vertices of a face with
-// barycentric weights (alpha, beta, gamma). The weights must sum to 1 (they are barycentric
-// coordinates, possibly negative), which keeps the problem translation invariant.
-struct LinearConstraint {
-  std::array<int, 3> vertices{{-1, -1, -1}};
-  std::array<double, 3> weights{{0, 0, 0}};
-  Vector3d target = Vector3d::Zero();
-
-  // w_v = target (Eq. (5)).
-  static LinearConstraint point(int v, const Vector3d& target);
-  // w(0) w_a + w(1) w_b + w(2) w_c = target (Eq. (6)).
-  static LinearConstraint barycentric(int a, int b, int c, const Vector3d& w,
-                                      const Vector3d& target);
-};
+// LinearConstraint (core/linear_constraint.h): weights of a constraint must sum to 1 (they
+// are barycentric coordinates, possibly negative), which keeps the problem translation invariant.
 
 struct DeformationOptions {
   double mu = 1.0;  // weight of the constraint term; the paper uses 1

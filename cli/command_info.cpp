@@ -1,0 +1,72 @@
+// meshquilt info FILE: counts, bounding box and topology of a mesh.
+#include <cstdio>
+
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "cli/json_writer.h"
+#include "core/atomic_file.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_io.h"
+#include "core/mesh_topology.h"
+
+namespace mq::cli {
+
+int run_info(int argc, char** argv, int first) {
+  CommandLine cl("info", "FILE [--json]",
+                 "Prints the faces, vertices, geometry elements (connected components), bounding\n"
+                 "box, thickness (smallest box side), closedness and manifoldness of a mesh file\n"
+                 "(OBJ, PLY or OFF).");
+  cl.positional("FILE", "mesh file to inspect");
+  cl.flag("json", "print the same figures as JSON");
+  if (!cl.parse(argc, argv, first)) return 0;
+  const std::string path = cl.positional_value("FILE");
+  const TriMesh mesh = read_mesh(path);
+  const TopologyReport topo = topology_report(mesh);
+  const BoundingBox box = bounding_box(mesh.V, mesh.F);
+  const Vector3d size = box.extent();
+  const double area = surface_area(mesh.V, mesh.F);
+  const double edge = mean_edge_length(mesh.V, mesh.F);
+  if (cl.has("json")) {
+    JsonWriter j;
+    j.begin_object()
+        .value("file", path)
+        .value("faces", mesh.num_faces())
+        .value("vertices", mesh.num_vertices())
+        .value("elements", topo.num_components)
+        .begin_array("bbox_min");
+    for (int k = 0; k < 3; ++k) j.value("", box.min(k));
+    j.end_array().begin_array("bbox_max");
+    for (int k = 0; k < 3; ++k) j.value("", box.max(k));
+    j.end_array()
+        .value("thickness", size.minCoeff())
+        .value("closed", topo.closed())
+        .value("manifold", topo.manifold())
+        .value("boundary_edges", topo.num_boundary_edges)
+        .value("non_manifold_edges", topo.num_non_manifold_edges)
+        .value("non_manifold_vertices", topo.num_non_manifold_vertices)
+        .value("degenerate_faces", topo.num_degenerate_faces)
+        .value("surface_area", area)
+        .value("mean_edge_length", edge)
+        .end_object();
+    std::fputs(j.str().c_str(), stdout);
+    return 0;
+  }
+  std::printf("file:              %s\n", path.c_str());
+  std::printf("faces:             %d\n", mesh.num_faces());
+  std::printf("vertices:          %d\n", mesh.num_vertices());
+  std::printf("elements:          %d\n", topo.num_components);
+  std::printf("bounding box:      [%.6g, %.6g, %.6g] - [%.6g, %.6g, %.6g]\n", box.min.x(),
+              box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z());
+  std::printf("size:              %.6g x %.6g x %.6g (thickness %.6g)\n", size.x(), size.y(),
+              size.z(), size.minCoeff());
+  std::printf("closed:            %s\n", topo.closed() ? "yes" : "no");
+  std::printf("boundary edges:    %d\n", topo.num_boundary_edges);
+  std::printf("non-manifold:      %d edges, %d vertices\n", topo.num_non_manifold_edges,
+              topo.num_non_manifold_vertices);
+  std::printf("degenerate faces:  %d\n", topo.num_degenerate_faces);
+  std::printf("surface area:      %.6g\n", area);
+  std::printf("mean edge length:  %.6g\n", edge);
+  return 0;
+}
+
+}  // namespace mq::cli

@@ -1,0 +1,59 @@
+// A small declarative command-line parser for the subcommands: options are declared with their
+// help text, parsed, validated (numbers must be finite and in range) and printed by --help.
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mq::cli {
+
+// Wrong usage: the CLI prints the message and a hint to --help, and exits with status 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class CommandLine {
+ public:
+  CommandLine(std::string command, std::string synopsis, std::string description);
+
+  // --name (no value).
+  void flag(const std::string& name, const std::string& help);
+  // --name VALUE... taking `arity` values; `fallback` is the default shown in --help ("" none).
+  void option(const std::string& name, const std::string& value_names, const std::string& help,
+              const std::string& fallback = "", int arity = 1);
+  // A required positional argument.
+  void positional(const std::string& name, const std::string& help);
+
+  // Parses argv[first..argc). Returns false when --help was given (help already printed).
+  // Throws UsageError for unknown options, missing values or positionals.
+  bool parse(int argc, char** argv, int first);
+
+  bool has(const std::string& name) const;
+  std::string get(const std::string& name) const;  // value, default, or "" when absent
+  std::string get(const std::string& name, int index) const;
+  std::string positional_value(const std::string& name) const;
+  // Numeric getters: throw UsageError naming the option for malformed, NaN or out-of-range.
+  double get_double(const std::string& name, int index = 0, double min = -1e300,
+                    double max = 1e300) const;
+  long long get_int(const std::string& name, long long min, long long max) const;
+
+  std::string help() const;
+
+ private:
+  struct Option {
+    std::string name, value_names, help, fallback;
+    int arity = 0;
+  };
+  const Option* find(const std::string& name) const;
+
+  std::string command_, synopsis_, description_;
+  std::vector<Option> options_;
+  std::vector<std::pair<std::string, std::string>> positionals_;
+  std::map<std::string, std::vector<std::string>> values_;
+  std::map<std::string, std::string> positional_values_;
+};
+
+}  // namespace mq::cli

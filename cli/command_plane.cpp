@@ -1,0 +1,129 @@
+// meshquilt plane: planar mesh quilting (paper section 2).
+#include <chrono>
+#include <cstdio>
+
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "cli/json_writer.h"
+#include "cli/run_context.h"
+#include "core/atomic_file.h"
+#include "core/mesh_io.h"
+#include "core/planar_quilting.h"
+#include "host/translation_cost_evaluator.h"
+
+namespace mq::cli {
+
+namespace {
+
+void write_stats(const std::string& path, const PlanarQuiltingStats& s, const std::string& device,
+                 int threads, double wall, const std::string& swatch, double length,
+                 double width) {
+  JsonWriter j;
+  j.begin_object()
+      .value("command", "plane")
+      .value("swatch", swatch)
+      .value("length", length)
+      .value("width", width)
+      .value("device", device)
+      .value("threads", threads)
+      .value("wall_seconds", wall)
+      .value("cell_size", s.cell_size)
+      .value("grid_nx", s.grid_nx)
+      .value("grid_ny", s.grid_ny)
+      .value("iterations", s.iterations)
+      .begin_object("output")
+      .value("faces", s.faces)
+      .value("vertices", s.vertices)
+      .value("elements", s.elements)
+      .end_object()
+      .begin_object("elements")
+      .value("added", s.elements_added)
+      .value("replaced", s.elements_replaced)
+      .value("stitched", s.elements_stitched)
+      .value("matched", s.elements_matched)
+      .value("dropped", s.elements_dropped)
+      .value("stitch_fallbacks", s.stitch_fallbacks)
+      .value("rejected_intersecting", s.rejected_intersecting)
+      .value("removed_post", s.removed_post)
+      .value("trimmed", s.trimmed)
+      .end_object()
+      .value("pairs", s.pairs)
+      .value("relations", s.relations)
+      .begin_object("stage_seconds");
+  for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
+  j.end_object().end_object();
+  write_file_atomically(path, j.str());
+}
+
+Device parse_device(const std::string& name) {
+  if (name == "auto") return Device::Auto;
+  if (name == "cpu") return Device::Cpu;
+  if (name == "opencl") return Device::OpenCL;
+  throw UsageError("--device expects auto, cpu or opencl, got '" + name + "'");
+}
+
+}  // namespace
+
+int run_plane(int argc, char** argv, int first) {
+  CommandLine cl("plane", "--swatch FILE --size L W -o OUT [options]",
+                 "Grows a swatch (any mesh file; its smallest bounding-box side is the layer's\n"
+                 "thickness) into a seamless L x W layer in the swatch's units, by mesh quilting\n"
+                 "(seed finding, geometry matching, element correspondences, deformation, merging).");
+  cl.option("swatch", "FILE", "input swatch mesh (OBJ, PLY or OFF)");
+  cl.option("size", "L W", "output extent along the swatch's two long axes", "", 2);
+  cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
+  cl.option("seed", "N", "random seed (used with --variety)", "1");
+  cl.option("cell", "SIZE", "grid cell size (default: from the swatch's element size)");
+  cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
+  cl.option("subpatch", "FRACTION", "sub-patch side as a fraction of the swatch side", "0.5");
+  cl.option("device", "auto|cpu|opencl", "where the translation cost runs", "auto");
+  cl.flag("no-deform", "skip element deformation (section 2.6)");
+  cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
+  add_run_options(cl);
+  if (!cl.parse(argc, argv, first)) return 0;
+  if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
+  if (!cl.has("size")) throw UsageError("--size L W is required");
+  if (!cl.has("output")) throw UsageError("-o OUT is required");
+  const std::string out_path = cl.get("output");
+  mesh_format_from_path(out_path);  // fail on an unknown extension before any work
+
+  PlanarQuiltingOptions options;
+  options.length = cl.get_double("size", 0, 1e-300, 1e300);
+  options.width = cl.get_double("size", 1, 1e-300, 1e300);
+  options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
+  if (cl.has("cell")) options.cell_size = cl.get_double("cell", 0, 1e-300, 1e300);
+  options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
+  options.subpatch_fraction = cl.get_double("subpatch", 0, 0.01, 1.0);
+  options.deform = !cl.has("no-deform");
+  options.trim_border = cl.has("trim");
+  const Device device = parse_device(cl.get("device"));
+
+  RunContext run(cl);
+  const auto start = std::chrono::steady_clock::now();
+  const TriMesh swatch = read_mesh(cl.get("swatch"));
+  std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
+  PlanarQuiltingStats stats;
+  const TriMesh result = quilt_plane(swatch, options, *evaluator, &stats, run.progress());
+  {
+    ScopedStageTimer timer(stats.times, "write");
+    write_mesh(out_path, result);
+  }
+  run.progress()->finish();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!run.stats_path().empty())
+    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall,
+                cl.get("swatch"), options.length, options.width);
+  if (!run.quiet()) {
+    std::printf("wrote %s: %d faces, %d vertices, %d elements\n", out_path.c_str(), stats.faces,
+                stats.vertices, stats.elements);
+    std::printf("%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+                "%d added, %d matched, %d removed\n",
+                stats.iterations, wall, evaluator->name().c_str(), run.threads(),
+                stats.elements_stitched, stats.elements_replaced, stats.elements_added,
+                stats.elements_matched, stats.removed_post);
+  }
+  return 0;
+}
+
+}  // namespace mq::cli

@@ -1,0 +1,34 @@
+// Progress on stderr: a bar with the estimated time remaining when stderr is a terminal, plain
+// periodic lines otherwise (logs, CI), nothing when quiet.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "core/progress.h"
+
+namespace mq::cli {
+
+class ConsoleProgress final : public ProgressSink {
+ public:
+  explicit ConsoleProgress(bool quiet);
+  ~ConsoleProgress() override;
+  void update(const std::string& stage, double done, double total) override;
+  void finish() override;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool quiet_;
+  bool terminal_;
+  bool line_open_ = false;
+  Clock::time_point start_;
+  Clock::time_point last_print_;
+  std::string stage_;
+  Clock::time_point stage_start_;
+  double last_fraction_ = -1;
+};
+
+// "1:05" / "1:02:03" for a duration in seconds.
+std::string format_duration(double seconds);
+
+}  // namespace mq::cli

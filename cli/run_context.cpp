@@ -1,0 +1,25 @@
+#include "cli/run_context.h"
+
+#include <tbb/info.h>
+
+namespace mq::cli {
+
+void add_run_options(CommandLine& cl) {
+  cl.flag("quiet", "print nothing but errors (no progress, no summary)");
+  cl.option("stats", "FILE.json", "write counts and per-stage timings as JSON");
+  cl.option("threads", "N", "worker threads (0 = all cores)", "0");
+}
+
+RunContext::RunContext(const CommandLine& cl)
+    : quiet_(cl.has("quiet")),
+      stats_path_(cl.get("stats")),
+      threads_(static_cast<int>(cl.get_int("threads", 0, 1024))),
+      progress_(quiet_) {
+  if (threads_ > 0)
+    control_ = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads_));
+  else
+    threads_ = tbb::info::default_concurrency();
+}
+
+}  // namespace mq::cli

@@ -1,0 +1,106 @@
+#include "core/element_correspondence.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace mq {
+
+namespace {
+
+// Marks the raster cells touched by each triangle's footprint box (a conservative raster).
+std::vector<unsigned char> rasterize(const Element& e, const Vector2d& lo, double res, int nx,
+                                     int ny) {
+  std::vector<unsigned char> bits(static_cast<size_t>(nx) * ny, 0);
+  for (int f = 0; f < e.F.rows(); ++f) {
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (int k = 0; k < 3; ++k) {
+      x0 = std::min(x0, e.V(e.F(f, k), 0));
+      x1 = std::max(x1, e.V(e.F(f, k), 0));
+      y0 = std::min(y0, e.V(e.F(f, k), 1));
+      y1 = std::max(y1, e.V(e.F(f, k), 1));
+    }
+    const int i0 = std::max(0, static_cast<int>((x0 - lo.x()) / res));
+    const int i1 = std::min(nx - 1, static_cast<int>((x1 - lo.x()) / res));
+    const int j0 = std::max(0, static_cast<int>((y0 - lo.y()) / res));
+    const int j1 = std::min(ny - 1, static_cast<int>((y1 - lo.y()) / res));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) bits[static_cast<size_t>(j) * nx + i] = 1;
+  }
+  return bits;
+}
+
+}  // namespace
+
+bool projections_overlap(const Element& a, const Element& b, double resolution) {
+  const Vector2d lo = a.lo.cwiseMax(b.lo), hi = a.hi.cwiseMin(b.hi);
+  if ((lo.array() > hi.array()).any()) return false;
+  const double res = std::max(resolution, 1e-3 * (hi - lo).maxCoeff());
+  if (!(res > 0)) return true;  // both footprints degenerate to the same point
+  const int nx = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / res)) + 1);
+  const int ny = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / res)) + 1);
+  const auto ra = rasterize(a, lo, res, nx, ny), rb = rasterize(b, lo, res, nx, ny);
+  for (size_t i = 0; i < ra.size(); ++i)
+    if (ra[i] && rb[i]) return true;
+  return false;
+}
+
+Correspondences find_correspondences(const std::vector<Element>& output,
+                                     const std::vector<int>& candidates,
+                                     const OverlapRegion& region, const PreparedSwatch& swatch,
+                                     const ClosestPointQuery& swatch_query, const Vector3d& t,
+                                     const CorrespondenceOptions& options) {
+  const double max_distance = options.prune_distance * swatch.mean_edge_length;
+  // Per candidate element, its pairs; filled in parallel, concatenated in candidate order.
+  std::vector<std::vector<VertexFacePair>> per_element(candidates.size());
+  tbb::parallel_for(size_t(0), candidates.size(), [&](size_t i) {
+    const int o = candidates[i];
+    const Element& e = output[o];
+    auto& pairs = per_element[i];
+    for (int v = 0; v < e.V.rows(); ++v) {
+      const Vector3d p = e.V.row(v).transpose();
+      if (!region.contains(p)) continue;
+      const Vector3d n = e.N.row(v).transpose();
+      const ClosestPointHit hit = swatch_query.match(p - t, n, options.lambda, max_distance);
+      if (hit.face < 0 || hit.distance > max_distance) continue;
+      if (n.dot(swatch_query.face_normals().row(hit.face).transpose()) < options.min_normal_dot)
+        continue;
+      VertexFacePair pair;
+      pair.out_element = o;
+      pair.out_vertex = v;
+      pair.in_element = swatch.face_element[hit.face];
+      pair.in_face = hit.face - swatch.element_first_face[pair.in_element];
+      pair.barycentric = hit.barycentric;
+      pair.closest = hit.point + t;
+      pair.distance = hit.distance;
+      pairs.push_back(pair);
+    }
+  });
+  Correspondences result;
+  for (auto& pairs : per_element)
+    for (const auto& p : pairs) result.relations.emplace_back(p.out_element, p.in_element);
+  std::sort(result.relations.begin(), result.relations.end());
+  result.relations.erase(std::unique(result.relations.begin(), result.relations.end()),
+                         result.relations.end());
+  // Drop relations whose projections do not overlap (false correspondences, section 2.5).
+  std::vector<char> keep(result.relations.size(), 1);
+  tbb::parallel_for(size_t(0), result.relations.size(), [&](size_t r) {
+    const auto [o, in] = result.relations[r];
+    Element moved = swatch.elements[in];
+    moved.translate(t);
+    keep[r] = projections_overlap(output[o], moved, swatch.mean_edge_length);
+  });
+  std::vector<std::pair<int, int>> relations;
+  for (size_t r = 0; r < keep.size(); ++r)
+    if (keep[r]) relations.push_back(result.relations[r]);
+  result.relations = std::move(relations);
+  for (auto& pairs : per_element)
+    for (const auto& p : pairs)
+      if (std::binary_search(result.relations.begin(), result.relations.end(),
+                             std::make_pair(p.out_element, p.in_element)))
+        result.pairs.push_back(p);
+  return result;
+}
+
+}  // namespace mq

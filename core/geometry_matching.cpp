@@ -1,0 +1,68 @@
+#include "core/geometry_matching.h"
+
+#include <algorithm>
+
+#include "core/errors.h"
+
+namespace mq {
+
+OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
+                           const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,
+                           const Vector2d& t_min, const Vector2d& t_max, double cell_size,
+                           const MatchingOptions& options, std::mt19937_64& rng) {
+  MQ_CHECK(candidates.rows() > 0, InvalidInput, "geometry matching needs at least one offset");
+  OffsetChoice choice;
+  choice.candidates = static_cast<int>(candidates.rows());
+  if (P.rows() == 0) {
+    // Nothing to match against: the first admissible placement.
+    choice.offset = candidates.row(0).transpose();
+    return choice;
+  }
+  TranslationCostProblem problem;
+  problem.points = P;
+  problem.point_normals = NP;
+  problem.lambda = options.lambda;
+  problem.offsets = candidates;
+  const Eigen::VectorXd costs = evaluator.evaluate(swatch, problem);
+  choice.evaluations = static_cast<int>(costs.size());
+  int best = best_offset(costs);
+  if (options.epsilon > 0) {
+    std::vector<int> near;
+    for (int i = 0; i < costs.size(); ++i)
+      if (costs(i) <= costs(best) * (1 + options.epsilon)) near.push_back(i);
+    best = near[rng() % near.size()];
+  }
+  Vector3d t = candidates.row(best).transpose();
+  double cost = costs(best);
+  if (options.refine_to > 0) {
+    // Compass search: try the four axis moves of the current step; move to the best improving
+    // one, else halve the step. Moves stay within the admissible range.
+    const Vector2d lo = t_min, hi = t_max.cwiseMax(t_min);
+    double step = 0.5 * cell_size;
+    problem.offsets.resize(4, 3);
+    while (step >= options.refine_to * cell_size) {
+      const Vector3d moves[4] = {{step, 0, 0}, {-step, 0, 0}, {0, step, 0}, {0, -step, 0}};
+      for (int k = 0; k < 4; ++k) {
+        Vector3d c = t + moves[k];
+        c.x() = std::clamp(c.x(), lo.x(), hi.x());
+        c.y() = std::clamp(c.y(), lo.y(), hi.y());
+        problem.offsets.row(k) = c.transpose();
+      }
+      const Eigen::VectorXd c = evaluator.evaluate(swatch, problem);
+      choice.evaluations += 4;
+      const int k = best_offset(c);
+      // Require a real improvement so float noise cannot make the search wander.
+      if (c(k) < cost * (1 - 1e-9)) {
+        t = problem.offsets.row(k).transpose();
+        cost = c(k);
+      } else {
+        step *= 0.5;
+      }
+    }
+  }
+  choice.offset = t;
+  choice.cost = cost;
+  return choice;
+}
+
+}  // namespace mq

@@ -1,0 +1,40 @@
+// Geometry matching, paper section 2.4: the placement of the swatch that best continues the
+// output around a seed, minimising E(t) of Eqs. (1)-(3) over whole-cell offsets, then refined
+// below the cell size by a compass search on the same cost.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "core/translation_cost.h"
+
+namespace mq {
+
+struct MatchingOptions {
+  double lambda = 1.0;   // Eq. (1)
+  // Choose at random among offsets within (1 + epsilon) of the minimum (variety); 0 = the
+  // minimum, ties to the lowest candidate index.
+  double epsilon = 0.0;
+  // Refine the chosen whole-cell offset by compass search down to this fraction of a cell
+  // (0 disables). The paper notes finer offsets help; periodic swatches then align exactly.
+  double refine_to = 1e-3;
+};
+
+struct OffsetChoice {
+  Vector3d offset = Vector3d::Zero();
+  double cost = 0;          // E(t) at the chosen offset
+  int candidates = 0;       // whole-cell offsets evaluated
+  int evaluations = 0;      // all offsets evaluated, refinement included
+};
+
+// Picks the swatch translation t for the sub-patch points P (#P by 3, unit normals NP #P by 3)
+// among `candidates` (#T by 3, whole-cell offsets, at least one). The refinement keeps the xy
+// of t inside [t_min, t_max], the continuous range of offsets for which the swatch still covers
+// the sub-patch. rng is used only when epsilon > 0. Throws InvalidInput for no candidates.
+OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
+                           const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,
+                           const Vector2d& t_min, const Vector2d& t_max, double cell_size,
+                           const MatchingOptions& options, std::mt19937_64& rng);
+
+}  // namespace mq

@@ -1,0 +1,58 @@
+// Planar mesh quilting, paper section 2: grows a swatch into a seamless L x W layer by seed
+// finding, geometry matching, element correspondences, element deformation and merging.
+#pragma once
+
+#include <cstdint>
+
+#include "core/element_correspondence.h"
+#include "core/element_merging.h"
+#include "core/geometry_matching.h"
+#include "core/progress.h"
+#include "core/stage_timer.h"
+
+namespace mq {
+
+struct PlanarQuiltingOptions {
+  double length = 0;      // L: output extent along x (swatch units)
+  double width = 0;       // W: output extent along y
+  double cell_size = 0;   // grid cell side; 0 derives it from the swatch's element size
+  // Side of the output sub-patch P_out as a fraction of the swatch's shorter side (section 2.4
+  // only asks that it be smaller than the swatch); larger values match more context.
+  double subpatch_fraction = 0.5;
+  MatchingOptions matching;
+  CorrespondenceOptions correspondence;
+  MergeOptions merging;
+  bool deform = true;        // section 2.6 element deformation
+  bool trim_border = false;  // cut elements crossing the domain border open instead of whole
+  uint64_t seed = 1;         // for the epsilon-random offset choice
+};
+
+struct PlanarQuiltingStats {
+  int iterations = 0;
+  double cell_size = 0;
+  int grid_nx = 0, grid_ny = 0;
+  int pairs = 0;                 // vertex-face pairs kept over all iterations
+  int relations = 0;             // element relations kept over all iterations
+  int elements_added = 0;        // swatch elements without partner added as they are
+  int elements_replaced = 0;     // output elements inside the overlap replaced by swatch ones
+  int elements_stitched = 0;     // cut-and-stitch merges
+  int elements_matched = 0;      // partners that coincided: output kept, no cut needed
+  int elements_dropped = 0;      // swatch elements inside the overlap, or refused merges
+  int stitch_fallbacks = 0;      // cut-and-stitch refused; output element kept whole
+  int rejected_intersecting = 0; // candidates dropped because they would intersect
+  int removed_post = 0;          // removed in post-processing (outside the domain)
+  int trimmed = 0;               // elements cut open at the border (trim_border)
+  int faces = 0, vertices = 0, elements = 0;
+  StageTimes times;
+};
+
+// Runs planar mesh quilting. The swatch's smallest bounding-box side is its thickness; the
+// output lies in [0, L] x [0, W] x [0, thickness] (whole elements may cross the border unless
+// trim_border). Deterministic for given input, options and evaluator results.
+// Throws InvalidInput for impossible parameters (non-positive or non-finite sizes, a domain
+// smaller than every element of the swatch, an output too large to hold in memory).
+TriMesh quilt_plane(const TriMesh& swatch, const PlanarQuiltingOptions& options,
+                    TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats = nullptr,
+                    ProgressSink* progress = nullptr);
+
+}  // namespace mq
