@@ -6,6 +6,7 @@
 #include "cli/json_writer.h"
 #include "core/atomic_file.h"
 #include "core/geometry_measures.h"
+#include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 
@@ -18,6 +19,7 @@ int run_info(int argc, char** argv, int first) {
                  "(OBJ, PLY or OFF).");
   cl.positional("FILE", "mesh file to inspect");
   cl.flag("json", "print the same figures as JSON");
+  cl.flag("intersections", "also count pairs of intersecting faces between different elements");
   if (!cl.parse(argc, argv, first)) return 0;
   const std::string path = cl.positional_value("FILE");
   const TriMesh mesh = read_mesh(path);
@@ -26,6 +28,9 @@ int run_info(int argc, char** argv, int first) {
   const Vector3d size = box.extent();
   const double area = surface_area(mesh.V, mesh.F);
   const double edge = mean_edge_length(mesh.V, mesh.F);
+  const bool check = cl.has("intersections");
+  long long crossing = -1;
+  if (check) crossing = static_cast<long long>(intersecting_face_pairs(mesh.V, mesh.F).size());
   if (cl.has("json")) {
     JsonWriter j;
     j.begin_object()
@@ -46,8 +51,9 @@ int run_info(int argc, char** argv, int first) {
         .value("non_manifold_vertices", topo.num_non_manifold_vertices)
         .value("degenerate_faces", topo.num_degenerate_faces)
         .value("surface_area", area)
-        .value("mean_edge_length", edge)
-        .end_object();
+        .value("mean_edge_length", edge);
+    if (check) j.value("intersecting_face_pairs", crossing);
+    j.end_object();
     std::fputs(j.str().c_str(), stdout);
     return 0;
   }
@@ -66,6 +72,7 @@ int run_info(int argc, char** argv, int first) {
   std::printf("degenerate faces:  %d\n", topo.num_degenerate_faces);
   std::printf("surface area:      %.6g\n", area);
   std::printf("mean edge length:  %.6g\n", edge);
+  if (check) std::printf("intersecting face pairs between elements: %lld\n", crossing);
   return 0;
 }
 

@@ -47,6 +47,11 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
       .value("removed_post", s.removed_post)
       .value("trimmed", s.trimmed)
       .end_object()
+      .begin_object("stitch_failures");
+  for (int k = 1; k < kStitchFailureKinds; ++k)
+    j.value(stitch_failure_name(static_cast<StitchFailure>(k)), s.stitch_failures[k]);
+  j.value("intersecting", s.stitch_failures[0]).end_object()
+      .value("matched_point_offsets", s.matched_point_offsets)
       .value("pairs", s.pairs)
       .value("relations", s.relations)
       .begin_object("stage_seconds");

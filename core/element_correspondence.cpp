@@ -33,17 +33,27 @@ std::vector<unsigned char> rasterize(const Element& e, const Vector2d& lo, doubl
 
 }  // namespace
 
-bool projections_overlap(const Element& a, const Element& b, double resolution) {
-  const Vector2d lo = a.lo.cwiseMax(b.lo), hi = a.hi.cwiseMin(b.hi);
-  if ((lo.array() > hi.array()).any()) return false;
-  const double res = std::max(resolution, 1e-3 * (hi - lo).maxCoeff());
-  if (!(res > 0)) return true;  // both footprints degenerate to the same point
+double footprint_overlap(const Element& a, const Element& b, double resolution) {
+  const Vector2d lo = a.lo.cwiseMin(b.lo), hi = a.hi.cwiseMax(b.hi);
+  const Vector2d ilo = a.lo.cwiseMax(b.lo), ihi = a.hi.cwiseMin(b.hi);
+  if ((ilo.array() > ihi.array()).any()) return 0.0;
+  // Raster over the union box, capped at 512 cells a side so huge elements stay cheap.
+  const double res = std::max(resolution, (hi - lo).maxCoeff() / 512.0);
+  if (!(res > 0)) return 1.0;  // both footprints degenerate to the same point
   const int nx = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / res)) + 1);
   const int ny = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / res)) + 1);
   const auto ra = rasterize(a, lo, res, nx, ny), rb = rasterize(b, lo, res, nx, ny);
-  for (size_t i = 0; i < ra.size(); ++i)
-    if (ra[i] && rb[i]) return true;
-  return false;
+  size_t na = 0, nb = 0, both = 0;
+  for (size_t i = 0; i < ra.size(); ++i) {
+    na += ra[i];
+    nb += rb[i];
+    both += ra[i] & rb[i];
+  }
+  return static_cast<double>(both) / static_cast<double>(std::max<size_t>(1, std::max(na, nb)));
+}
+
+bool projections_overlap(const Element& a, const Element& b, double resolution) {
+  return footprint_overlap(a, b, resolution) > 0.0;
 }
 
 Correspondences find_correspondences(const std::vector<Element>& output,

@@ -51,4 +51,9 @@ Correspondences find_correspondences(const std::vector<Element>& output,
 // given resolution (conservative by at most one cell).
 bool projections_overlap(const Element& a, const Element& b, double resolution);
 
+// Area of the intersection of the two footprints (xy projections of the triangles) over the
+// larger footprint, on the same raster: 1 for the same element placed twice, small when a short
+// piece lies along a long one.
+double footprint_overlap(const Element& a, const Element& b, double resolution);
+
 }  // namespace mq

@@ -4,7 +4,9 @@
 #include "core/closest_point_query.h"
 #include "core/element_cut.h"
 #include "core/element_stitch.h"
+#include "core/errors.h"
 #include "core/laplacian_deformation.h"
+#include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 
 namespace mq {
@@ -25,43 +27,102 @@ int count_boundary_edges(const MatrixX3i& F, int nv) {
   return n;
 }
 
-// Hard labels of section 2.7 for cutting element `a` against its partner `b`.
-std::vector<CutLabel> hard_labels(const Element& a, const Element& b,
-                                  const ClosestPointQuery& query_b, const OverlapRegion& region,
-                                  double cover) {
-  const int nf = static_cast<int>(a.F.rows());
-  std::vector<CutLabel> hard(nf, CutLabel::Free);
-  // Faces of b that have a partner on a (their centroid lies close to a).
-  const ClosestPointQuery query_a(a.V, a.F);
-  const int nfb = static_cast<int>(b.F.rows());
-  std::vector<char> b_covered(nfb, 0), b_outside(nfb, 0);
-  for (int g = 0; g < nfb; ++g) {
-    const Vector3d c =
-        (b.V.row(b.F(g, 0)) + b.V.row(b.F(g, 1)) + b.V.row(b.F(g, 2))).transpose() / 3.0;
-    b_covered[g] = query_a.closest(c, cover).face >= 0;
-    b_outside[g] = !region.contains(c);
-  }
-  const MatrixX3i TT = face_adjacency(edge_topology(b.F, static_cast<int>(b.V.rows())));
-  const Adjacency vf = vertex_faces(a.F, static_cast<int>(a.V.rows()));
-  std::vector<char> sink_vertex(a.V.rows(), 0);
-  for (int v = 0; v < a.V.rows(); ++v) {
-    const ClosestPointHit hit = query_b.closest(Vector3d(a.V.row(v).transpose()), cover);
-    if (hit.face < 0) continue;
-    bool rim = b_outside[hit.face] != 0;
-    for (int k = 0; k < 3 && !rim; ++k) {
-      const int g = TT(hit.face, k);
-      rim = g < 0 || !b_covered[g];
+Vector3d centroid(const Element& e, int f) {
+  return (e.V.row(e.F(f, 0)) + e.V.row(e.F(f, 1)) + e.V.row(e.F(f, 2))).transpose() / 3.0;
+}
+
+bool face_outside(const Element& e, int f, const OverlapRegion& region) {
+  for (int k = 0; k < 3; ++k)
+    if (region.contains(Vector3d(e.V.row(e.F(f, k)).transpose()))) return false;
+  return true;
+}
+
+// Breadth-first depth of every face from the seed faces over the dual graph (-1: unreached).
+std::vector<int> dual_depth(const MatrixX3i& TT, const std::vector<int>& seeds) {
+  std::vector<int> depth(TT.rows(), -1), queue = seeds;
+  for (const int f : seeds) depth[f] = 0;
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int f = queue[head];
+    for (int k = 0; k < 3; ++k) {
+      const int g = TT(f, k);
+      if (g >= 0 && depth[g] < 0) {
+        depth[g] = depth[f] + 1;
+        queue.push_back(g);
+      }
     }
-    sink_vertex[v] = rim;
   }
-  for (int v = 0; v < a.V.rows(); ++v)
-    if (sink_vertex[v])
-      for (const int* f = vf.begin(v); f != vf.end(v); ++f) hard[*f] = CutLabel::Remove;
-  // Outside the overlap: always kept (SOURCE wins over SINK so the cut stays feasible).
+  return depth;
+}
+
+// Labels for cutting the output element (section 2.7). SOURCE: faces outside the overlapping
+// region. SINK: the far end, seen from the SOURCE faces, of the band of faces that the swatch
+// element covers: the part the swatch element continues and replaces (a thread's end cap, the
+// half of a ring lying over the new patch). The paper marks the faces around vertices whose
+// partner face lies at the rim of the matched area; on closed tubes that rim can fall between
+// two vertex rings and be missed, while the far end of the covered band is always defined.
+std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery& query_in,
+                                    const OverlapRegion& region, double cover) {
+  const int nf = static_cast<int>(out.F.rows());
+  std::vector<CutLabel> hard(nf, CutLabel::Free);
+  std::vector<int> source;
+  std::vector<char> covered(nf, 0);
   for (int f = 0; f < nf; ++f) {
-    bool outside = true;
-    for (int k = 0; k < 3; ++k) outside = outside && !region.contains(a.V.row(a.F(f, k)));
-    if (outside) hard[f] = CutLabel::Keep;
+    if (face_outside(out, f, region)) {
+      hard[f] = CutLabel::Keep;
+      source.push_back(f);
+    } else {
+      covered[f] = query_in.closest(centroid(out, f), cover).face >= 0;
+    }
+  }
+  const MatrixX3i TT = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
+  const std::vector<int> depth = dual_depth(TT, source);
+  int deepest = -1;
+  for (int f = 0; f < nf; ++f)
+    if (covered[f]) deepest = std::max(deepest, depth[f]);
+  if (deepest <= 0) return hard;  // nothing covered beyond the kept part: no SINK
+  // The last two layers of the covered band form the SINK.
+  for (int f = 0; f < nf; ++f)
+    if (covered[f] && depth[f] >= deepest - 1 && hard[f] == CutLabel::Free)
+      hard[f] = CutLabel::Remove;
+  return hard;
+}
+
+// Labels for cutting the swatch element so that its cut complements the output's: a face lying
+// on a kept output face is removed (the output already has it), one lying on a removed output
+// face is kept (it replaces it) except within two rings of the output's seam, where the min-cut
+// closes the loop; faces outside the overlapping region are always kept.
+std::vector<CutLabel> swatch_labels(const Element& in, const Element& out,
+                                    const std::vector<bool>& keep_out,
+                                    const ClosestPointQuery& query_out,
+                                    const OverlapRegion& region, double cover) {
+  const int nf = static_cast<int>(in.F.rows());
+  const MatrixX3i TT_out = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
+  // Output faces within two rings of the output's cut are "near the seam".
+  std::vector<int> seam;
+  for (int f = 0; f < TT_out.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int g = TT_out(f, k);
+      if (g >= 0 && keep_out[f] != keep_out[g]) {
+        seam.push_back(f);
+        break;
+      }
+    }
+  const std::vector<int> seam_depth = dual_depth(TT_out, seam);
+  std::vector<CutLabel> hard(nf, CutLabel::Free);
+  for (int g = 0; g < nf; ++g) {
+    if (face_outside(in, g, region)) {
+      hard[g] = CutLabel::Keep;
+      continue;
+    }
+    const ClosestPointHit hit = query_out.closest(centroid(in, g), cover);
+    if (hit.face < 0) continue;
+    if (keep_out[hit.face]) {
+      hard[g] = CutLabel::Remove;  // the output keeps this part
+    } else if (seam_depth[hit.face] < 0 || seam_depth[hit.face] > 2) {
+      hard[g] = CutLabel::Keep;  // replaces a removed output part away from the seam
+    }
+    // else: over the removed side, close to the output's seam: the min-cut closes the loop
+    // there, so the two kept parts meet with a small gap and never overlap.
   }
   return hard;
 }
@@ -74,6 +135,21 @@ TriMesh kept_part(const Element& e, const std::vector<bool>& keep) {
 }
 
 }  // namespace
+
+const char* stitch_failure_name(StitchFailure f) {
+  switch (f) {
+    case StitchFailure::None: return "none";
+    case StitchFailure::EmptyCut: return "empty_cut";
+    case StitchFailure::NothingCut: return "nothing_cut";
+    case StitchFailure::BadSeam: return "bad_seam";
+    case StitchFailure::LoopsUnpaired: return "loops_unpaired";
+    case StitchFailure::NotOneComponent: return "not_one_component";
+    case StitchFailure::OpenSeam: return "open_seam";
+    case StitchFailure::Distorted: return "distorted";
+    case StitchFailure::SelfIntersecting: return "self_intersecting";
+  }
+  return "unknown";
+}
 
 bool elements_coincide(const Element& a, const Element& b, double tolerance) {
   const ClosestPointQuery qa(a.V, a.F), qb(b.V, b.F);
@@ -103,18 +179,25 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   // behaves the same whatever the swatch's units.
   const double unit = mean_edge_length > 0 ? mean_edge_length : 1.0;
   const MatrixX3d out_V = out.V / unit, in_V = in.V / unit;
-  const std::vector<bool> keep_out =
-      graph_cut_keep_faces(out_V, out.F, dist_out / unit,
-                           hard_labels(out, in, query_in, region, cover));
+  const std::vector<bool> keep_out = graph_cut_keep_faces(
+      out_V, out.F, dist_out / unit, output_labels(out, query_in, region, cover));
   const std::vector<bool> keep_in =
-      graph_cut_keep_faces(in_V, in.F, dist_in / unit, hard_labels(in, out, query_out, region, cover));
+      graph_cut_keep_faces(in_V, in.F, dist_in / unit,
+                           swatch_labels(in, out, keep_out, query_out, region, cover));
   const TriMesh a = kept_part(out, keep_out), b = kept_part(in, keep_in);
   if (a.F.rows() == 0 || b.F.rows() == 0) return fail(StitchFailure::EmptyCut);
   if (a.F.rows() == out.F.rows() || b.F.rows() == in.F.rows())
     return fail(StitchFailure::NothingCut);
   StitchOptions stitch_options;
   stitch_options.max_loop_distance = options.max_loop_distance * mean_edge_length;
-  const std::optional<StitchResult> stitched = stitch_cut_elements(a, b, stitch_options);
+  stitch_options.weld_tolerance = 0.25 * mean_edge_length;
+  std::optional<StitchResult> stitched;
+  try {
+    stitched = stitch_cut_elements(a, b, stitch_options);
+  } catch (const TopologyError&) {
+    // The cut left a boundary that is not a set of simple loops (parts touching at a vertex).
+    return fail(StitchFailure::BadSeam);
+  }
   if (!stitched) return fail(StitchFailure::LoopsUnpaired);
   std::vector<int> fc;
   if (connected_components(stitched->mesh.F, stitched->mesh.num_vertices(), fc) != 1)
@@ -126,9 +209,26 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;
-  result.V = deform_element(stitched->mesh.V, stitched->mesh.F, stitched->constraints, deformation);
+  std::vector<LinearConstraint> constraints = stitched->constraints;
+  const std::vector<LinearConstraint> anchors = anchor_far_vertices(
+      stitched->mesh.V, stitched->mesh.F, constraints, options.deformation_rings);
+  constraints.insert(constraints.end(), anchors.begin(), anchors.end());
+  result.V = deform_element(stitched->mesh.V, stitched->mesh.F, constraints, deformation);
   result.F = stitched->mesh.F;
   result.update();
+  // The stitched element must stay within the space of its two parents (a wrongly paired seam
+  // drags vertices far away) and must not pass through itself.
+  const double slack = 2.0 * mean_edge_length;
+  const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
+  const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
+  if ((result.lo.array() < lo.array()).any() || (result.hi.array() > hi.array()).any() ||
+      result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
+      result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
+    return fail(StitchFailure::Distorted);
+  IntersectionOptions all_pairs;
+  all_pairs.between_components_only = false;
+  if (!intersecting_face_pairs(result.V, result.F, all_pairs).empty())
+    return fail(StitchFailure::SelfIntersecting);
   return result;
 }
 

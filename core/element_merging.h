@@ -14,19 +14,38 @@ struct MergeOptions {
   // Two elements closer than this many swatch mean edge lengths everywhere (both ways) are the
   // same element placed twice: the output one is kept and no cut is made.
   double coincidence_tolerance = 0.05;
+  // Partners whose footprints overlap over at least this fraction of the larger one are also the
+  // same element (for compact elements a stitch of two halves would only deform them).
+  double same_element_overlap = 0.5;
   // A face counts as having a partner on the other element when its centroid lies within this
   // many mean edge lengths of it (the "corresponding" faces of section 2.7's SINK rule).
-  double cover_distance = 1.0;
+  double cover_distance = 2.0;
   // Seam loops whose centroids are farther apart than this many mean edge lengths are not
   // bridged (the stitch is refused and the caller keeps the output element).
-  double max_loop_distance = 6.0;
+  double max_loop_distance = 3.0;
+  // The stitching deformation is confined to this many edge rings around the seam; vertices
+  // beyond stay in place (mesh merging keeps the far parts of both elements as they were).
+  int deformation_rings = 8;
 };
 
 // Every vertex of a lies within tolerance of b and every vertex of b within tolerance of a.
 bool elements_coincide(const Element& a, const Element& b, double tolerance);
 
 // Why a cut-and-stitch was refused (for stats and messages).
-enum class StitchFailure { None, EmptyCut, NothingCut, LoopsUnpaired, NotOneComponent, OpenSeam };
+enum class StitchFailure {
+  None,
+  EmptyCut,          // a cut removed a whole element
+  NothingCut,        // a cut removed nothing: no seam to join
+  BadSeam,           // the cut boundary is not a set of simple loops
+  LoopsUnpaired,     // seam loops could not be paired within max_loop_distance
+  NotOneComponent,   // the bridged result is not one connected component
+  OpenSeam,          // a seam loop was left open
+  Distorted,         // the deformed result left its parents' space
+  SelfIntersecting,  // the deformed result passes through itself
+};
+inline constexpr int kStitchFailureKinds = 9;
+// Short name of a failure kind, for stats.
+const char* stitch_failure_name(StitchFailure f);
 
 // Cuts the output element `out` and the swatch element `in` (already in the output frame) along
 // min-cut seams (Eq. (7) weights, infinite SOURCE links outside the overlapping region, SINK

@@ -56,20 +56,44 @@ int nearest_loop(const Loop& loop, const std::vector<Loop>& others) {
 Vector3d row(const MatrixX3d& V, int i) { return V.row(i).transpose(); }
 
 // Zipper strip between loop a (walked backwards) and loop b (walked forwards), appended to F.
-void bridge(const MatrixX3d& V, const std::vector<int>& a, const std::vector<int>& b,
-            std::vector<Eigen::Vector3i>& faces) {
-  const int n = static_cast<int>(a.size()), m = static_cast<int>(b.size());
+// Positions in a and b of the closest pair of vertices between the two loops.
+std::pair<int, int> closest_pair(const MatrixX3d& V, const std::vector<int>& a,
+                                 const std::vector<int>& b) {
   int p = 0, q = 0;
   double best = -1;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j) {
+  for (size_t i = 0; i < a.size(); ++i)
+    for (size_t j = 0; j < b.size(); ++j) {
       const double d = (row(V, a[i]) - row(V, b[j])).squaredNorm();
       if (best < 0 || d < best) {
         best = d;
-        p = i;
-        q = j;
+        p = static_cast<int>(i);
+        q = static_cast<int>(j);
       }
     }
+  return {p, q};
+}
+
+// When the two loops have the same length and lie on each other vertex for vertex (the seams of
+// a periodic swatch placed exactly), returns for each position k of b the vertex of a it
+// coincides with; else an empty vector.
+std::vector<int> weld_map(const MatrixX3d& V, const std::vector<int>& a, const std::vector<int>& b,
+                          double tolerance) {
+  const int n = static_cast<int>(a.size());
+  if (n != static_cast<int>(b.size()) || tolerance <= 0) return {};
+  const auto [p, q] = closest_pair(V, a, b);
+  std::vector<int> map(n);
+  for (int k = 0; k < n; ++k) {
+    const int ia = a[(p - k + n) % n], jb = (q + k) % n;
+    if ((row(V, ia) - row(V, b[jb])).norm() > tolerance) return {};
+    map[jb] = ia;
+  }
+  return map;
+}
+
+void bridge(const MatrixX3d& V, const std::vector<int>& a, const std::vector<int>& b,
+            std::vector<Eigen::Vector3i>& faces) {
+  const int n = static_cast<int>(a.size()), m = static_cast<int>(b.size());
+  auto [p, q] = closest_pair(V, a, b);
   for (int done_a = 0, done_b = 0; done_a < n || done_b < m;) {
     const int ap = a[p], a_prev = a[(p + n - 1) % n], bq = b[q], b_next = b[(q + 1) % m];
     bool advance_a = done_b == m;
@@ -123,6 +147,8 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
   const std::vector<Loop> loops_b = describe_loops(B.V, B.F, A.num_vertices());
 
   std::vector<Eigen::Vector3i> bridge_faces;
+  std::vector<int> replace(V.rows());
+  for (int v = 0; v < V.rows(); ++v) replace[v] = v;
   for (size_t i = 0; i < loops_a.size(); ++i) {
     const int j = nearest_loop(loops_a[i], loops_b);
     if (j < 0 || nearest_loop(loops_b[j], loops_a) != static_cast<int>(i)) continue;
@@ -131,13 +157,32 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
       continue;
     const Loop& la = loops_a[i];
     const Loop& lb = loops_b[j];
+    const std::vector<int> welded = weld_map(V, la.vertices, lb.vertices, options.weld_tolerance);
+    if (!welded.empty()) {
+      // Coincident seams are glued vertex to vertex: b's loop vertices are replaced by a's.
+      for (size_t k = 0; k < welded.size(); ++k) {
+        replace[lb.vertices[k]] = welded[k];
+        result.constraints.push_back(LinearConstraint::point(
+            welded[k], 0.5 * (row(V, welded[k]) + row(V, lb.vertices[k]))));
+      }
+      ++result.bridged_loops;
+      continue;
+    }
     bridge(V, la.vertices, lb.vertices, bridge_faces);
+    // Section 2.7 pulls both seams towards their averaged points. Only the part of the offset
+    // across the seam direction (the loops' normal) is averaged: averaging the part along it
+    // too would collapse the bridge strip to zero width.
+    Vector3d axis = la.vector_area - lb.vector_area;
+    axis = axis.norm() > 0 ? Vector3d(axis.normalized()) : Vector3d::Zero();
+    auto lateral_target = [&](int v, const std::vector<int>& other) {
+      const Vector3d x = row(V, v);
+      const Vector3d d = closest_on_loop(V, other, x) - x;
+      return Vector3d(x + 0.5 * (d - d.dot(axis) * axis));
+    };
     for (int v : la.vertices)
-      result.constraints.push_back(LinearConstraint::point(
-          v, 0.5 * (row(V, v) + closest_on_loop(V, lb.vertices, row(V, v)))));
+      result.constraints.push_back(LinearConstraint::point(v, lateral_target(v, lb.vertices)));
     for (int v : lb.vertices)
-      result.constraints.push_back(LinearConstraint::point(
-          v, 0.5 * (row(V, v) + closest_on_loop(V, la.vertices, row(V, v)))));
+      result.constraints.push_back(LinearConstraint::point(v, lateral_target(v, la.vertices)));
     ++result.bridged_loops;
   }
   if (result.bridged_loops == 0) return std::nullopt;
@@ -147,6 +192,23 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
   F.conservativeResize(old_rows + static_cast<Eigen::Index>(bridge_faces.size()), 3);
   for (size_t k = 0; k < bridge_faces.size(); ++k)
     F.row(old_rows + static_cast<Eigen::Index>(k)) = bridge_faces[k].transpose();
+  // Apply the welds and drop the vertices they made unused, renumbering the constraints.
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) F(f, k) = replace[F(f, k)];
+  std::vector<int> index(V.rows(), -1);
+  int count = 0;
+  for (int v = 0; v < V.rows(); ++v)
+    if (replace[v] == v) index[v] = count++;
+  if (count < V.rows()) {
+    MatrixX3d W(count, 3);
+    for (int v = 0; v < V.rows(); ++v)
+      if (index[v] >= 0) W.row(index[v]) = V.row(v);
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) F(f, k) = index[F(f, k)];
+    for (LinearConstraint& c : result.constraints) c.vertices[0] = index[c.vertices[0]];
+    result.mesh.V = std::move(W);
+    result.mesh.N.resize(0, 3);
+  }
   std::vector<int> face_component;
   if (connected_components(F, result.mesh.num_vertices(), face_component) != 1) return std::nullopt;
   return result;

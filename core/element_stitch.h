@@ -13,6 +13,9 @@ namespace mq {
 struct StitchOptions {
   // Loops whose centroids are farther apart than this are not bridged.
   double max_loop_distance = std::numeric_limits<double>::infinity();
+  // Paired loops of equal length lying on each other within this distance, vertex for vertex,
+  // are welded instead of bridged (0: never weld).
+  double weld_tolerance = 0;
 };
 
 struct StitchResult {

@@ -25,6 +25,7 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
   problem.offsets = candidates;
   const Eigen::VectorXd costs = evaluator.evaluate(swatch, problem);
   choice.evaluations = static_cast<int>(costs.size());
+  choice.point_offsets = static_cast<long long>(costs.size()) * P.rows();
   int best = best_offset(costs);
   if (options.epsilon > 0) {
     std::vector<int> near;
@@ -40,6 +41,24 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
     const Vector2d lo = t_min, hi = t_max.cwiseMax(t_min);
     double step = 0.5 * cell_size;
     problem.offsets.resize(4, 3);
+    // The refinement only polishes a placement already chosen exactly among whole cells, so it
+    // matches a fixed, evenly strided subset of the sub-patch (its cost is then comparable
+    // between the moves, which is all the search needs).
+    if (P.rows() > options.refine_points) {
+      const Eigen::Index n = options.refine_points;
+      MatrixX3d Ps(n, 3), Ns(n, 3);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Index k = i * P.rows() / n;
+        Ps.row(i) = P.row(k);
+        Ns.row(i) = NP.row(k);
+      }
+      problem.points = std::move(Ps);
+      problem.point_normals = std::move(Ns);
+      problem.offsets = t.transpose();
+      cost = evaluator.evaluate(swatch, problem)(0);  // the start point on the subset
+      ++choice.evaluations;
+      problem.offsets.resize(4, 3);
+    }
     while (step >= options.refine_to * cell_size) {
       const Vector3d moves[4] = {{step, 0, 0}, {-step, 0, 0}, {0, step, 0}, {0, -step, 0}};
       for (int k = 0; k < 4; ++k) {
@@ -50,6 +69,7 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
       }
       const Eigen::VectorXd c = evaluator.evaluate(swatch, problem);
       choice.evaluations += 4;
+      choice.point_offsets += 4 * problem.points.rows();
       const int k = best_offset(c);
       // Require a real improvement so float noise cannot make the search wander.
       if (c(k) < cost * (1 - 1e-9)) {
@@ -61,7 +81,7 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
     }
   }
   choice.offset = t;
-  choice.cost = cost;
+  choice.cost = cost;  // on the refinement subset when it was used
   return choice;
 }
 

@@ -12,13 +12,17 @@
 namespace mq {
 
 struct MatchingOptions {
-  double lambda = 1.0;   // Eq. (1)
+  // Eq. (1) weight of the distance. It multiplies distances measured in grid cells rather than
+  // in the swatch's own units, so a swatch matches the same way whatever its scale.
+  double lambda = 1.0;
   // Choose at random among offsets within (1 + epsilon) of the minimum (variety); 0 = the
   // minimum, ties to the lowest candidate index.
   double epsilon = 0.0;
   // Refine the chosen whole-cell offset by compass search down to this fraction of a cell
   // (0 disables). The paper notes finer offsets help; periodic swatches then align exactly.
   double refine_to = 1e-3;
+  // Sub-patch points used by the refinement (an evenly strided subset when there are more).
+  Eigen::Index refine_points = 256;
 };
 
 struct OffsetChoice {
@@ -26,6 +30,7 @@ struct OffsetChoice {
   double cost = 0;          // E(t) at the chosen offset
   int candidates = 0;       // whole-cell offsets evaluated
   int evaluations = 0;      // all offsets evaluated, refinement included
+  long long point_offsets = 0;  // (point, offset) pairs evaluated
 };
 
 // Picks the swatch translation t for the sub-patch points P (#P by 3, unit normals NP #P by 3)

@@ -263,3 +263,35 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
 }
 
 }  // namespace mq
+
+namespace mq {
+
+std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const MatrixX3i& F,
+                                                  const std::vector<LinearConstraint>& constraints,
+                                                  int rings) {
+  const int nv = static_cast<int>(V.rows());
+  const Adjacency adj = vertex_adjacency(F, nv);
+  std::vector<int> depth(nv, -1), queue;
+  for (const LinearConstraint& c : constraints)
+    for (int k = 0; k < 3; ++k) {
+      const int v = c.vertices[k];
+      if (v >= 0 && v < nv && depth[v] < 0) {
+        depth[v] = 0;
+        queue.push_back(v);
+      }
+    }
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (const int* w = adj.begin(v); w != adj.end(v); ++w)
+      if (depth[*w] < 0) {
+        depth[*w] = depth[v] + 1;
+        queue.push_back(*w);
+      }
+  }
+  std::vector<LinearConstraint> anchors;
+  for (int v = 0; v < nv; ++v)
+    if (depth[v] > rings) anchors.push_back(LinearConstraint::point(v, V.row(v).transpose()));
+  return anchors;
+}
+
+}  // namespace mq

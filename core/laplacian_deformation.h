@@ -87,3 +87,16 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
                                        const DeformationOptions& options = {});
 
 }  // namespace mq
+
+namespace mq {
+
+// Keeps a deformation local: returns point constraints holding in place every vertex farther
+// than `rings` edges (1-ring hops) from the vertices the given constraints involve. Without them
+// an element constrained only at one end (a long thread stitched at a seam) is free to swing
+// about the constrained region, since Eq. (5) only preserves untransformed Laplacian coordinates.
+// Components without any constraint are left alone (they do not move anyway).
+std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const MatrixX3i& F,
+                                                  const std::vector<LinearConstraint>& constraints,
+                                                  int rings);
+
+}  // namespace mq

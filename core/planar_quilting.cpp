@@ -223,10 +223,14 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
           }
         }
       }
-      MatrixX3d P(points.size(), 3), NP(points.size(), 3);
-      for (size_t i = 0; i < points.size(); ++i) {
-        P.row(i) = points[i].transpose();
-        NP.row(i) = normals[i].transpose();
+      const size_t n = options.match_points > 0
+                           ? std::min(points.size(), static_cast<size_t>(options.match_points))
+                           : points.size();
+      MatrixX3d P(n, 3), NP(n, 3);
+      for (size_t i = 0; i < n; ++i) {
+        const size_t k = i * points.size() / n;
+        P.row(i) = points[k].transpose();
+        NP.row(i) = normals[k].transpose();
       }
       const int kx0 = static_cast<int>(std::ceil(t_min.x() / cell - 1e-9));
       const int ky0 = static_cast<int>(std::ceil(t_min.y() / cell - 1e-9));
@@ -238,8 +242,11 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       if (offsets.empty()) offsets.emplace_back(t_max.x(), t_max.y(), 0.0);
       MatrixX3d T(offsets.size(), 3);
       for (size_t i = 0; i < offsets.size(); ++i) T.row(i) = offsets[i].transpose();
-      choice = choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell,
-                             options.matching, rng);
+      MatchingOptions matching = options.matching;
+      matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
+      choice = choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching,
+                             rng);
+      stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;
     const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
@@ -276,12 +283,20 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       if (options.deform) {
         std::vector<DeformationJob> jobs;
         std::vector<std::pair<bool, int>> owners;  // (is output, id)
+        // Section 2.6 aligns elements where they correspond; the rest of a long element (a
+        // thread running far out of the overlap) is anchored so it does not swing.
+        auto anchored = [&](const Element& e, std::vector<LinearConstraint> cs) {
+          const auto anchors =
+              anchor_far_vertices(e.V, e.F, cs, options.merging.deformation_rings);
+          cs.insert(cs.end(), anchors.begin(), anchors.end());
+          return cs;
+        };
         for (auto& [id, cs] : out_constraints) {
-          jobs.push_back({&output[id].V, &output[id].F, std::move(cs)});
+          jobs.push_back({&output[id].V, &output[id].F, anchored(output[id], std::move(cs))});
           owners.emplace_back(true, id);
         }
         for (auto& [id, cs] : in_constraints) {
-          jobs.push_back({&moved[id].V, &moved[id].F, std::move(cs)});
+          jobs.push_back({&moved[id].V, &moved[id].F, anchored(moved[id], std::move(cs))});
           owners.emplace_back(false, id);
         }
         DeformationOptions d;
@@ -302,8 +317,16 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     // Step 5 (section 2.7): merge.
     {
       ScopedStageTimer timer(times, "merging");
+      // Partners of each swatch element. Relations carried by only a few pairs next to a strong
+      // one come from elements that merely touch it (crossing threads of a weave, neighbouring
+      // rings): they are not the same element and are ignored.
+      std::map<std::pair<int, int>, int> pair_count;
+      for (const VertexFacePair& p : corr.pairs) ++pair_count[{p.out_element, p.in_element}];
+      std::vector<int> strongest(moved.size(), 0);
+      for (const auto& [rel, n] : pair_count) strongest[rel.second] = std::max(strongest[rel.second], n);
       std::vector<std::vector<int>> partners(moved.size());
-      for (const auto& [o, i] : corr.relations) partners[i].push_back(o);
+      for (const auto& [o, i] : corr.relations)
+        if (4 * pair_count[{o, i}] >= strongest[i]) partners[i].push_back(o);
       auto inside = [&](const Element& e) {
         for (int v = 0; v < e.V.rows(); ++v)
           if (!region.contains(e.V.row(v).transpose())) return false;
@@ -353,7 +376,10 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
         }
         const int o = crossing[0];
         const Element& base = current(o);
-        if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge)) {
+        // The same element placed twice (nearly identical, or mostly the same footprint, as for
+        // two apples slightly apart): keep the output one rather than stitching two halves.
+        if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge) ||
+            footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
           ++stats.elements_matched;
           busy[o] = 1;
           continue;
@@ -371,6 +397,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
           ++stats.elements_stitched;
         } else {
           ++stats.stitch_fallbacks;
+          ++stats.stitch_failures[static_cast<int>(joined ? StitchFailure::None : why)];
         }
       }
       busy.resize(output.size(), 0);

@@ -2,6 +2,7 @@
 // finding, geometry matching, element correspondences, element deformation and merging.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "core/element_correspondence.h"
@@ -19,6 +20,10 @@ struct PlanarQuiltingOptions {
   // Side of the output sub-patch P_out as a fraction of the swatch's shorter side (section 2.4
   // only asks that it be smaller than the swatch); larger values match more context.
   double subpatch_fraction = 0.5;
+  // Sub-patch vertices matched in Eq. (3): all of them up to this many, else an evenly strided
+  // subset of this size (the paper sums over every vertex; a dense subset ranks offsets the same
+  // way at a fraction of the cost; 0 = all).
+  int match_points = 1024;
   MatchingOptions matching;
   CorrespondenceOptions correspondence;
   MergeOptions merging;
@@ -31,6 +36,7 @@ struct PlanarQuiltingStats {
   int iterations = 0;
   double cell_size = 0;
   int grid_nx = 0, grid_ny = 0;
+  long long matched_point_offsets = 0;  // (point, offset) evaluations of Eq. (2)
   int pairs = 0;                 // vertex-face pairs kept over all iterations
   int relations = 0;             // element relations kept over all iterations
   int elements_added = 0;        // swatch elements without partner added as they are
@@ -39,6 +45,7 @@ struct PlanarQuiltingStats {
   int elements_matched = 0;      // partners that coincided: output kept, no cut needed
   int elements_dropped = 0;      // swatch elements inside the overlap, or refused merges
   int stitch_fallbacks = 0;      // cut-and-stitch refused; output element kept whole
+  std::array<int, kStitchFailureKinds> stitch_failures{};  // fallbacks by StitchFailure
   int rejected_intersecting = 0; // candidates dropped because they would intersect
   int removed_post = 0;          // removed in post-processing (outside the domain)
   int trimmed = 0;               // elements cut open at the border (trim_border)
