@@ -22,7 +22,7 @@ struct MergeOptions {
   double cover_distance = 2.0;
   // Seam loops whose centroids are farther apart than this many mean edge lengths are not
   // bridged (the stitch is refused and the caller keeps the output element).
-  double max_loop_distance = 3.0;
+  double max_loop_distance = 6.0;
   // The stitching deformation is confined to this many edge rings around the seam; vertices
   // beyond stay in place (mesh merging keeps the far parts of both elements as they were).
   int deformation_rings = 8;
