@@ -29,6 +29,42 @@ double min_face_cosine(const Vector3d& d, const MatrixX3d& FN, const Adjacency& 
   return c;
 }
 
+// The unit direction maximising the smallest cosine with the incident face normals (a
+// spherical minimax centre): the optimum has one, two or three active normals, so it is the
+// best of the normals, the normalised pair sums and the directions equidistant from triples.
+// Used where the area-weighted normal is below kMinCosine to some face (sharp vertices): a
+// prism whose corner direction lies below a face's plane is inverted at every height.
+Vector3d cone_direction(const Vector3d& normal, const MatrixX3d& FN, const Adjacency& vf, int i) {
+  Vector3d best = normal;
+  double best_cos = min_face_cosine(normal, FN, vf, i);
+  auto consider = [&](Vector3d d) {
+    const double len = d.norm();
+    if (!(len > 1e-12)) return;
+    d /= len;
+    const double c = min_face_cosine(d, FN, vf, i);
+    if (c > best_cos) {
+      best_cos = c;
+      best = d;
+    }
+  };
+  const int* f = vf.begin(i);
+  const int k = vf.degree(i);
+  for (int a = 0; a < k; ++a) {
+    const Vector3d na = FN.row(f[a]);
+    consider(na);
+    for (int b = a + 1; b < k; ++b) {
+      const Vector3d nb = FN.row(f[b]);
+      consider(na + nb);
+      for (int c = b + 1; c < k; ++c) {
+        const Vector3d d = (na - nb).cross(na - Vector3d(FN.row(f[c])));
+        consider(d);
+        consider(-d);
+      }
+    }
+  }
+  return best;
+}
+
 // Laplacian diffusion of the normals, refusing steps that leave a vertex's face cone.
 MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterations) {
   const int n = static_cast<int>(V.rows());
@@ -36,9 +72,16 @@ MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterat
   const Adjacency vv = vertex_adjacency(F, n);
   const Adjacency vf = vertex_faces(F, n);
   MatrixX3d D = vertex_normals(V, F);
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
     MQ_CHECK(vf.degree(i) == 0 || D.row(i).squaredNorm() > 0.5, TopologyError,
              "offset surface: vertex ", i, " has no normal (its faces cancel)");
+    if (vf.degree(i) == 0 || min_face_cosine(D.row(i), FN, vf, i) >= kMinCosine) continue;
+    D.row(i) = cone_direction(D.row(i), FN, vf, i);
+    MQ_CHECK(min_face_cosine(D.row(i), FN, vf, i) > 0.0, TopologyError, "offset surface: vertex ",
+             i, " (", V(i, 0), " ", V(i, 1), " ", V(i, 2),
+             ") has no direction above all its faces (the base folds there), so no valid "
+             "shell prism exists at any height");
+  }
   for (int it = 0; it < iterations; ++it) {
     MatrixX3d next = D;
     tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& r) {
@@ -137,17 +180,18 @@ OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const Offse
              "offset surface: cannot make a valid shell (", stuck,
              " offending vertices already at the minimum height ", floor_h, " after ", round + 1,
              " rounds)");
-    // Smooth downward only, so heights never grow and the loop terminates.
-    for (int pass = 0; pass < 2; ++pass) {
-      Eigen::VectorXd next = out.heights;
+    // Grade the heights: none more than twice its lowest neighbour's, so a lowered region
+    // tapers off over a few rings instead of leaving a step; heights only decrease.
+    for (bool changed = true; changed;) {
+      changed = false;
       for (int i = 0; i < n; ++i) {
-        if (!used[i] || vv.degree(i) == 0) continue;
-        double mean = 0.0;
-        for (const int* j = vv.begin(i); j != vv.end(i); ++j) mean += out.heights(*j);
-        mean /= vv.degree(i);
-        next(i) = std::max(floor_h, std::min(out.heights(i), 0.5 * (out.heights(i) + mean)));
+        for (const int* j = vv.begin(i); j != vv.end(i); ++j) {
+          if (out.heights(i) > 2.0 * out.heights(*j)) {
+            out.heights(i) = 2.0 * out.heights(*j);
+            changed = true;
+          }
+        }
       }
-      out.heights.swap(next);
     }
   }
   return out;

@@ -27,19 +27,22 @@ struct OffsetSurface {
 };
 
 // Offsets the base (V, F) outward.
-// Directions: area-weighted vertex normals diffused by uniform Laplacian steps and
-// renormalised; a step is refused at a vertex when it would bring the direction closer than
-// cos = 0.1 to the plane of an incident face (then the prisms could not be valid at any height).
+// Directions: area-weighted vertex normals; where one lies closer than cos = 0.1 to the plane
+// of an incident face (sharp vertices), the direction maximising the smallest cosine with the
+// incident face normals replaces it. Then Laplacian diffusion steps, renormalised, each refused
+// at a vertex where it would leave that cone (prisms below a face's plane are inverted at any
+// height, so lowering could not repair them).
 // Heights: all start at `height`; each round builds the shell prisms (shell_tet_indices) and
 // finds faces with a non-positive or near-flat tet, and faces of the shell boundary (offset,
 // base, side walls) that intersect each other (base-base pairs excepted: the base is given);
 // every vertex of such a face has its height halved (not below the floor), then heights are
-// smoothed downward (h_i <- min(h_i, (h_i + mean of neighbours) / 2), twice) so the shell
-// thins gradually. Convex regions are never lowered; concave ones are, as far as needed.
+// graded (none more than twice its lowest neighbour's) so a lowered region tapers over a few
+// rings. Heights only decrease; convex regions are not lowered, concave ones as far as needed.
 //   V  #V by 3 base vertices (finite), F  #F by 3 faces, counter-clockwise seen from outside
 // Deterministic; the result does not depend on the thread count.
 // Throws InvalidInput for bad options, non-finite coordinates, bad or repeated indices or no
-// faces; TopologyError when a referenced vertex has no normal (its faces cancel) or when the
+// faces; TopologyError when a referenced vertex has no normal, when the base folds so that no
+// direction lies above all of a vertex's faces (the message names the vertex), or when the
 // shell stays invalid with every offending vertex at the height floor (or after max_rounds).
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options);
 
