@@ -4,15 +4,10 @@
 #include <memory>
 
 #include "core/translation_cost.h"
+#include "host/device.h"
 #include "host/opencl_runtime.h"
 
 namespace mq {
-
-enum class Device {
-  Cpu,     // TBB path
-  OpenCL,  // kernel on the device chosen by RuntimeOptions / environment
-  Auto,    // OpenCL when a platform with a double-precision device exists, else CPU
-};
 
 // Creates an evaluator. Throws DeviceError for Device::OpenCL when no usable device exists (or
 // the kernel does not build); Auto never fails for lack of a platform.

@@ -1,0 +1,49 @@
+// The offset surface bounding the shell space of paper section 3.2 from outside: each base
+// vertex moved along a smoothed normal by a per-vertex height, lowered where needed so that
+// the shell between base and offset is a valid tetrahedral embedding.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "core/mesh.h"
+
+namespace mq {
+
+struct OffsetOptions {
+  double height = 0.0;            // shell height w (> 0), e.g. a few % of the bbox diagonal
+  int smoothing_iterations = 10;  // Laplacian diffusion steps of the vertex normals (>= 0)
+  double min_fraction = 0.1;      // no vertex's height drops below min_fraction * height
+  int max_rounds = 64;            // bound on the shrink-and-check rounds (>= 1)
+};
+
+// The offset vertices W = V + h_i d_i with their directions and heights.
+//   V           #V by 3 offset positions
+//   heights     #V heights h_i in [min_fraction * height, height] (0 for unreferenced vertices)
+//   directions  #V by 3 unit directions d_i (zero for unreferenced vertices)
+struct OffsetSurface {
+  MatrixX3d V;
+  Eigen::VectorXd heights;
+  MatrixX3d directions;
+};
+
+// Offsets the base (V, F) outward.
+// Directions: area-weighted vertex normals; where one lies closer than cos = 0.1 to the plane
+// of an incident face (sharp vertices), the direction maximising the smallest cosine with the
+// incident face normals replaces it. Then Laplacian diffusion steps, renormalised, each refused
+// at a vertex where it would leave that cone (prisms below a face's plane are inverted at any
+// height, so lowering could not repair them).
+// Heights: all start at `height`; each round builds the shell prisms (shell_tet_indices) and
+// finds faces with a non-positive or near-flat tet, and faces of the shell boundary (offset,
+// base, side walls) that intersect each other (base-base pairs excepted: the base is given);
+// every vertex of such a face has its height halved (not below the floor), then heights are
+// graded (none more than twice its lowest neighbour's) so a lowered region tapers over a few
+// rings. Heights only decrease; convex regions are not lowered, concave ones as far as needed.
+//   V  #V by 3 base vertices (finite), F  #F by 3 faces, counter-clockwise seen from outside
+// Deterministic; the result does not depend on the thread count.
+// Throws InvalidInput for bad options, non-finite coordinates, bad or repeated indices or no
+// faces; TopologyError when a referenced vertex has no normal, when the base folds so that no
+// direction lies above all of a vertex's faces (the message names the vertex), or when the
+// shell stays invalid with every offending vertex at the height floor (or after max_rounds).
+OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options);
+
+}  // namespace mq
