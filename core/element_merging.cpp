@@ -54,8 +54,8 @@ std::vector<int> dual_depth(const MatrixX3i& TT, const std::vector<int>& seeds) 
   return depth;
 }
 
-// Labels for cutting the output element (section 2.7). SOURCE: faces outside the overlapping
-// region. SINK: the far end, seen from the SOURCE faces, of the band of faces that the swatch
+// Labels for cutting the output element (section 2.7). SOURCE: faces of the old output outside
+// the new patch. SINK: the far end, seen from the SOURCE faces, of the band of faces that the swatch
 // element covers: the part the swatch element continues and replaces (a thread's end cap, the
 // half of a ring lying over the new patch). The paper marks the faces around vertices whose
 // partner face lies at the rim of the matched area; on closed tubes that rim can fall between
@@ -67,7 +67,13 @@ std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery&
   std::vector<int> source;
   std::vector<char> covered(nf, 0);
   for (int f = 0; f < nf; ++f) {
-    if (face_outside(out, f, region)) {
+    // SOURCE is the old output, outside the new patch. Parts of an output element reaching into
+    // unprocessed cells of the patch (elements are kept whole, so they protrude) are not: that
+    // is where the swatch takes over.
+    bool old_region = true;
+    for (int k = 0; k < 3; ++k)
+      old_region = old_region && !region.in_patch(out.V(out.F(f, k), 0), out.V(out.F(f, k), 1));
+    if (old_region) {
       hard[f] = CutLabel::Keep;
       source.push_back(f);
     } else {
