@@ -186,9 +186,9 @@ Eigen::SparseMatrix<double> clamped_cotangent_laplacian(const MatrixX3d& V, cons
   return L;
 }
 
-// Harmonic interpolation of the projected keys; rows of vertices it does not reach are zero.
-MatrixX3d harmonic_vectors(const MatrixX3d& V, const MatrixX3i& F,
-                           const std::vector<KeyVector>& keys, const MatrixX3d& VN) {
+// Biharmonic interpolation of the projected keys; rows of vertices it does not reach are zero.
+MatrixX3d interpolated_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
+                                   const std::vector<KeyVector>& keys, const MatrixX3d& VN) {
   const int n = static_cast<int>(V.rows());
   MQ_CHECK(!keys.empty(), InvalidInput, "key vectors: no key vector given");
   std::vector<char> used(n, 0);
@@ -225,11 +225,21 @@ MatrixX3d harmonic_vectors(const MatrixX3d& V, const MatrixX3i& F,
   for (int v = 0; v < n; ++v)
     if (used[v] && key_of[v] < 0 && has_key[vertex_component[v]]) unknown[v] = nu++;
   if (nu == 0) return X;
+  // Bilaplacian Q = L M^-1 L with the lumped (barycentric) mass matrix: unlike the Laplacian,
+  // whose point constraints give spikes, it interpolates smoothly (C1) through the keys.
   const Eigen::SparseMatrix<double> L = clamped_cotangent_laplacian(V, F);
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd face_area = face_areas(V, F);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) mass(F(f, k)) += face_area(f) / 3.0;
+  const double mean_mass = mass.sum() / std::max(1, static_cast<int>((mass.array() > 0).count()));
+  for (int v = 0; v < n; ++v)  // zero-area fans: keep the system defined
+    mass(v) = 1.0 / std::max(mass(v), 1e-12 * mean_mass);
+  const Eigen::SparseMatrix<double> Q = L * mass.asDiagonal() * L;
   std::vector<Eigen::Triplet<double>> t;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nu, 3);
-  for (int c = 0; c < L.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(L, c); it; ++it) {
+  for (int c = 0; c < Q.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(Q, c); it; ++it) {
       const int i = static_cast<int>(it.row()), j = static_cast<int>(it.col());
       if (unknown[i] < 0) continue;
       if (unknown[j] >= 0)
@@ -241,10 +251,10 @@ MatrixX3d harmonic_vectors(const MatrixX3d& V, const MatrixX3i& F,
   A.setFromTriplets(t.begin(), t.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
   MQ_CHECK(solver.info() == Eigen::Success, SolverFailure,
-           "key vectors: factorisation of the Laplacian failed");
+           "key vectors: factorisation of the bilaplacian failed");
   const Eigen::MatrixXd x = solver.solve(rhs);
   MQ_CHECK(solver.info() == Eigen::Success && x.allFinite(), SolverFailure,
-           "key vectors: the harmonic solve failed");
+           "key vectors: the biharmonic solve failed");
   for (int v = 0; v < n; ++v)
     if (unknown[v] >= 0) X.row(v) = x.row(unknown[v]);
   return X;
@@ -331,7 +341,7 @@ MatrixX3d vertex_field_from_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
                                         const std::vector<KeyVector>& keys) {
   check_mesh(V, F);
   const MatrixX3d VN = vertex_normals(V, F);
-  const MatrixX3d X = harmonic_vectors(V, F, keys, VN);
+  const MatrixX3d X = interpolated_key_vectors(V, F, keys, VN);
   const MatrixX3d fallback = vertex_tangent_field(V, F, face_field_from_raw_vertex(V, F, X));
   MatrixX3d out(V.rows(), 3);
   for (int v = 0; v < V.rows(); ++v) {
@@ -344,7 +354,7 @@ MatrixX3d vertex_field_from_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
 MatrixX3d tangent_field_from_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
                                          const std::vector<KeyVector>& keys) {
   check_mesh(V, F);
-  const MatrixX3d X = harmonic_vectors(V, F, keys, vertex_normals(V, F));
+  const MatrixX3d X = interpolated_key_vectors(V, F, keys, vertex_normals(V, F));
   return face_field_from_raw_vertex(V, F, X);
 }
 

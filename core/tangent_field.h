@@ -1,7 +1,7 @@
 // Guidance vector fields on a base mesh (paper section 3.1: an optional field orients the
 // synthesis on curved surfaces): unit tangent vectors per face, from a world direction, from
-// per-vertex vectors, from key vectors diffused over the surface (harmonic interpolation, as in
-// Lai et al.'s geometry texture synthesis, section 4.3), or a smooth default.
+// per-vertex vectors, from key vectors interpolated over the surface (as in Lai et al.'s geometry
+// texture synthesis, section 4.3), or a smooth default.
 //
 // Common contract of the #F by 3 fields returned here: every row is a unit vector orthogonal
 // to its face normal (a face of zero area gets a unit vector too; its normal is undefined).
@@ -50,11 +50,13 @@ struct KeyVector {
 // it cannot be read. An empty list is returned for a file without key lines.
 std::vector<KeyVector> read_key_vectors(const std::string& path, int num_vertices);
 
-// Harmonic interpolation of the key vectors over the surface: each key is projected into its
-// vertex's tangent plane (area-weighted vertex normal) and normalised; the three coordinates
-// are then interpolated independently by solving the Laplace equation with the keys as
-// Dirichlet values, with cotangent weights clamped below at 1e-3 (a maximum principle holds and
-// the system is positive definite on every component that holds a key); one factorisation.
+// Interpolation of the key vectors over the surface by diffusion: each key is projected into its
+// vertex's tangent plane (area-weighted vertex normal) and normalised; the three coordinates are
+// then interpolated independently as the minimiser of the discrete bilaplacian energy
+// x^T L M^-1 L x with the keys as Dirichlet values (L: cotangent Laplacian with edge weights
+// clamped below at 1e-3, M: lumped barycentric mass; one factorisation). The plain harmonic
+// (Laplacian) interpolant was tried first: with point constraints it is spiky, the keys barely
+// influence their own neighbourhood; the biharmonic one is smooth through the keys.
 // Returns #V by 3 unit vectors in the vertex tangent planes; at a key vertex exactly its
 // projected key. Vertices of components without keys, or where the interpolant vanishes, get
 // the vertex_tangent_field of the face field below; unreferenced vertices get zero rows.
