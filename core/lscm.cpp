@@ -1,11 +1,11 @@
 #include "core/lscm.h"
 
 #include <Eigen/Sparse>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
-#include "core/boundary_loops.h"
 #include "core/errors.h"
 #include "core/mesh_topology.h"
 
@@ -24,16 +24,47 @@ void check_indices(const MatrixX3i& F, Eigen::Index n) {
 // Checks that F is a connected, manifold disk; returns its boundary loop.
 std::vector<int> disk_boundary(const MatrixX3i& F, int n) {
   const EdgeTopology topo = edge_topology(F, n);
-  // boundary_loops also rejects non-manifold edges and boundary vertices.
-  std::vector<std::vector<int>> loops = boundary_loops(F, n);
-  MQ_CHECK(!loops.empty(), TopologyError, "lscm: the patch has no boundary (closed surface)");
-  MQ_CHECK(loops.size() == 1, TopologyError, "lscm: the patch has ", loops.size(),
-           " boundary loops, expected one (a topological disk)");
+  // Boundary edges traversed as in their face; each vertex needs in- and out-degree <= 1.
+  std::vector<int> next(n, -1), in_count(n, 0);
+  for (int e = 0; e < topo.num_edges(); ++e)
+    MQ_CHECK(!topo.is_non_manifold(e), TopologyError, "lscm: edge (", topo.E(e, 0), ", ",
+             topo.E(e, 1), ") is used by ", topo.edge_faces.degree(e), " faces");
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      if (!topo.is_boundary(topo.FE(f, k))) continue;
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      MQ_CHECK(next[a] < 0, TopologyError, "lscm: non-manifold boundary vertex ", a);
+      next[a] = b;
+      ++in_count[b];
+    }
+  int start = -1;
+  for (int v = 0; v < n; ++v) {
+    MQ_CHECK((next[v] >= 0 ? 1 : 0) == in_count[v], TopologyError,
+             "lscm: non-manifold or inconsistently oriented boundary at vertex ", v);
+    if (start < 0 && next[v] >= 0) start = v;
+  }
+  MQ_CHECK(start >= 0, TopologyError, "lscm: the patch has no boundary (closed surface)");
+  std::vector<int> loop;
+  for (int v = start; v != start || loop.empty(); v = next[v]) loop.push_back(v);
+  const int boundary_edges =
+      static_cast<int>(std::count_if(next.begin(), next.end(), [](int v) { return v >= 0; }));
+  MQ_CHECK(static_cast<int>(loop.size()) == boundary_edges, TopologyError,
+           "lscm: the patch has several boundary loops, expected one (a topological disk)");
   const int euler = n - topo.num_edges() + static_cast<int>(F.rows());
   MQ_CHECK(euler == 1, TopologyError, "lscm: the patch has Euler characteristic ", euler,
            ", expected 1 (a topological disk)");
-  std::vector<int> face_component;
-  const int components = connected_components(F, n, face_component);
+  // Connected through edges: union-find over vertices.
+  std::vector<int> root(n);
+  for (int v = 0; v < n; ++v) root[v] = v;
+  auto find_root = [&](int i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  int components = n;
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    const int a = find_root(topo.E(e, 0)), b = find_root(topo.E(e, 1));
+    if (a != b) root[std::max(a, b)] = std::min(a, b), --components;
+  }
   MQ_CHECK(components == 1, TopologyError, "lscm: the patch has ", components,
            " connected components, expected one");
   // Each vertex's corners must form a single fan (no pinch): union the corners of a vertex
@@ -64,7 +95,7 @@ std::vector<int> disk_boundary(const MatrixX3i& F, int n) {
              " is non-manifold (its faces form several fans)");
     fan_root[v] = r;
   }
-  return std::move(loops[0]);
+  return loop;
 }
 
 }  // namespace
