@@ -1,0 +1,188 @@
+#include "core/local_patch.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/lscm.h"
+
+namespace mq {
+
+LocalPatchBuilder::LocalPatchBuilder(const TriMesh& base)
+    : base_(&base), topo_(edge_topology(base.F, base.num_vertices())), TT_(face_adjacency(topo_)) {
+  init();
+}
+
+LocalPatchBuilder::LocalPatchBuilder(const TriMesh& base, const EdgeTopology& topo,
+                                     const MatrixX3i& TT)
+    : base_(&base), topo_(topo), TT_(TT) {
+  init();
+}
+
+void LocalPatchBuilder::init() {
+  const TriMesh& base = *base_;
+  const int nf = base.num_faces(), nv = base.num_vertices();
+  MQ_CHECK(TT_.rows() == nf && topo_.FE.rows() == nf, InvalidInput,
+           "LocalPatchBuilder: topology has ", topo_.FE.rows(), " / ", TT_.rows(),
+           " face rows for a base mesh with ", nf, " faces");
+  MQ_CHECK(base.V.allFinite(), InvalidInput, "LocalPatchBuilder: non-finite base vertex");
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k)
+      MQ_CHECK(base.F(f, k) >= 0 && base.F(f, k) < nv, InvalidInput, "LocalPatchBuilder: face ", f,
+               " has vertex index ", base.F(f, k), " out of range");
+  area_ = face_areas(base.V, base.F);
+  usable_.resize(nf);
+  for (int f = 0; f < nf; ++f)
+    usable_[f] = area_(f) > 0 && base.F(f, 0) != base.F(f, 1) && base.F(f, 1) != base.F(f, 2) &&
+                 base.F(f, 2) != base.F(f, 0);
+  face_in_patch_.assign(nf, 0);
+  face_seen_.assign(nf, 0);
+  vertex_in_patch_.assign(nv, 0);
+  vertex_local_tick_.assign(nv, 0);
+  vertex_local_.assign(nv, -1);
+}
+
+uint32_t LocalPatchBuilder::next_tick() {
+  if (++tick_ == 0) {  // wrapped: clear the stamps once every 2^32 ticks
+    std::fill(face_in_patch_.begin(), face_in_patch_.end(), 0);
+    std::fill(face_seen_.begin(), face_seen_.end(), 0);
+    std::fill(vertex_in_patch_.begin(), vertex_in_patch_.end(), 0);
+    std::fill(vertex_local_tick_.begin(), vertex_local_tick_.end(), 0);
+    tick_ = 1;
+  }
+  return tick_;
+}
+
+// Disk-preserving test for a face outside the patch (which is a disk with a simple boundary).
+bool LocalPatchBuilder::can_add(int f) const {
+  if (!usable_[f]) return false;
+  int shared = 0, free_edge = -1, in_patch = 0;
+  for (int k = 0; k < 3; ++k) {
+    const int g = TT_(f, k);
+    if (g >= 0 && face_in_patch_[g] == patch_tick_)
+      ++shared;
+    else
+      free_edge = k;
+    if (vertex_in_patch_[base_->F(f, k)] == patch_tick_) ++in_patch;
+  }
+  // One shared edge and a new vertex: the disk grows by a triangle on its boundary.
+  if (shared == 1) return in_patch == 2;
+  // Two shared edges: the face closes a notch at their common vertex; the third edge must not
+  // already be in the patch (possible only through a non-manifold base edge).
+  if (shared == 2) {
+    const int e = topo_.FE(f, free_edge);
+    for (const int* g = topo_.edge_faces.begin(e); g != topo_.edge_faces.end(e); ++g)
+      if (face_in_patch_[*g] == patch_tick_) return false;
+    return true;
+  }
+  return false;  // three shared edges would close the surface
+}
+
+void LocalPatchBuilder::flatten(LocalPatch& patch, size_t num_faces) {
+  patch.faces.resize(num_faces);
+  const uint32_t tick = next_tick();
+  const MatrixX3i& BF = base_->F;
+  patch.vertex_map.clear();
+  patch.mesh.F.resize(static_cast<Eigen::Index>(num_faces), 3);
+  patch.area = 0;
+  for (size_t i = 0; i < num_faces; ++i) {
+    const int f = patch.faces[i];
+    patch.area += area_(f);
+    for (int k = 0; k < 3; ++k) {
+      const int v = BF(f, k);
+      if (vertex_local_tick_[v] != tick) {
+        vertex_local_tick_[v] = tick;
+        vertex_local_[v] = static_cast<int>(patch.vertex_map.size());
+        patch.vertex_map.push_back(v);
+      }
+      patch.mesh.F(static_cast<Eigen::Index>(i), k) = vertex_local_[v];
+    }
+  }
+  patch.mesh.V.resize(static_cast<Eigen::Index>(patch.vertex_map.size()), 3);
+  for (size_t i = 0; i < patch.vertex_map.size(); ++i)
+    patch.mesh.V.row(static_cast<Eigen::Index>(i)) = base_->V.row(patch.vertex_map[i]);
+  patch.mesh.N.resize(0, 3);
+  patch.uv = lscm(patch.mesh.V, patch.mesh.F);
+  const Eigen::VectorXd d = face_area_distortion(patch.mesh.V, patch.mesh.F, patch.uv);
+  patch.max_distortion = d.maxCoeff();
+}
+
+LocalPatch LocalPatchBuilder::grow(int seed_face, const LocalPatchOptions& options) {
+  const int nf = base_->num_faces();
+  MQ_CHECK(seed_face >= 0 && seed_face < nf, InvalidInput, "local patch: seed face ", seed_face,
+           " out of range [0, ", nf, ")");
+  MQ_CHECK(usable_[seed_face], InvalidInput, "local patch: seed face ", seed_face,
+           " is degenerate");
+  MQ_CHECK(std::isfinite(options.max_area) && options.max_area >= 0, InvalidInput,
+           "local patch: max_area must be finite and >= 0, got ", options.max_area);
+  MQ_CHECK(options.max_depth >= 0, InvalidInput, "local patch: max_depth must be >= 0, got ",
+           options.max_depth);
+  MQ_CHECK(options.max_distortion >= 1, InvalidInput,
+           "local patch: max_distortion must be >= 1, got ", options.max_distortion);
+
+  LocalPatch patch;
+  patch_tick_ = next_tick();
+  double area = 0;
+  const bool limit_area = options.max_area > 0;
+  auto full = [&] { return limit_area && area >= options.max_area; };
+  auto add = [&](int f) {
+    face_in_patch_[f] = patch_tick_;
+    for (int k = 0; k < 3; ++k) vertex_in_patch_[base_->F(f, k)] = patch_tick_;
+    patch.faces.push_back(f);
+    area += area_(f);
+  };
+  add(seed_face);
+  std::vector<int> frontier{seed_face}, candidates, refused, next;
+  for (int depth = 1; depth <= options.max_depth && !frontier.empty() && !full(); ++depth) {
+    const uint32_t layer = next_tick();
+    candidates.clear();
+    for (int f : frontier)
+      for (int k = 0; k < 3; ++k) {
+        const int g = TT_(f, k);
+        if (g < 0 || face_in_patch_[g] == patch_tick_ || face_seen_[g] == layer) continue;
+        face_seen_[g] = layer;
+        candidates.push_back(g);
+      }
+    next.clear();
+    // Retry refused faces while the layer makes progress: an added neighbour can turn a
+    // pinching face into a notch-closing one.
+    while (!candidates.empty() && !full()) {
+      refused.clear();
+      for (int g : candidates) {
+        if (full()) break;
+        if (can_add(g)) {
+          add(g);
+          next.push_back(g);
+        } else {
+          refused.push_back(g);
+        }
+      }
+      if (refused.size() == candidates.size()) break;
+      candidates.swap(refused);
+    }
+    frontier.swap(next);
+  }
+
+  flatten(patch, patch.faces.size());
+  while ((patch.max_distortion > options.max_distortion ||
+          count_flipped(patch.mesh.F, patch.uv) > 0) &&
+         patch.faces.size() > 1) {
+    // Halve the area: the longest growth-order prefix within half of it (at least the seed).
+    const double target = 0.5 * patch.area;
+    size_t keep = 1;
+    double prefix = area_(patch.faces[0]);
+    while (keep < patch.faces.size() && prefix + area_(patch.faces[keep]) <= target)
+      prefix += area_(patch.faces[keep++]);
+    ++patch.shrink_steps;
+    flatten(patch, keep);
+  }
+  return patch;
+}
+
+LocalPatch grow_local_patch(const TriMesh& base, const EdgeTopology& topo, const MatrixX3i& TT,
+                            int seed_face, const LocalPatchOptions& options) {
+  return LocalPatchBuilder(base, topo, TT).grow(seed_face, options);
+}
+
+}  // namespace mq

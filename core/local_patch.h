@@ -1,0 +1,83 @@
+// Local surface patches on a base mesh (paper section 3.1): a patch grows from a seed triangle by
+// breadth-first traversal, stays a topological disk, and is flattened by a least-squares
+// conformal map; it shrinks while the map's area distortion exceeds a bound.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/mesh.h"
+#include "core/mesh_topology.h"
+
+namespace mq {
+
+struct LocalPatchOptions {
+  double max_area = 0;        // stop growing once the patch area reaches this (0: unlimited)
+  int max_depth = 1 << 30;    // breadth-first layers around the seed (0: the seed alone)
+  double max_distortion = 4;  // shrink while the worst face area distortion exceeds this (>= 1)
+};
+
+struct LocalPatch {
+  std::vector<int> faces;       // base face ids in growth order, seed first
+  TriMesh mesh;                 // the patch's own vertices and faces (F rows match faces)
+  std::vector<int> vertex_map;  // patch vertex -> base vertex
+  MatrixX2d uv;                 // LSCM of the patch, #patch V by 2, area-matched to 3D
+  double max_distortion = 1;    // worst face area distortion of uv
+  int shrink_steps = 0;         // how many times the patch was halved
+  double area = 0;              // 3D area of the patch
+};
+
+// Grows and flattens local patches on one base mesh. Keeps per-face and per-vertex stamp arrays
+// so that each grow() costs time proportional to the patch, not to the base mesh.
+// Not thread-safe (grow() uses the workspace): use one builder per thread.
+class LocalPatchBuilder {
+ public:
+  // base is borrowed and must outlive the builder; its topology is computed here (O(#F log #F)).
+  // Throws InvalidInput for an index out of range or a non-finite position.
+  explicit LocalPatchBuilder(const TriMesh& base);
+  // Same with precomputed topology (copied): topo = edge_topology(base.F, #V),
+  // TT = face_adjacency(topo). Throws InvalidInput when their sizes do not match base.
+  LocalPatchBuilder(const TriMesh& base, const EdgeTopology& topo, const MatrixX3i& TT);
+
+  // Grows a patch from seed_face across manifold edges (TT), layer by layer, until its area
+  // reaches options.max_area or options.max_depth layers are done. A face is added only when the
+  // patch stays a topological disk: it shares one edge with the patch and brings a new vertex,
+  // or it shares two edges and closes a notch; faces with zero area or a repeated vertex are
+  // never added. Faces refused in a layer are retried after the rest of it. The patch is then
+  // flattened with lscm; while the worst face area distortion exceeds options.max_distortion or
+  // a UV triangle is flipped, the patch is cut to the longest prefix of its growth order with at
+  // most half its area (every prefix is a disk) and flattened again.
+  // Guarantees: one boundary loop, Euler characteristic 1, the seed is faces[0], area <
+  // max_area + area of one face (when max_area > 0). The result may still exceed max_distortion
+  // only when it is down to the seed alone.
+  // Throws InvalidInput for a seed out of range or degenerate, or bad options (max_area < 0 or
+  // not finite, max_depth < 0, max_distortion < 1 or NaN); SolverFailure from lscm.
+  LocalPatch grow(int seed_face, const LocalPatchOptions& options = {});
+
+  const TriMesh& base() const { return *base_; }
+
+ private:
+  void init();
+  bool can_add(int f) const;
+  void flatten(LocalPatch& patch, size_t num_faces);
+  uint32_t next_tick();
+
+  const TriMesh* base_;
+  EdgeTopology topo_;
+  MatrixX3i TT_;
+  Eigen::VectorXd area_;
+  std::vector<char> usable_;             // per base face: non-degenerate
+  std::vector<uint32_t> face_in_patch_;  // == patch tick when in the current patch
+  std::vector<uint32_t> face_seen_;      // == layer tick when queued in the current layer
+  std::vector<uint32_t> vertex_in_patch_;
+  std::vector<uint32_t> vertex_local_tick_;
+  std::vector<int> vertex_local_;
+  uint32_t tick_ = 0;
+  uint32_t patch_tick_ = 0;
+};
+
+// One-off form: LocalPatchBuilder(base, topo, TT).grow(seed_face, options); O(#F) setup.
+LocalPatch grow_local_patch(const TriMesh& base, const EdgeTopology& topo, const MatrixX3i& TT,
+                            int seed_face, const LocalPatchOptions& options);
+
+}  // namespace mq

@@ -1,0 +1,238 @@
+#include "core/lscm.h"
+
+#include <Eigen/Sparse>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/mesh_topology.h"
+
+namespace mq {
+namespace {
+
+Vector3d row3(const MatrixX3d& V, int i) { return V.row(i).transpose(); }
+
+void check_indices(const MatrixX3i& F, Eigen::Index n) {
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      MQ_CHECK(F(f, k) >= 0 && F(f, k) < n, InvalidInput, "face ", f, " has vertex index ", F(f, k),
+               " out of range [0, ", n, ")");
+}
+
+// Checks that F is a connected, manifold disk; returns its boundary loop.
+std::vector<int> disk_boundary(const MatrixX3i& F, int n) {
+  const EdgeTopology topo = edge_topology(F, n);
+  // Boundary edges traversed as in their face; each vertex needs in- and out-degree <= 1.
+  std::vector<int> next(n, -1), in_count(n, 0);
+  for (int e = 0; e < topo.num_edges(); ++e)
+    MQ_CHECK(!topo.is_non_manifold(e), TopologyError, "lscm: edge (", topo.E(e, 0), ", ",
+             topo.E(e, 1), ") is used by ", topo.edge_faces.degree(e), " faces");
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      if (!topo.is_boundary(topo.FE(f, k))) continue;
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      MQ_CHECK(next[a] < 0, TopologyError, "lscm: non-manifold boundary vertex ", a);
+      next[a] = b;
+      ++in_count[b];
+    }
+  int start = -1;
+  for (int v = 0; v < n; ++v) {
+    MQ_CHECK((next[v] >= 0 ? 1 : 0) == in_count[v], TopologyError,
+             "lscm: non-manifold or inconsistently oriented boundary at vertex ", v);
+    if (start < 0 && next[v] >= 0) start = v;
+  }
+  MQ_CHECK(start >= 0, TopologyError, "lscm: the patch has no boundary (closed surface)");
+  std::vector<int> loop;
+  for (int v = start; v != start || loop.empty(); v = next[v]) loop.push_back(v);
+  const int boundary_edges =
+      static_cast<int>(std::count_if(next.begin(), next.end(), [](int v) { return v >= 0; }));
+  MQ_CHECK(static_cast<int>(loop.size()) == boundary_edges, TopologyError,
+           "lscm: the patch has several boundary loops, expected one (a topological disk)");
+  const int euler = n - topo.num_edges() + static_cast<int>(F.rows());
+  MQ_CHECK(euler == 1, TopologyError, "lscm: the patch has Euler characteristic ", euler,
+           ", expected 1 (a topological disk)");
+  // Connected through edges: union-find over vertices.
+  std::vector<int> root(n);
+  for (int v = 0; v < n; ++v) root[v] = v;
+  auto find_root = [&](int i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  int components = n;
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    const int a = find_root(topo.E(e, 0)), b = find_root(topo.E(e, 1));
+    if (a != b) root[std::max(a, b)] = std::min(a, b), --components;
+  }
+  MQ_CHECK(components == 1, TopologyError, "lscm: the patch has ", components,
+           " connected components, expected one");
+  // Each vertex's corners must form a single fan (no pinch): union the corners of a vertex
+  // across every interior edge and count the fans per vertex.
+  std::vector<int> parent(3 * F.rows());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto corner = [&](int f, int v) {
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) return 3 * f + k;
+    return -1;
+  };
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    if (topo.edge_faces.degree(e) != 2) continue;
+    const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
+    for (int s = 0; s < 2; ++s) {
+      const int a = find(corner(f, topo.E(e, s))), b = find(corner(g, topo.E(e, s)));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<int> fan_root(n, -1);
+  for (int c = 0; c < 3 * F.rows(); ++c) {
+    const int v = F(c / 3, c % 3), r = find(c);
+    MQ_CHECK(fan_root[v] < 0 || fan_root[v] == r, TopologyError, "lscm: vertex ", v,
+             " is non-manifold (its faces form several fans)");
+    fan_root[v] = r;
+  }
+  return loop;
+}
+
+}  // namespace
+
+MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
+  const int n = static_cast<int>(V.rows());
+  const int nf = static_cast<int>(F.rows());
+  MQ_CHECK(nf > 0, InvalidInput, "lscm: the patch has no faces");
+  check_indices(F, n);
+  MQ_CHECK(V.allFinite(), InvalidInput, "lscm: non-finite vertex position");
+  std::vector<char> used(n, 0);
+  for (int f = 0; f < nf; ++f) {
+    MQ_CHECK(F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0), InvalidInput,
+             "lscm: face ", f, " repeats a vertex");
+    for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
+  }
+  for (int v = 0; v < n; ++v)
+    MQ_CHECK(used[v], InvalidInput, "lscm: vertex ", v, " is used by no face");
+  const std::vector<int> boundary = disk_boundary(F, n);
+
+  // Pins: double sweep over the boundary for a far-apart pair (first farthest point wins ties).
+  auto farthest = [&](int from) {
+    int best = boundary[0];
+    double best_d = -1;
+    for (int v : boundary) {
+      const double d = (row3(V, v) - row3(V, from)).squaredNorm();
+      if (d > best_d) best_d = d, best = v;
+    }
+    return best;
+  };
+  const int pin1 = farthest(boundary[0]);
+  const int pin0 = farthest(pin1);
+  const double pin_distance = (row3(V, pin1) - row3(V, pin0)).norm();
+  MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
+
+  // Unknowns: u and v of every free vertex; pinned values go to the right-hand side.
+  std::vector<int> unknown(n, -1);
+  int nu = 0;
+  for (int v = 0; v < n; ++v)
+    if (v != pin0 && v != pin1) unknown[v] = nu++;
+  Vector2d pinned[2] = {Vector2d::Zero(), Vector2d(pin_distance, 0)};
+  auto pinned_uv = [&](int v) { return v == pin0 ? pinned[0] : pinned[1]; };
+
+  // Per triangle, in a local orthonormal frame with edges e_j = p_{j+2} - p_{j+1}, the residual
+  // of Cauchy-Riemann is proportional to sum_j u_j e_j + v_j rot90(e_j); weight 1 / (2 sqrt(A)).
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(nf) * 12);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
+  double area3d = 0;
+  for (int f = 0; f < nf; ++f) {
+    const Vector3d P0 = row3(V, F(f, 0)), P1 = row3(V, F(f, 1)), P2 = row3(V, F(f, 2));
+    const Vector3d normal = (P1 - P0).cross(P2 - P0);
+    const double twice_area = normal.norm();
+    const double l01 = (P1 - P0).norm();
+    MQ_CHECK(twice_area > 0 && l01 > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
+             " has zero area");
+    area3d += 0.5 * twice_area;
+    const Vector3d x = (P1 - P0) / l01;
+    const Vector3d y = normal.cross(x).normalized();
+    const Vector2d p[3] = {Vector2d::Zero(), Vector2d(l01, 0),
+                           Vector2d((P2 - P0).dot(x), (P2 - P0).dot(y))};
+    const double w = 1.0 / std::sqrt(2.0 * twice_area);  // 1 / (2 sqrt(A))
+    for (int j = 0; j < 3; ++j) {
+      const Vector2d e = w * (p[(j + 2) % 3] - p[(j + 1) % 3]);
+      const Vector2d r(-e.y(), e.x());  // rot90(e)
+      const int vj = F(f, j);
+      // Row 2f: u_j e.x + v_j r.x; row 2f+1: u_j e.y + v_j r.y.
+      if (unknown[vj] >= 0) {
+        const int cu = unknown[vj], cv = nu + unknown[vj];
+        triplets.emplace_back(2 * f, cu, e.x());
+        triplets.emplace_back(2 * f, cv, r.x());
+        triplets.emplace_back(2 * f + 1, cu, e.y());
+        triplets.emplace_back(2 * f + 1, cv, r.y());
+      } else {
+        const Vector2d q = pinned_uv(vj);
+        rhs(2 * f) -= q.x() * e.x() + q.y() * r.x();
+        rhs(2 * f + 1) -= q.x() * e.y() + q.y() * r.y();
+      }
+    }
+  }
+  MatrixX2d UV(n, 2);
+  UV.row(pin0) = pinned[0].transpose();
+  UV.row(pin1) = pinned[1].transpose();
+  if (nu > 0) {
+    Eigen::SparseMatrix<double> A(2 * nf, 2 * nu);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    const Eigen::SparseMatrix<double> AtA = A.transpose() * A;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(AtA);
+    MQ_CHECK(solver.info() == Eigen::Success, SolverFailure,
+             "lscm: factorisation of the conformal energy failed");
+    const Eigen::VectorXd x = solver.solve(A.transpose() * rhs);
+    MQ_CHECK(solver.info() == Eigen::Success && x.allFinite(), SolverFailure,
+             "lscm: the conformal solve failed");
+    for (int v = 0; v < n; ++v)
+      if (unknown[v] >= 0) UV.row(v) << x(unknown[v]), x(nu + unknown[v]);
+  }
+
+  // Rescale about pin0 so that total UV area equals total 3D area.
+  double area_uv = 0;
+  for (int f = 0; f < nf; ++f) {
+    const Vector2d a = UV.row(F(f, 0)).transpose(), b = UV.row(F(f, 1)).transpose(),
+                   c = UV.row(F(f, 2)).transpose();
+    const Vector2d ab = b - a, ac = c - a;
+    area_uv += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+  }
+  MQ_CHECK(area_uv > 0 && std::isfinite(area_uv), SolverFailure,
+           "lscm: the conformal map has non-positive total area");
+  UV *= std::sqrt(area3d / area_uv);
+  return UV;
+}
+
+Eigen::VectorXd face_area_distortion(const MatrixX3d& V, const MatrixX3i& F, const MatrixX2d& UV) {
+  MQ_CHECK(V.rows() == UV.rows(), InvalidInput, "face_area_distortion: ", V.rows(),
+           " vertices but ", UV.rows(), " UV rows");
+  check_indices(F, V.rows());
+  Eigen::VectorXd d(F.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    const Vector3d P0 = row3(V, F(f, 0));
+    const double a3 = 0.5 * (row3(V, F(f, 1)) - P0).cross(row3(V, F(f, 2)) - P0).norm();
+    const Vector2d ab = (UV.row(F(f, 1)) - UV.row(F(f, 0))).transpose();
+    const Vector2d ac = (UV.row(F(f, 2)) - UV.row(F(f, 0))).transpose();
+    const double a2 = 0.5 * std::abs(ab.x() * ac.y() - ab.y() * ac.x());
+    d(f) =
+        (a3 > 0 && a2 > 0) ? std::max(a2 / a3, a3 / a2) : std::numeric_limits<double>::infinity();
+  }
+  return d;
+}
+
+int count_flipped(const MatrixX3i& F, const MatrixX2d& UV) {
+  check_indices(F, UV.rows());
+  int flipped = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Vector2d ab = (UV.row(F(f, 1)) - UV.row(F(f, 0))).transpose();
+    const Vector2d ac = (UV.row(F(f, 2)) - UV.row(F(f, 0))).transpose();
+    if (ab.x() * ac.y() - ab.y() * ac.x() < 0) ++flipped;
+  }
+  return flipped;
+}
+
+}  // namespace mq
