@@ -1,22 +1,28 @@
 // The overlapping region of paper section 2.5: where a newly placed swatch patch covers output
-// cells that were already processed.
+// that was already synthesised. Planar quilting knows "already synthesised" from its grid cells,
+// surface quilting from its base triangles; both give it as a predicate over the patch plane.
 #pragma once
 
+#include <functional>
+
 #include "core/mesh.h"
-#include "core/synthesis_grid.h"
 
 namespace mq {
 
 class OverlapRegion {
  public:
-  // patch_lo, patch_hi: the xy footprint of the translated swatch. The grid's processed flags
-  // are read at construction and must describe the output before this patch was merged.
-  OverlapRegion(const SynthesisGrid& grid, Vector2d patch_lo, Vector2d patch_hi);
+  // Whether the point (x, y) of the patch plane lies over output synthesised before this patch.
+  using ProcessedTest = std::function<bool(double x, double y)>;
 
-  // Inside the patch footprint and over a processed cell.
-  bool contains(double x, double y) const;
+  // patch_lo, patch_hi: the xy footprint of the translated swatch. `processed` must describe the
+  // output before this patch is merged (take a snapshot if the caller's state changes).
+  OverlapRegion(Vector2d patch_lo, Vector2d patch_hi, ProcessedTest processed)
+      : lo_(patch_lo), hi_(patch_hi), processed_(std::move(processed)) {}
+
+  // Inside the patch footprint and over synthesised output.
+  bool contains(double x, double y) const { return in_patch(x, y) && processed_(x, y); }
   bool contains(const Vector3d& p) const { return contains(p.x(), p.y()); }
-  // Inside the patch footprint (processed or not).
+  // Inside the patch footprint (synthesised or not).
   bool in_patch(double x, double y) const {
     return x >= lo_.x() && y >= lo_.y() && x <= hi_.x() && y <= hi_.y();
   }
@@ -24,9 +30,8 @@ class OverlapRegion {
   const Vector2d& patch_hi() const { return hi_; }
 
  private:
-  const SynthesisGrid& grid_;
-  std::vector<unsigned char> processed_;
   Vector2d lo_, hi_;
+  ProcessedTest processed_;
 };
 
 }  // namespace mq

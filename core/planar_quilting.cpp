@@ -7,9 +7,8 @@
 #include <memory>
 
 #include "core/closest_point_query.h"
+#include "core/patch_quilting.h"
 #include "core/errors.h"
-#include "core/laplacian_deformation.h"
-#include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/synthesis_grid.h"
 
@@ -24,29 +23,28 @@ TriMesh as_mesh(const Element& e) {
   return m;
 }
 
-bool boxes_overlap(const Element& a, const Element& b) {
-  return a.lo.x() <= b.hi.x() && b.lo.x() <= a.hi.x() && a.lo.y() <= b.hi.y() &&
-         b.lo.y() <= a.hi.y() && a.z_lo <= b.z_hi && b.z_lo <= a.z_hi;
-}
-
 // The growing output: elements with a per-cell index of their footprints for local queries.
-class OutputStore {
+class OutputStore final : public PatchOutput {
  public:
   explicit OutputStore(const SynthesisGrid& grid) : grid_(grid), cells_(grid.num_cells()) {}
 
-  int add(Element e) {
+  const Element& element(int id) const override { return elements_[id]; }
+  std::vector<int> elements_near(const Vector2d& lo, const Vector2d& hi) const override {
+    return query(lo, hi);
+  }
+  int add(Element e) override {
     const int id = static_cast<int>(elements_.size());
     elements_.push_back(std::move(e));
     alive_.push_back(1);
     index(id);
     return id;
   }
-  void replace(int id, Element e) {
+  void replace(int id, Element e) override {
     elements_[id] = std::move(e);
     index(id);
   }
-  void remove(int id) { alive_[id] = 0; }
-  bool alive(int id) const { return alive_[id] != 0; }
+  void remove(int id) override { alive_[id] = 0; }
+  bool alive(int id) const override { return alive_[id] != 0; }
   const Element& operator[](int id) const { return elements_[id]; }
   const std::vector<Element>& elements() const { return elements_; }
   int size() const { return static_cast<int>(elements_.size()); }
@@ -150,7 +148,6 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       1, std::min({static_cast<int>(options.subpatch_fraction * std::min(swatch_cells_x,
                                                                           swatch_cells_y)),
                    swatch_cells_x, swatch_cells_y}));
-  const double mean_edge = swatch.mean_edge_length;
   const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
 
   std::unique_ptr<SwatchDistanceGrid> distance_grid;
@@ -163,19 +160,15 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   OutputStore output(grid);
   std::mt19937_64 rng(options.seed);
 
-  // Adds e unless it would intersect a live output element other than those in `ignore`.
-  auto fits = [&](const Element& e, const std::vector<int>& ignore) {
-    const TriMesh m = as_mesh(e);
-    for (const int id : output.query(e.lo, e.hi)) {
-      if (std::find(ignore.begin(), ignore.end(), id) != ignore.end()) continue;
-      if (boxes_overlap(output[id], e) && meshes_intersect(as_mesh(output[id]), m)) return false;
-    }
-    return true;
-  };
-  auto in_domain = [&](const Element& e) {
+  const std::function<bool(const Element&)> in_domain = [&](const Element& e) {
     return e.hi.x() > domain_lo.x() && e.lo.x() < domain_hi.x() && e.hi.y() > domain_lo.y() &&
            e.lo.y() < domain_hi.y();
   };
+  PatchQuiltingOptions patch_options;
+  patch_options.correspondence = options.correspondence;
+  patch_options.merging = options.merging;
+  patch_options.deform = options.deform;
+  PatchCounts patch_counts;
   // Marks the cells lying entirely inside the patch footprint [lo, hi].
   auto mark_patch = [&](const Vector2d& lo, const Vector2d& hi) {
     const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x() / cell - 1e-9)));
@@ -250,158 +243,17 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     }
     const Vector3d t = choice.offset;
     const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
-    const OverlapRegion region(grid, patch_lo, patch_hi);
+    // A snapshot of the processed cells: merging must see the output as it was before.
+    std::vector<unsigned char> processed(grid.num_cells());
+    for (int i = 0; i < grid.num_cells(); ++i) processed[i] = grid.processed(grid.cell(i));
+    const OverlapRegion region(patch_lo, patch_hi, [&grid, processed](double x, double y) {
+      const Cell c = grid.cell_of(x, y);
+      return grid.contains(c) && processed[grid.index(c)] != 0;
+    });
 
-    // Step 3 (section 2.5): correspondences in the overlapping region.
-    Correspondences corr;
-    std::vector<Element> moved(swatch.elements.size());
-    {
-      ScopedStageTimer timer(times, "correspondence");
-      for (size_t i = 0; i < moved.size(); ++i) {
-        moved[i] = swatch.elements[i];
-        moved[i].translate(t);
-      }
-      corr = find_correspondences(output.elements(), output.query(patch_lo, patch_hi), region,
-                                  swatch, *swatch_query, t, options.correspondence);
-      stats.pairs += static_cast<int>(corr.pairs.size());
-      stats.relations += static_cast<int>(corr.relations.size());
-    }
-
-    // Step 4 (section 2.6): deform both sides of every relation towards the averaged points.
-    std::map<int, Element> deformed_out;  // output id -> deformed copy
-    {
-      ScopedStageTimer timer(times, "deformation");
-      std::map<int, std::vector<LinearConstraint>> out_constraints, in_constraints;
-      for (const VertexFacePair& p : corr.pairs) {
-        const Vector3d v = output[p.out_element].V.row(p.out_vertex).transpose();
-        const Vector3d target = 0.5 * (v + p.closest);
-        out_constraints[p.out_element].push_back(LinearConstraint::point(p.out_vertex, target));
-        const auto& f = swatch.elements[p.in_element].F.row(p.in_face);
-        in_constraints[p.in_element].push_back(
-            LinearConstraint::barycentric(f(0), f(1), f(2), p.barycentric, target));
-      }
-      if (options.deform) {
-        std::vector<DeformationJob> jobs;
-        std::vector<std::pair<bool, int>> owners;  // (is output, id)
-        // Section 2.6 aligns elements where they correspond; the rest of a long element (a
-        // thread running far out of the overlap) is anchored so it does not swing.
-        auto anchored = [&](const Element& e, std::vector<LinearConstraint> cs) {
-          const auto anchors =
-              anchor_far_vertices(e.V, e.F, cs, options.merging.deformation_rings);
-          cs.insert(cs.end(), anchors.begin(), anchors.end());
-          return cs;
-        };
-        for (auto& [id, cs] : out_constraints) {
-          jobs.push_back({&output[id].V, &output[id].F, anchored(output[id], std::move(cs))});
-          owners.emplace_back(true, id);
-        }
-        for (auto& [id, cs] : in_constraints) {
-          jobs.push_back({&moved[id].V, &moved[id].F, anchored(moved[id], std::move(cs))});
-          owners.emplace_back(false, id);
-        }
-        DeformationOptions d;
-        d.mu = options.merging.mu;
-        std::vector<MatrixX3d> solved = deform_elements(jobs, d);
-        for (size_t j = 0; j < solved.size(); ++j) {
-          const auto [is_out, id] = owners[j];
-          Element& e = is_out ? deformed_out[id] : moved[id];
-          if (is_out) {
-            e.F = output[id].F;
-          }
-          e.V = std::move(solved[j]);
-          e.update();
-        }
-      }
-    }
-
-    // Step 5 (section 2.7): merge.
-    {
-      ScopedStageTimer timer(times, "merging");
-      // Partners of each swatch element. Relations carried by only a few pairs next to a strong
-      // one come from elements that merely touch it (crossing threads of a weave, neighbouring
-      // rings): they are not the same element and are ignored.
-      std::map<std::pair<int, int>, int> pair_count;
-      for (const VertexFacePair& p : corr.pairs) ++pair_count[{p.out_element, p.in_element}];
-      std::vector<int> strongest(moved.size(), 0);
-      for (const auto& [rel, n] : pair_count) strongest[rel.second] = std::max(strongest[rel.second], n);
-      std::vector<std::vector<int>> partners(moved.size());
-      for (const auto& [o, i] : corr.relations)
-        if (4 * pair_count[{o, i}] >= strongest[i]) partners[i].push_back(o);
-      auto inside = [&](const Element& e) {
-        for (int v = 0; v < e.V.rows(); ++v)
-          if (!region.contains(e.V.row(v).transpose())) return false;
-        return true;
-      };
-      // Output elements take their deformed shape once they are merged with a partner.
-      auto current = [&](int id) -> const Element& {
-        auto it = deformed_out.find(id);
-        return it == deformed_out.end() ? output[id] : it->second;
-      };
-      std::vector<char> busy(output.size(), 0);
-      for (size_t i = 0; i < moved.size(); ++i) {
-        const Element& in = moved[i];
-        if (!in_domain(in)) continue;
-        std::vector<int> related;
-        for (const int o : partners[i])
-          if (output.alive(o)) related.push_back(o);
-        if (related.empty()) {
-          // No partner: added as it is (if it fits among the existing elements).
-          if (fits(in, {})) {
-            output.add(in);
-            ++stats.elements_added;
-          } else {
-            ++stats.rejected_intersecting;
-          }
-          continue;
-        }
-        if (inside(in)) {
-          ++stats.elements_dropped;  // the output already has this element
-          continue;
-        }
-        std::vector<int> replaced, crossing;
-        for (const int o : related) (inside(output[o]) && !busy[o] ? replaced : crossing).push_back(o);
-        if (crossing.empty()) {
-          if (fits(in, replaced)) {
-            for (const int o : replaced) output.remove(o);
-            output.add(in);
-            stats.elements_replaced += static_cast<int>(replaced.size());
-          } else {
-            ++stats.rejected_intersecting;
-          }
-          continue;
-        }
-        if (crossing.size() != 1 || busy[crossing[0]]) {
-          ++stats.elements_dropped;
-          continue;
-        }
-        const int o = crossing[0];
-        const Element& base = current(o);
-        // The same element placed twice (nearly identical, or mostly the same footprint, as for
-        // two apples slightly apart): keep the output one rather than stitching two halves.
-        if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge) ||
-            footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
-          ++stats.elements_matched;
-          busy[o] = 1;
-          continue;
-        }
-        StitchFailure why = StitchFailure::None;
-        std::optional<Element> joined =
-            cut_and_stitch(base, in, region, mean_edge, options.merging, &why);
-        std::vector<int> ignore = replaced;
-        ignore.push_back(o);
-        if (joined && fits(*joined, ignore)) {
-          for (const int r : replaced) output.remove(r);
-          output.replace(o, std::move(*joined));
-          busy.resize(output.size(), 0);
-          busy[o] = 1;
-          ++stats.elements_stitched;
-        } else {
-          ++stats.stitch_fallbacks;
-          ++stats.stitch_failures[static_cast<int>(joined ? StitchFailure::None : why)];
-        }
-      }
-      busy.resize(output.size(), 0);
-    }
+    // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
+    quilt_patch(output, swatch, *swatch_query, t, region, in_domain, patch_options, patch_counts,
+                times);
     mark_patch(patch_lo, patch_hi);
     grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
     report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
@@ -444,6 +296,16 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     }
     for (const Element& e : trimmed) kept.push_back(&e);
   }
+  stats.pairs = patch_counts.pairs;
+  stats.relations = patch_counts.relations;
+  stats.elements_added += patch_counts.added;
+  stats.elements_replaced = patch_counts.replaced;
+  stats.elements_stitched = patch_counts.stitched;
+  stats.elements_matched = patch_counts.matched;
+  stats.elements_dropped = patch_counts.dropped;
+  stats.stitch_fallbacks = patch_counts.stitch_fallbacks;
+  stats.rejected_intersecting = patch_counts.rejected_intersecting;
+  stats.stitch_failures = patch_counts.stitch_failures;
   TriMesh result = merge_elements(kept);
   // Back to the swatch's own axes (the thickness axis returns to where it was).
   const Eigen::Matrix3d back = swatch.rotation.transpose();

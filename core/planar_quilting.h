@@ -37,8 +37,8 @@ struct PlanarQuiltingStats {
   double cell_size = 0;
   int grid_nx = 0, grid_ny = 0;
   long long matched_point_offsets = 0;  // (point, offset) evaluations of Eq. (2)
-  int pairs = 0;                 // vertex-face pairs kept over all iterations
-  int relations = 0;             // element relations kept over all iterations
+  long long pairs = 0;           // vertex-face pairs kept over all iterations
+  long long relations = 0;       // element relations kept over all iterations
   int elements_added = 0;        // swatch elements without partner added as they are
   int elements_replaced = 0;     // output elements inside the overlap replaced by swatch ones
   int elements_stitched = 0;     // cut-and-stitch merges
