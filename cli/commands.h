@@ -8,5 +8,6 @@ int run_info(int argc, char** argv, int first);
 int run_swatch(int argc, char** argv, int first);
 int run_render(int argc, char** argv, int first);
 int run_plane(int argc, char** argv, int first);
+int run_surface(int argc, char** argv, int first);
 
 }  // namespace mq::cli

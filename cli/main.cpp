@@ -18,6 +18,7 @@ constexpr const char* kUsage =
     "\n"
     "commands:\n"
     "  plane    grow a swatch into a seamless L x W layer\n"
+    "  surface  cover a base mesh with the swatch's geometry in a thin shell\n"
     "  swatch   generate a sample swatch (chainmail, weave, apples, ivy)\n"
     "  info     print counts, bounding box and topology of a mesh file\n"
     "  render   render a mesh to a PNG preview\n"
@@ -34,6 +35,7 @@ constexpr Command kCommands[] = {
     {"swatch", mq::cli::run_swatch},
     {"render", mq::cli::run_render},
     {"plane", mq::cli::run_plane},
+    {"surface", mq::cli::run_surface},
 };
 
 }  // namespace

@@ -1,0 +1,155 @@
+// meshquilt surface: mesh quilting over a base mesh (paper section 3.1).
+#include <chrono>
+#include <cstdio>
+
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "cli/json_writer.h"
+#include "cli/run_context.h"
+#include "core/atomic_file.h"
+#include "core/mesh_io.h"
+#include "core/surface_quilting.h"
+#include "core/tangent_field.h"
+#include "host/translation_cost_evaluator.h"
+
+namespace mq::cli {
+
+namespace {
+
+void write_stats(const std::string& path, const SurfaceQuiltingStats& s, const std::string& device,
+                 int threads, double wall, const std::string& base, const std::string& swatch) {
+  JsonWriter j;
+  j.begin_object()
+      .value("command", "surface")
+      .value("base", base)
+      .value("swatch", swatch)
+      .value("device", device)
+      .value("threads", threads)
+      .value("wall_seconds", wall)
+      .value("base_faces", s.base_faces)
+      .value("swatch_scale", s.swatch_scale)
+      .value("shell_height", s.shell_height)
+      .value("cell_size", s.cell_size)
+      .value("iterations", s.iterations)
+      .value("patches_shrunk", s.patches_shrunk)
+      .begin_object("output")
+      .value("faces", s.faces)
+      .value("vertices", s.vertices)
+      .value("elements", s.elements)
+      .end_object()
+      .begin_object("elements")
+      .value("added", s.counts.added)
+      .value("replaced", s.counts.replaced)
+      .value("stitched", s.counts.stitched)
+      .value("matched", s.counts.matched)
+      .value("dropped", s.counts.dropped)
+      .value("stitch_fallbacks", s.counts.stitch_fallbacks)
+      .value("rejected_intersecting", s.counts.rejected_intersecting)
+      .value("rejected_outside_patch", s.rejected_outside_patch)
+      .value("removed_post", s.removed_post)
+      .end_object()
+      .begin_object("element_area")
+      .value("mean", s.element_area_mean)
+      .value("cv", s.element_area_cv)
+      .value("min", s.element_area_min)
+      .value("max", s.element_area_max)
+      .end_object()
+      .value("matched_point_offsets", s.matched_point_offsets)
+      .value("pairs", s.counts.pairs)
+      .value("relations", s.counts.relations)
+      .begin_object("stage_seconds");
+  for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
+  j.end_object().end_object();
+  write_file_atomically(path, j.str());
+}
+
+Device parse_device(const std::string& name) {
+  if (name == "auto") return Device::Auto;
+  if (name == "cpu") return Device::Cpu;
+  if (name == "opencl") return Device::OpenCL;
+  throw UsageError("--device expects auto, cpu or opencl, got '" + name + "'");
+}
+
+}  // namespace
+
+int run_surface(int argc, char** argv, int first) {
+  CommandLine cl("surface", "--base BASE --swatch SW -o OUT [options]",
+                 "Covers a base mesh (closed or with boundary, any genus, several components)\n"
+                 "with the swatch's geometry inside a thin shell over its surface, by mesh\n"
+                 "quilting over local conformal patches (paper section 3.1).");
+  cl.option("base", "FILE", "base mesh (OBJ, PLY or OFF)");
+  cl.option("swatch", "FILE", "swatch mesh; its smallest bounding-box side is the shell height");
+  cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
+  cl.option("scale", "S", "swatch's longer side as a fraction of the base's bounding-box diagonal",
+            "0.1");
+  cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
+            3);
+  cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");
+  cl.option("keys", "FILE", "guidance: 'vertex x y z' key vectors diffused over the surface");
+  cl.option("seed", "N", "random seed (used with --variety)", "1");
+  cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
+  cl.option("device", "auto|cpu|opencl", "where the translation cost runs", "auto");
+  cl.flag("no-deform", "skip element deformation (section 2.6)");
+  cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
+  add_run_options(cl);
+  if (!cl.parse(argc, argv, first)) return 0;
+  if (!cl.has("base")) throw UsageError("--base FILE is required");
+  if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
+  if (!cl.has("output")) throw UsageError("-o OUT is required");
+  if (cl.has("field") + cl.has("field-file") + cl.has("keys") > 1)
+    throw UsageError("give at most one of --field, --field-file and --keys");
+  const std::string out_path = cl.get("output");
+  mesh_format_from_path(out_path);
+
+  SurfaceQuiltingOptions options;
+  options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
+  options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
+  options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
+  options.patch.deform = !cl.has("no-deform");
+  options.remove_intersecting = !cl.has("keep-intersecting");
+  const Device device = parse_device(cl.get("device"));
+
+  RunContext run(cl);
+  const auto start = std::chrono::steady_clock::now();
+  const TriMesh base = read_mesh(cl.get("base"));
+  const TriMesh swatch = read_mesh(cl.get("swatch"));
+  if (cl.has("field")) {
+    const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
+                     cl.get_double("field", 2));
+    if (!(d.norm() > 0)) throw UsageError("--field needs a non-zero direction");
+    options.field = tangent_field_from_direction(base.V, base.F, d);
+  } else if (cl.has("field-file")) {
+    options.field = tangent_field_from_vertex_vectors(
+        base.V, base.F, read_vertex_vector_field(cl.get("field-file"), base.num_vertices()));
+  } else if (cl.has("keys")) {
+    options.field = tangent_field_from_key_vectors(
+        base.V, base.F, read_key_vectors(cl.get("keys"), base.num_vertices()));
+  }
+  std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt quilt =
+      quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+  const TriMesh result = embed_by_normal_displacement(base, quilt);
+  {
+    ScopedStageTimer timer(stats.times, "write");
+    write_mesh(out_path, result);
+  }
+  run.progress()->finish();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!run.stats_path().empty())
+    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("base"),
+                cl.get("swatch"));
+  if (!run.quiet()) {
+    std::printf("wrote %s: %d faces, %d vertices, %d elements (shell height %.4g)\n",
+                out_path.c_str(), stats.faces, stats.vertices, stats.elements, stats.shell_height);
+    std::printf("%d patches in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+                "%d added, %d matched, %d removed\n",
+                stats.iterations, wall, evaluator->name().c_str(), run.threads(),
+                stats.counts.stitched, stats.counts.replaced, stats.counts.added,
+                stats.counts.matched, stats.removed_post);
+  }
+  return 0;
+}
+
+}  // namespace mq::cli

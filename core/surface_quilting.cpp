@@ -1,0 +1,594 @@
+#include "core/surface_quilting.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <set>
+#include <unordered_map>
+
+#include "core/closest_point_query.h"
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/local_patch.h"
+#include "core/mesh_intersections.h"
+#include "core/mesh_topology.h"
+#include "core/quilt_elements.h"
+#include "core/tangent_field.h"
+
+namespace mq {
+
+namespace {
+
+// Barycentric coordinates of p's orthogonal projection onto the plane of (a, b, c); they are not
+// clamped, so points beyond the triangle extrapolate its affine map.
+Vector3d plane_barycentric(const Vector3d& p, const Vector3d& a, const Vector3d& b,
+                           const Vector3d& c) {
+  const Vector3d e0 = b - a, e1 = c - a, d = p - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double d20 = d.dot(e0), d21 = d.dot(e1);
+  const double den = d00 * d11 - d01 * d01;
+  if (!(std::abs(den) > 0)) return Vector3d(1, 0, 0);
+  const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+  return Vector3d(1 - v - w, v, w);
+}
+
+Vector3d triangle_barycentric_2d(const Vector2d& p, const Vector2d& a, const Vector2d& b,
+                                 const Vector2d& c) {
+  const Vector2d e0 = b - a, e1 = c - a, d = p - a;
+  const double den = e0.x() * e1.y() - e1.x() * e0.y();
+  if (!(std::abs(den) > 0)) return Vector3d(1, 0, 0);
+  const double v = (d.x() * e1.y() - e1.x() * d.y()) / den;
+  const double w = (e0.x() * d.y() - d.x() * e0.y()) / den;
+  return Vector3d(1 - v - w, v, w);
+}
+
+// A flattened local patch in the synthesis frame: the LSCM map rotated so that the guidance
+// field points along +x at the seed and translated so the seed's centroid is the origin.
+class PatchFrame {
+ public:
+  PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction)
+      : base_(base), patch_(std::move(patch)) {
+    const MatrixX3i& F = patch_.mesh.F;
+    for (int f = 0; f < F.rows(); ++f) local_of_[patch_.faces[f]] = f;
+    // The seed face's affine map takes the 3D field direction into the UV plane.
+    const int s = 0;
+    const Vector3d a = patch_.mesh.V.row(F(s, 0)), b = patch_.mesh.V.row(F(s, 1)),
+                   c = patch_.mesh.V.row(F(s, 2));
+    const Vector2d ua = patch_.uv.row(F(s, 0)), ub = patch_.uv.row(F(s, 1)),
+                   uc = patch_.uv.row(F(s, 2));
+    const Vector3d w = plane_barycentric(a + direction, a, b, c);
+    Vector2d d = w(0) * ua + w(1) * ub + w(2) * uc - ua;
+    if (!(d.norm() > 0)) d = Vector2d(1, 0);
+    d.normalize();
+    const Vector2d origin = (ua + ub + uc) / 3.0;
+    uv_.resize(patch_.uv.rows(), 2);
+    for (int v = 0; v < patch_.uv.rows(); ++v) {
+      const Vector2d q = patch_.uv.row(v).transpose() - origin;
+      uv_.row(v) << q.dot(d), q.x() * -d.y() + q.y() * d.x();
+    }
+    build_grid();
+    query_ = std::make_unique<ClosestPointQuery>(patch_.mesh.V, patch_.mesh.F);
+  }
+
+  const LocalPatch& patch() const { return patch_; }
+  const MatrixX2d& uv() const { return uv_; }
+  int local_face(int base_face) const {
+    auto it = local_of_.find(base_face);
+    return it == local_of_.end() ? -1 : it->second;
+  }
+
+  // Frame position of a local coordinate; beyond the patch, through the nearest patch face.
+  Vector2d to_frame(int base_face, const Vector3d& bary) const {
+    int f = local_face(base_face);
+    Vector3d w = bary;
+    if (f < 0) {
+      const Vector3d p = bary(0) * base_.V.row(base_.F(base_face, 0)).transpose() +
+                         bary(1) * base_.V.row(base_.F(base_face, 1)).transpose() +
+                         bary(2) * base_.V.row(base_.F(base_face, 2)).transpose();
+      f = query_->closest(p).face;
+      const MatrixX3i& F = patch_.mesh.F;
+      w = plane_barycentric(p, patch_.mesh.V.row(F(f, 0)), patch_.mesh.V.row(F(f, 1)),
+                            patch_.mesh.V.row(F(f, 2)));
+    }
+    const MatrixX3i& F = patch_.mesh.F;
+    return w(0) * uv_.row(F(f, 0)).transpose() + w(1) * uv_.row(F(f, 1)).transpose() +
+           w(2) * uv_.row(F(f, 2)).transpose();
+  }
+
+  // The patch face containing frame point q (true) or the nearest one (false, with barycentric
+  // coordinates extrapolating it).
+  bool locate(const Vector2d& q, int& face, Vector3d& bary) const {
+    const MatrixX3i& F = patch_.mesh.F;
+    face = -1;
+    double best = std::numeric_limits<double>::infinity();
+    const int cx = std::clamp(static_cast<int>((q.x() - lo_.x()) / cell_), 0, nx_ - 1);
+    const int cy = std::clamp(static_cast<int>((q.y() - lo_.y()) / cell_), 0, ny_ - 1);
+    // Ring search over the grid: the first containing triangle wins; else the nearest by the
+    // most negative barycentric coordinate over the rings visited.
+    for (int r = 0; r < std::max(nx_, ny_); ++r) {
+      for (int y = cy - r; y <= cy + r; ++y)
+        for (int x = cx - r; x <= cx + r; ++x) {
+          if (std::max(std::abs(x - cx), std::abs(y - cy)) != r) continue;
+          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+          for (const int f : cells_[y * nx_ + x]) {
+            const Vector3d w = triangle_barycentric_2d(q, uv_.row(F(f, 0)), uv_.row(F(f, 1)),
+                                                       uv_.row(F(f, 2)));
+            const double outside = -w.minCoeff();
+            if (outside <= 1e-9) {
+              face = f;
+              bary = w;
+              return true;
+            }
+            if (outside < best || (outside == best && f < face)) {
+              best = outside;
+              face = f;
+              bary = w;
+            }
+          }
+        }
+      if (face >= 0 && r >= 1) break;
+    }
+    return false;
+  }
+
+  // Minimum distance from q to the patch's boundary in the frame.
+  double distance_to_border(const Vector2d& q) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& [i, j] : border_) {
+      const Vector2d a = uv_.row(i), b = uv_.row(j), d = b - a;
+      const double t = d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0)
+                                           : 0.0;
+      best = std::min(best, (a + t * d - q).norm());
+    }
+    return best;
+  }
+
+ private:
+  void build_grid() {
+    const MatrixX3i& F = patch_.mesh.F;
+    lo_ = uv_.colwise().minCoeff().transpose();
+    const Vector2d hi = uv_.colwise().maxCoeff().transpose();
+    const double side = std::max((hi - lo_).maxCoeff(), 1e-12);
+    const int n = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(F.rows()))));
+    cell_ = side / n;
+    nx_ = std::max(1, static_cast<int>((hi.x() - lo_.x()) / cell_) + 1);
+    ny_ = std::max(1, static_cast<int>((hi.y() - lo_.y()) / cell_) + 1);
+    cells_.assign(static_cast<size_t>(nx_) * ny_, {});
+    for (int f = 0; f < F.rows(); ++f) {
+      Vector2d a = uv_.row(F(f, 0)), b = a;
+      for (int k = 1; k < 3; ++k) {
+        a = a.cwiseMin(uv_.row(F(f, k)).transpose());
+        b = b.cwiseMax(uv_.row(F(f, k)).transpose());
+      }
+      const int x0 = std::clamp(static_cast<int>((a.x() - lo_.x()) / cell_), 0, nx_ - 1);
+      const int x1 = std::clamp(static_cast<int>((b.x() - lo_.x()) / cell_), 0, nx_ - 1);
+      const int y0 = std::clamp(static_cast<int>((a.y() - lo_.y()) / cell_), 0, ny_ - 1);
+      const int y1 = std::clamp(static_cast<int>((b.y() - lo_.y()) / cell_), 0, ny_ - 1);
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) cells_[y * nx_ + x].push_back(f);
+    }
+    const EdgeTopology topo = edge_topology(F, static_cast<int>(uv_.rows()));
+    for (int e = 0; e < topo.num_edges(); ++e)
+      if (topo.is_boundary(e)) border_.emplace_back(topo.E(e, 0), topo.E(e, 1));
+  }
+
+  const TriMesh& base_;
+  LocalPatch patch_;
+  MatrixX2d uv_;
+  std::unordered_map<int, int> local_of_;
+  Vector2d lo_ = Vector2d::Zero();
+  double cell_ = 1;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::vector<int>> cells_;
+  std::vector<std::pair<int, int>> border_;
+  std::unique_ptr<ClosestPointQuery> query_;
+};
+
+// The output elements in local coordinates, with an index from base faces to the elements that
+// have vertices above them.
+struct SurfaceStore {
+  std::vector<SurfaceElement> elements;
+  std::vector<unsigned char> alive;
+  std::vector<std::vector<int>> by_face;
+
+  explicit SurfaceStore(int num_faces) : by_face(num_faces) {}
+  void index(int id) {
+    std::vector<int> faces = elements[id].face;
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    for (const int f : faces)
+      if (by_face[f].empty() || by_face[f].back() != id) by_face[f].push_back(id);
+  }
+  int add(SurfaceElement e) {
+    elements.push_back(std::move(e));
+    alive.push_back(1);
+    index(static_cast<int>(elements.size()) - 1);
+    return static_cast<int>(elements.size()) - 1;
+  }
+};
+
+// The store seen through one patch frame: the elements near the patch, flattened.
+class FramedOutput final : public PatchOutput {
+ public:
+  FramedOutput(SurfaceStore& store, std::map<int, Element> frame)
+      : store_(store), frame_(std::move(frame)) {}
+
+  const Element& element(int id) const override { return frame_.at(id); }
+  bool alive(int id) const override { return store_.alive[id] != 0 && frame_.count(id); }
+  std::vector<int> elements_near(const Vector2d& lo, const Vector2d& hi) const override {
+    std::vector<int> ids;
+    for (const auto& [id, e] : frame_)
+      if (store_.alive[id] && e.lo.x() <= hi.x() && e.hi.x() >= lo.x() && e.lo.y() <= hi.y() &&
+          e.hi.y() >= lo.y())
+        ids.push_back(id);
+    return ids;
+  }
+  int add(Element e) override {
+    const int id = static_cast<int>(store_.elements.size());
+    store_.elements.emplace_back();  // filled in local coordinates by the caller
+    store_.alive.push_back(1);
+    frame_[id] = std::move(e);
+    changed_.insert(id);
+    return id;
+  }
+  void replace(int id, Element e) override {
+    frame_[id] = std::move(e);
+    changed_.insert(id);
+  }
+  void remove(int id) override { store_.alive[id] = 0; }
+
+  const std::set<int>& changed() const { return changed_; }
+  const Element& frame_element(int id) const { return frame_.at(id); }
+
+ private:
+  SurfaceStore& store_;
+  std::map<int, Element> frame_;
+  std::set<int> changed_;
+};
+
+void validate_base(const TriMesh& base) {
+  MQ_CHECK(base.F.rows() > 0, InvalidInput, "the base mesh has no faces");
+  MQ_CHECK(base.V.allFinite(), InvalidInput, "the base mesh has non-finite vertex coordinates");
+  for (int f = 0; f < base.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      MQ_CHECK(base.F(f, k) >= 0 && base.F(f, k) < base.V.rows(), InvalidInput, "base face ", f,
+               " references missing vertex ", base.F(f, k));
+}
+
+}  // namespace
+
+Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face,
+                               const Vector3d& b, double height) {
+  Vector3d p = Vector3d::Zero(), n = Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    p += b(k) * base.V.row(base.F(face, k)).transpose();
+    n += b(k) * N.row(base.F(face, k)).transpose();
+  }
+  if (n.norm() > 0) n.normalize();
+  return p + height * n;
+}
+
+TriMesh embed_by_normal_displacement(const TriMesh& base, const SurfaceQuilt& quilt) {
+  const MatrixX3d N = vertex_normals(base.V, base.F);
+  TriMesh out;
+  Eigen::Index nv = 0, nf = 0;
+  for (const SurfaceElement& e : quilt.elements) {
+    nv += static_cast<Eigen::Index>(e.face.size());
+    nf += e.F.rows();
+  }
+  out.V.resize(nv, 3);
+  out.F.resize(nf, 3);
+  nv = nf = 0;
+  for (const SurfaceElement& e : quilt.elements) {
+    for (size_t v = 0; v < e.face.size(); ++v)
+      out.V.row(nv + v) = displace_along_normal(base, N, e.face[v],
+                                                e.barycentric.row(v).transpose(), e.height(v))
+                              .transpose();
+    out.F.middleRows(nf, e.F.rows()) = e.F.array() + static_cast<int>(nv);
+    nv += static_cast<Eigen::Index>(e.face.size());
+    nf += e.F.rows();
+  }
+  return out;
+}
+
+SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                           const SurfaceQuiltingOptions& options,
+                           TranslationCostEvaluator& evaluator, SurfaceQuiltingStats* stats_out,
+                           ProgressSink* progress) {
+  SurfaceQuiltingStats stats;
+  StageTimes& times = stats.times;
+  validate_base(base_in);
+  MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
+           "the swatch scale must be positive and finite, got ", options.scale);
+  TriMesh base = base_in;
+  remove_unreferenced_vertices(base);
+  const int nf = base.num_faces();
+  MQ_CHECK(options.field.rows() == 0 || options.field.rows() == nf, InvalidInput,
+           "the guidance field has ", options.field.rows(), " vectors for ", nf, " base faces");
+  stats.base_faces = nf;
+
+  // The swatch at its size on the surface (section 3.1's relative size s).
+  PreparedSwatch swatch;
+  MatrixX3d field;
+  std::unique_ptr<SwatchDistanceGrid> distance_grid;
+  std::unique_ptr<ClosestPointQuery> swatch_query;
+  EdgeTopology topo;
+  MatrixX3i TT;
+  {
+    ScopedStageTimer timer(times, "prepare");
+    const double diagonal = bounding_box(base.V, base.F).extent().norm();
+    PreparedSwatch unit = prepare_swatch(swatch_mesh);
+    const double factor = options.scale * diagonal / std::max(unit.size.x(), unit.size.y());
+    TriMesh scaled = swatch_mesh;
+    scaled.V *= factor;
+    swatch = prepare_swatch(scaled);
+    stats.swatch_scale = factor;
+    distance_grid = std::make_unique<SwatchDistanceGrid>(swatch.mesh.V, swatch.mesh.F);
+    swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
+    field = options.field.rows() ? options.field : smooth_tangent_field(base.V, base.F);
+    topo = edge_topology(base.F, base.num_vertices());
+    TT = face_adjacency(topo);
+  }
+  const double H = swatch.size.z();
+  stats.shell_height = H;
+  const double cell = std::min(0.5 * swatch.mean_element_diameter,
+                               std::min(swatch.size.x(), swatch.size.y()) / 8.0);
+  stats.cell_size = cell;
+  const int swatch_cells = static_cast<int>(std::floor(
+      std::min(swatch.size.x(), swatch.size.y()) / cell + 1e-9));
+  const int window =
+      std::max(1, std::min(swatch_cells, static_cast<int>(options.subpatch_fraction *
+                                                          swatch_cells)));
+  const double footprint_area = swatch.size.x() * swatch.size.y();
+  // Faces are marked synthesised only this far inside both the swatch and the patch, so that
+  // elements cut off at the patch border are grown again by a later patch.
+  double max_element = 0;
+  for (const Element& e : swatch.elements) max_element = std::max(max_element, e.footprint_diameter());
+  const double margin = std::min(max_element, 0.25 * std::min(swatch.size.x(), swatch.size.y()));
+
+  LocalPatchBuilder builder(base, topo, TT);
+  SurfaceStore store(nf);
+  std::vector<unsigned char> done(nf, 0);
+  std::vector<int> count(nf, 0);
+  std::set<std::pair<int, int>> queue;  // (-synthesised neighbours, face)
+  for (int f = 0; f < nf; ++f) queue.emplace(0, f);
+  int num_done = 0;
+  auto mark = [&](int f) {
+    if (done[f]) return;
+    done[f] = 1;
+    ++num_done;
+    queue.erase({-count[f], f});
+    for (int k = 0; k < 3; ++k) {
+      const int g = TT(f, k);
+      if (g < 0 || done[g]) continue;
+      queue.erase({-count[g], g});
+      ++count[g];
+      queue.emplace(-count[g], g);
+    }
+  };
+  std::mt19937_64 rng(options.seed);
+  LocalPatchOptions patch_options;
+  patch_options.max_area = options.patch_area_factor * footprint_area;
+  patch_options.max_distortion = options.max_distortion;
+  const MatrixX3d base_normals = vertex_normals(base.V, base.F);
+  const ClosestPointQuery base_query(base.V, base.F);
+
+  while (!queue.empty()) {
+    const int seed = queue.begin()->second;
+    ++stats.iterations;
+    std::unique_ptr<PatchFrame> frame;
+    {
+      ScopedStageTimer timer(times, "parameterization");
+      LocalPatch patch;
+      try {
+        patch = builder.grow(seed, patch_options);
+      } catch (const InvalidInput&) {
+        mark(seed);  // a degenerate triangle: nothing can be placed on it
+        continue;
+      }
+      if (patch.shrink_steps > 0) ++stats.patches_shrunk;
+      frame = std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose());
+    }
+    const LocalPatch& patch = frame->patch();
+
+    // The output near the patch, flattened into the frame.
+    std::map<int, Element> flat;
+    {
+      ScopedStageTimer timer(times, "parameterization");
+      std::set<int> ids;
+      for (const int f : patch.faces)
+        for (const int id : store.by_face[f])
+          if (store.alive[id]) ids.insert(id);
+      for (const int id : ids) {
+        const SurfaceElement& s = store.elements[id];
+        Element e;
+        e.F = s.F;
+        e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
+        for (size_t v = 0; v < s.face.size(); ++v) {
+          const Vector2d q = frame->to_frame(s.face[v], s.barycentric.row(v).transpose());
+          e.V.row(v) << q.x(), q.y(), s.height(v);
+        }
+        e.update();
+        flat.emplace(id, std::move(e));
+      }
+    }
+    // Whether a frame point lies over a face synthesised before this patch.
+    auto processed = [&frame, &done](double x, double y) {
+      int f;
+      Vector3d b;
+      if (!frame->locate(Vector2d(x, y), f, b)) return false;
+      return done[frame->patch().faces[f]] != 0;
+    };
+
+    // Step 2: geometry matching around the seed (the frame origin).
+    OffsetChoice choice;
+    {
+      ScopedStageTimer timer(times, "matching");
+      const double half = 0.5 * window * cell;
+      std::vector<Vector3d> points, normals;
+      for (const auto& [id, e] : flat)
+        for (int v = 0; v < e.V.rows(); ++v)
+          if (std::abs(e.V(v, 0)) <= half && std::abs(e.V(v, 1)) <= half) {
+            points.push_back(e.V.row(v).transpose());
+            normals.push_back(e.N.row(v).transpose());
+          }
+      const size_t n = options.match_points > 0
+                           ? std::min(points.size(), static_cast<size_t>(options.match_points))
+                           : points.size();
+      MatrixX3d P(n, 3), NP(n, 3);
+      for (size_t i = 0; i < n; ++i) {
+        const size_t k = i * points.size() / n;
+        P.row(i) = points[k].transpose();
+        NP.row(i) = normals[k].transpose();
+      }
+      const Vector2d t_min = Vector2d::Constant(half) - swatch.size.head<2>();
+      const Vector2d t_max = Vector2d::Constant(-half);
+      std::vector<Vector3d> offsets;
+      const int kx0 = static_cast<int>(std::ceil(t_min.x() / cell - 1e-9));
+      const int ky0 = static_cast<int>(std::ceil(t_min.y() / cell - 1e-9));
+      const int kx1 = static_cast<int>(std::floor(t_max.x() / cell + 1e-9));
+      const int ky1 = static_cast<int>(std::floor(t_max.y() / cell + 1e-9));
+      for (int ky = ky0; ky <= ky1; ++ky)
+        for (int kx = kx0; kx <= kx1; ++kx) offsets.emplace_back(kx * cell, ky * cell, 0.0);
+      if (offsets.empty()) offsets.emplace_back(t_max.x(), t_max.y(), 0.0);
+      MatrixX3d T(offsets.size(), 3);
+      for (size_t i = 0; i < offsets.size(); ++i) T.row(i) = offsets[i].transpose();
+      MatchingOptions matching = options.matching;
+      matching.lambda = options.matching.lambda / cell;
+      // The first patch has nothing to match: the swatch is centred on the seed.
+      if (P.rows() == 0) T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
+      choice = choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+      stats.matched_point_offsets += choice.point_offsets;
+    }
+    const Vector3d t = choice.offset;
+    const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
+    const OverlapRegion region(patch_lo, patch_hi, processed);
+
+    // Steps 3-5 in the frame. A swatch element enters only if it lies wholly on the patch, so
+    // that it can be stored in local coordinates.
+    FramedOutput framed(store, std::move(flat));
+    int outside = 0;
+    const std::function<bool(const Element&)> admissible = [&](const Element& e) {
+      int f;
+      Vector3d b;
+      for (int v = 0; v < e.V.rows(); ++v)
+        if (!frame->locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b)) {
+          ++outside;
+          return false;
+        }
+      return true;
+    };
+    PatchCounts counts;
+    quilt_patch(framed, swatch, *swatch_query, t, region, admissible, options.patch, counts, times);
+    accumulate(stats.counts, counts);
+    stats.rejected_outside_patch += outside;
+
+    // New and changed elements back to local coordinates.
+    {
+      ScopedStageTimer timer(times, "parameterization");
+      for (const int id : framed.changed()) {
+        if (!store.alive[id]) continue;
+        const Element& e = framed.frame_element(id);
+        SurfaceElement s;
+        s.F = e.F;
+        s.face.resize(e.V.rows());
+        s.barycentric.resize(e.V.rows(), 3);
+        s.height.resize(e.V.rows());
+        for (int v = 0; v < e.V.rows(); ++v) {
+          int f;
+          Vector3d b;
+          const bool in = frame->locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b);
+          if (in) {
+            s.face[v] = patch.faces[f];
+            s.barycentric.row(v) = b.cwiseMax(0.0).transpose() / b.cwiseMax(0.0).sum();
+          } else {
+            // Beyond the patch (a changed element reaching out of it): extrapolate the nearest
+            // patch face's map into 3D and project onto the base.
+            const MatrixX3i& PF = patch.mesh.F;
+            const Vector3d p = b(0) * patch.mesh.V.row(PF(f, 0)).transpose() +
+                               b(1) * patch.mesh.V.row(PF(f, 1)).transpose() +
+                               b(2) * patch.mesh.V.row(PF(f, 2)).transpose();
+            const ClosestPointHit hit = base_query.closest(p);
+            s.face[v] = hit.face;
+            s.barycentric.row(v) = hit.barycentric.transpose();
+          }
+          s.height(v) = std::clamp(e.V(v, 2), 0.0, H);
+        }
+        store.elements[id] = std::move(s);
+        store.index(id);
+      }
+    }
+    // Mark the patch faces now covered: inside the swatch footprint and away from the borders.
+    for (size_t f = 0; f < patch.faces.size(); ++f) {
+      bool covered = true;
+      for (int k = 0; k < 3 && covered; ++k) {
+        const Vector2d q = frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k));
+        covered = q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
+                  q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
+                  frame->distance_to_border(q) >= margin;
+      }
+      if (covered) mark(patch.faces[f]);
+    }
+    mark(seed);  // progress is guaranteed
+    report_progress(progress, "quilting", num_done, nf);
+  }
+
+  SurfaceQuilt quilt;
+  quilt.shell_height = H;
+  {
+    ScopedStageTimer timer(times, "post-processing");
+    for (size_t id = 0; id < store.elements.size(); ++id)
+      if (store.alive[id] && !store.elements[id].face.empty())
+        quilt.elements.push_back(std::move(store.elements[id]));
+    // Elements that could not be established whole end up intersecting their neighbours once
+    // embedded (tight concave spots): they are removed, later ones first kept out.
+    if (options.remove_intersecting) {
+      const TriMesh embedded = embed_by_normal_displacement(base, quilt);
+      std::vector<int> element_of;
+      for (size_t e = 0; e < quilt.elements.size(); ++e)
+        element_of.insert(element_of.end(), quilt.elements[e].F.rows(), static_cast<int>(e));
+      std::vector<char> drop(quilt.elements.size(), 0);
+      for (const auto& [f, g] : intersecting_face_pairs(embedded.V, embedded.F)) {
+        const int a = element_of[f], b = element_of[g];
+        if (!drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
+      }
+      std::vector<SurfaceElement> kept;
+      for (size_t e = 0; e < quilt.elements.size(); ++e) {
+        if (drop[e]) {
+          ++stats.removed_post;
+          continue;
+        }
+        kept.push_back(std::move(quilt.elements[e]));
+      }
+      quilt.elements = std::move(kept);
+    }
+  }
+  report_progress(progress, "quilting", 1, 1);
+  const TriMesh embedded = embed_by_normal_displacement(base, quilt);
+  stats.faces = embedded.num_faces();
+  stats.vertices = embedded.num_vertices();
+  stats.elements = static_cast<int>(quilt.elements.size());
+  if (!quilt.elements.empty()) {
+    std::vector<double> areas;
+    Eigen::Index f0 = 0;
+    const Eigen::VectorXd A = face_areas(embedded.V, embedded.F);
+    for (const SurfaceElement& e : quilt.elements) {
+      areas.push_back(A.segment(f0, e.F.rows()).sum());
+      f0 += e.F.rows();
+    }
+    double mean = 0, var = 0;
+    for (double a : areas) mean += a;
+    mean /= static_cast<double>(areas.size());
+    for (double a : areas) var += (a - mean) * (a - mean);
+    var /= static_cast<double>(areas.size());
+    stats.element_area_mean = mean;
+    stats.element_area_cv = mean > 0 ? std::sqrt(var) / mean : 0;
+    stats.element_area_min = *std::min_element(areas.begin(), areas.end());
+    stats.element_area_max = *std::max_element(areas.begin(), areas.end());
+  }
+  if (stats_out) *stats_out = std::move(stats);
+  return quilt;
+}
+
+}  // namespace mq

@@ -1,0 +1,85 @@
+// Mesh quilting over curved surfaces, paper section 3.1: the base mesh's triangles replace the
+// planar grid; each iteration grows a local patch from the most constrained unsynthesised
+// triangle, flattens it conformally, runs the planar steps of section 2 in that plane (oriented
+// by a guidance field) and stores the new geometry in local coordinates on the base mesh.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry_matching.h"
+#include "core/patch_quilting.h"
+#include "core/progress.h"
+#include "core/stage_timer.h"
+
+namespace mq {
+
+// Output geometry in local coordinates over the base mesh: vertex i of an element lies above
+// base face `face[i]`, at the point with barycentric coordinates `barycentric.row(i)` of that
+// face, at height `height[i]` in [0, shell height] along the surface normal.
+struct SurfaceElement {
+  MatrixX3i F;                     // #F by 3, indices into the element's vertices
+  std::vector<int> face;           // #V base faces
+  MatrixX3d barycentric;           // #V by 3
+  Eigen::VectorXd height;          // #V
+};
+
+struct SurfaceQuilt {
+  std::vector<SurfaceElement> elements;
+  double shell_height = 0;
+};
+
+struct SurfaceQuiltingOptions {
+  // The swatch is scaled uniformly so that its longer footprint side is `scale` times the base
+  // mesh's bounding-box diagonal; its thickness, scaled alike, is the shell height.
+  double scale = 0.1;
+  // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
+  MatrixX3d field;
+  // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
+  // threshold"); a patch whose area distortion exceeds max_distortion is shrunk (paper: 4).
+  double patch_area_factor = 3.0;
+  double max_distortion = 4.0;
+  double subpatch_fraction = 0.5;  // as for planar quilting
+  int match_points = 1024;
+  MatchingOptions matching;
+  PatchQuiltingOptions patch;
+  // Elements that intersect others after the final embedding are removed (post-processing).
+  bool remove_intersecting = true;
+  uint64_t seed = 1;
+};
+
+struct SurfaceQuiltingStats {
+  int iterations = 0;
+  int base_faces = 0;
+  int patches_shrunk = 0;
+  double swatch_scale = 0;     // factor applied to the swatch
+  double shell_height = 0;
+  double cell_size = 0;
+  long long matched_point_offsets = 0;
+  PatchCounts counts;
+  int rejected_outside_patch = 0;  // swatch elements reaching beyond the flattened patch
+  int removed_post = 0;            // elements not established whole (intersecting after embedding)
+  int faces = 0, vertices = 0, elements = 0;
+  // Spread of element surface areas after embedding (how even the texture is over the surface).
+  double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
+  StageTimes times;
+};
+
+// Runs mesh quilting over `base`. Throws InvalidInput for an empty or non-finite base or swatch,
+// scale <= 0 or not finite, a field of the wrong size.
+SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
+                           const SurfaceQuiltingOptions& options,
+                           TranslationCostEvaluator& evaluator,
+                           SurfaceQuiltingStats* stats = nullptr,
+                           ProgressSink* progress = nullptr);
+
+// 3D positions of local coordinates by plain normal displacement: the base point plus height
+// times the interpolated unit vertex normal.
+//   N  #V(base) by 3 unit vertex normals of the base
+Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face,
+                               const Vector3d& barycentric, double height);
+
+// The whole quilt embedded by normal displacement, elements in order.
+TriMesh embed_by_normal_displacement(const TriMesh& base, const SurfaceQuilt& quilt);
+
+}  // namespace mq
