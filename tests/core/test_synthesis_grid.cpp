@@ -107,7 +107,7 @@ TEST(SynthesisGrid, AssignFacesListsEveryTouchedCell) {
   MatrixX3d V(9, 3);
   V << 0.2, 0.2, 0, 0.8, 0.2, 0, 0.5, 0.7, 0,  // inside cell (0, 0)
       0.5, 0.5, 0, 2.5, 0.5, 0, 1.5, 1.5, 0,   // spans cells x 0..2, y 0..1
-      -3, -3, 0, -2, -3, 0, -2, -2, 0;          // outside the grid
+      -3, -3, 0, -2, -3, 0, -2, -2, 0;         // outside the grid
   MatrixX3i F(3, 3);
   F << 0, 1, 2, 3, 4, 5, 6, 7, 8;
   const auto cells = g.assign_faces(V, F);
