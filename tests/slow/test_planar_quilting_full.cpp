@@ -78,8 +78,9 @@ void expect_quilts_or_refuses(const std::string& file, double scale) {
   try {
     const TriMesh out = quilt(swatch, scale * e(2), scale * e(1));
     ASSERT_GT(out.num_faces(), 0);
-    if (closed_input)
+    if (closed_input) {
       for (const TriMesh& part : test::components(out)) EXPECT_TRUE(topology_report(part).closed());
+    }
     EXPECT_TRUE(intersecting_face_pairs(out.V, out.F).empty());
   } catch (const InvalidInput& err) {
     EXPECT_EQ(std::string(err.what()).find('\n'), std::string::npos) << err.what();
