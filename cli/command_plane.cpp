@@ -16,8 +16,7 @@ namespace mq::cli {
 namespace {
 
 void write_stats(const std::string& path, const PlanarQuiltingStats& s, const std::string& device,
-                 int threads, double wall, const std::string& swatch, double length,
-                 double width) {
+                 int threads, double wall, const std::string& swatch, double length, double width) {
   JsonWriter j;
   j.begin_object()
       .value("command", "plane")
@@ -50,7 +49,8 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
       .begin_object("stitch_failures");
   for (int k = 1; k < kStitchFailureKinds; ++k)
     j.value(stitch_failure_name(static_cast<StitchFailure>(k)), s.stitch_failures[k]);
-  j.value("intersecting", s.stitch_failures[0]).end_object()
+  j.value("intersecting", s.stitch_failures[0])
+      .end_object()
       .value("matched_point_offsets", s.matched_point_offsets)
       .value("pairs", s.pairs)
       .value("relations", s.relations)
@@ -70,10 +70,11 @@ Device parse_device(const std::string& name) {
 }  // namespace
 
 int run_plane(int argc, char** argv, int first) {
-  CommandLine cl("plane", "--swatch FILE --size L W -o OUT [options]",
-                 "Grows a swatch (any mesh file; its smallest bounding-box side is the layer's\n"
-                 "thickness) into a seamless L x W layer in the swatch's units, by mesh quilting\n"
-                 "(seed finding, geometry matching, element correspondences, deformation, merging).");
+  CommandLine cl(
+      "plane", "--swatch FILE --size L W -o OUT [options]",
+      "Grows a swatch (any mesh file; its smallest bounding-box side is the layer's\n"
+      "thickness) into a seamless L x W layer in the swatch's units, by mesh quilting\n"
+      "(seed finding, geometry matching, element correspondences, deformation, merging).");
   cl.option("swatch", "FILE", "input swatch mesh (OBJ, PLY or OFF)");
   cl.option("size", "L W", "output extent along the swatch's two long axes", "", 2);
   cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
@@ -91,6 +92,7 @@ int run_plane(int argc, char** argv, int first) {
   if (!cl.has("output")) throw UsageError("-o OUT is required");
   const std::string out_path = cl.get("output");
   mesh_format_from_path(out_path);  // fail on an unknown extension before any work
+  check_output_directory(out_path);
 
   PlanarQuiltingOptions options;
   options.length = cl.get_double("size", 0, 1e-300, 1e300);
@@ -117,16 +119,16 @@ int run_plane(int argc, char** argv, int first) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!run.stats_path().empty())
-    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall,
-                cl.get("swatch"), options.length, options.width);
+    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
+                options.length, options.width);
   if (!run.quiet()) {
     std::printf("wrote %s: %d faces, %d vertices, %d elements\n", out_path.c_str(), stats.faces,
                 stats.vertices, stats.elements);
-    std::printf("%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-                "%d added, %d matched, %d removed\n",
-                stats.iterations, wall, evaluator->name().c_str(), run.threads(),
-                stats.elements_stitched, stats.elements_replaced, stats.elements_added,
-                stats.elements_matched, stats.removed_post);
+    std::printf(
+        "%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+        "%d added, %d matched, %d removed\n",
+        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.elements_stitched,
+        stats.elements_replaced, stats.elements_added, stats.elements_matched, stats.removed_post);
   }
   return 0;
 }

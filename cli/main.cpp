@@ -69,6 +69,6 @@ int main(int argc, char** argv) {
       return 3;
     }
   }
-  std::fprintf(stderr, "meshquilt: unknown command '%s'\n\n%s", argv[1], kUsage);
+  std::fprintf(stderr, "meshquilt: unknown command '%s' (see 'meshquilt --help')\n", argv[1]);
   return 2;
 }

@@ -14,9 +14,14 @@ namespace mq::cli {
 // Declares the shared options on a command line.
 void add_run_options(CommandLine& cl);
 
+// Throws InvalidInput naming `path` when the directory it would be written to does not exist,
+// so that a run fails before its work rather than after it (leaving nothing half done).
+void check_output_directory(const std::string& path);
+
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {
  public:
+  // Throws InvalidInput when the --stats file's directory does not exist.
   explicit RunContext(const CommandLine& cl);
   ProgressSink* progress() { return &progress_; }
   bool quiet() const { return quiet_; }

@@ -25,8 +25,8 @@ TEST(MeshTopology, CubeNormalsPointOutward) {
   const TriMesh cube = test::unit_cube();
   const MatrixX3d FN = face_normals(cube.V, cube.F);
   for (int f = 0; f < cube.num_faces(); ++f) {
-    const Vector3d centroid = (cube.V.row(cube.F(f, 0)) + cube.V.row(cube.F(f, 1)) +
-                               cube.V.row(cube.F(f, 2))) / 3.0;
+    const Vector3d centroid =
+        (cube.V.row(cube.F(f, 0)) + cube.V.row(cube.F(f, 1)) + cube.V.row(cube.F(f, 2))) / 3.0;
     EXPECT_GT(FN.row(f).dot(centroid - Vector3d(0.5, 0.5, 0.5)), 0.0) << "face " << f;
   }
   const MatrixX3d VN = vertex_normals(cube.V, cube.F);

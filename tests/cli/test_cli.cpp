@@ -1,0 +1,325 @@
+// The meshquilt executable, run as a user would: help, errors, every subcommand end to end,
+// and byte-identical output whatever the thread count or device.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;  // exit code, or 128 + signal number when killed by a signal
+  bool signaled = false;
+  std::string out, err;
+  std::vector<std::string> err_lines() const {
+    std::vector<std::string> lines;
+    std::istringstream in(err);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  }
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// Runs `meshquilt ARGS` in `dir` with stdout and stderr captured in files (so neither is a
+// terminal).
+CliRun meshquilt(const std::string& dir, const std::string& args) {
+  const std::string out = dir + "/.stdout", err = dir + "/.stderr";
+  const std::string cmd = "cd '" + dir + "' && exec '" + std::string(MESHQUILT_CLI) + "' " + args +
+                          " >'" + out + "' 2>'" + err + "' </dev/null";
+  const int raw = std::system(cmd.c_str());
+  CliRun r;
+  if (WIFEXITED(raw)) {
+    r.status = WEXITSTATUS(raw);
+  } else if (WIFSIGNALED(raw)) {
+    r.signaled = true;
+    r.status = 128 + WTERMSIG(raw);
+  }
+  r.out = slurp(out);
+  r.err = slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+// Files in dir (names), without the captured streams.
+std::vector<std::string> listing(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The value printed for "key": in a JSON text (the first occurrence), as text.
+std::string json_value(const std::string& json, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const size_t at = json.find(k);
+  if (at == std::string::npos) return "";
+  size_t b = at + k.size();
+  while (b < json.size() && json[b] == ' ') ++b;
+  size_t e = b;
+  while (e < json.size() && json[e] != ',' && json[e] != '\n' && json[e] != '}') ++e;
+  return json.substr(b, e - b);
+}
+
+// A small chain mail swatch (9 rings) written by the CLI itself.
+std::string small_swatch(const std::string& dir) {
+  const CliRun r =
+      meshquilt(dir, "swatch chainmail --rows 3 --cols 3 --detail 24 -o sw.obj --quiet");
+  EXPECT_EQ(r.status, 0) << r.err;
+  return "sw.obj";
+}
+
+bool opencl_platform_present() {
+  FILE* p = popen("clinfo -l 2>/dev/null", "r");
+  if (!p) return false;
+  std::string text;
+  char buf[256];
+  while (std::fgets(buf, sizeof buf, p)) text += buf;
+  pclose(p);
+  return text.find("Platform #") != std::string::npos;
+}
+
+TEST(Cli, HelpOfEveryCommand) {
+  const std::string dir = test::temp_dir();
+  for (const std::string cmd : {"", "plane", "swatch", "info", "render"}) {
+    const CliRun r = meshquilt(dir, cmd + " --help");
+    EXPECT_EQ(r.status, 0) << cmd;
+    EXPECT_NE(r.out.find("usage: meshquilt " + cmd), std::string::npos) << cmd << ":\n" << r.out;
+    EXPECT_TRUE(r.err.empty()) << cmd << ": " << r.err;
+  }
+  const CliRun v = meshquilt(dir, "--version");
+  EXPECT_EQ(v.status, 0);
+  EXPECT_EQ(v.out.rfind("meshquilt ", 0), 0u);
+}
+
+TEST(Cli, UnknownCommandOrOptionExitsTwoWithOneLine) {
+  const std::string dir = test::temp_dir();
+  for (const std::string args :
+       {"frobnicate", "plane --bogus", "swatch chainmail -o x.obj --bogus 3", "info --nope x.obj",
+        "render x.obj -o x.png --zoom 2", "swatch teapot -o x.obj", "plane --swatch"}) {
+    const CliRun r = meshquilt(dir, args);
+    EXPECT_EQ(r.status, 2) << args;
+    const auto lines = r.err_lines();
+    ASSERT_EQ(lines.size(), 1u) << args << ":\n" << r.err;
+    EXPECT_EQ(lines[0].rfind("meshquilt", 0), 0u) << lines[0];
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+  EXPECT_TRUE(listing(dir).empty());
+}
+
+TEST(Cli, SwatchKindsAreClosed) {
+  const std::string dir = test::temp_dir();
+  for (const std::string kind : {"chainmail", "weave", "apples", "ivy"}) {
+    const std::string small =
+        kind == "chainmail" || kind == "weave" ? " --rows 2 --cols 3 --detail 8" : " --count 4";
+    const CliRun s = meshquilt(dir, "swatch " + kind + small + " -o " + kind + ".off");
+    ASSERT_EQ(s.status, 0) << kind << ": " << s.err;
+    ASSERT_TRUE(fs::exists(dir + "/" + kind + ".off"));
+    const CliRun i = meshquilt(dir, "info " + kind + ".off --json");
+    ASSERT_EQ(i.status, 0) << i.err;
+    EXPECT_EQ(json_value(i.out, "closed"), "true") << kind << "\n" << i.out;
+    EXPECT_EQ(json_value(i.out, "boundary_edges"), "0") << kind;
+    EXPECT_NE(json_value(i.out, "elements"), "1") << kind;
+  }
+  // info --intersections on a generated swatch: its elements do not intersect.
+  const CliRun i = meshquilt(dir, "info chainmail.off --json --intersections");
+  ASSERT_EQ(i.status, 0) << i.err;
+  EXPECT_NE(i.out.find("intersect"), std::string::npos) << i.out;
+}
+
+TEST(Cli, PlaneEndToEndWithStats) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const CliRun r =
+      meshquilt(dir, "plane --swatch " + sw + " --size 8 7 -o out.ply --stats s.json --device cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote out.ply"), std::string::npos) << r.out;
+  ASSERT_TRUE(fs::exists(dir + "/out.ply"));
+  const std::string stats = slurp(dir + "/s.json");
+  for (const char* key : {"iterations", "faces", "vertices", "elements", "stitched", "replaced",
+                          "added", "removed_post", "stage_seconds", "matching", "merging"})
+    EXPECT_NE(stats.find("\"" + std::string(key) + "\":"), std::string::npos) << key;
+  EXPECT_GT(std::stoi(json_value(stats, "iterations")), 1);
+  // The counts agree with what info reads back from the file.
+  const CliRun i = meshquilt(dir, "info out.ply --json");
+  ASSERT_EQ(i.status, 0) << i.err;
+  const size_t output = stats.find("\"output\":");
+  ASSERT_NE(output, std::string::npos);
+  EXPECT_EQ(json_value(stats.substr(output), "faces"), json_value(i.out, "faces"));
+  EXPECT_EQ(json_value(stats.substr(output), "vertices"), json_value(i.out, "vertices"));
+  EXPECT_EQ(json_value(stats.substr(output), "elements"), json_value(i.out, "elements"));
+  EXPECT_EQ(json_value(i.out, "closed"), "true");
+  // No temporary files left beside the outputs.
+  const std::vector<std::string> expected{"out.ply", "s.json", "sw.obj"};
+  EXPECT_EQ(listing(dir), expected);
+}
+
+// Each bad invocation exits non-zero without a crash, prints one line starting with "meshquilt",
+// and leaves no output file behind; an existing output file is left untouched.
+TEST(Cli, BadInputFailsCleanly) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  spit(dir + "/empty.obj", "");
+  spit(dir + "/truncated.off", "OFF\n8 12 0\n0 0 0\n1 0 0\n0 1 0\n");
+  spit(dir + "/nan.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
+  spit(dir + "/garbage.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
+  struct Case {
+    std::string args, out;
+  };
+  const std::vector<Case> cases{
+      {"plane --swatch missing.obj --size 5 5 -o o.obj", "o.obj"},
+      {"plane --swatch empty.obj --size 5 5 -o o.obj", "o.obj"},
+      {"plane --swatch truncated.off --size 5 5 -o o.obj", "o.obj"},
+      {"plane --swatch nan.off --size 5 5 -o o.obj", "o.obj"},
+      {"plane --swatch garbage.obj --size 5 5 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size 0 5 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size nan 5 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size -3 5 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size 5 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size 5 5 --cell 100 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size 5 5 --threads -1 -o o.obj", "o.obj"},
+      {"plane --swatch " + sw + " --size 5 5 -o o.xyz", "o.xyz"},
+      {"plane --swatch " + sw + " --size 5 5 -o o.obj --stats nodir/s.json", "o.obj"},
+      {"plane --swatch " + sw + " --size 5 5 -o nodir/o.obj", "nodir/o.obj"},
+      {"info missing.obj", ""},
+      {"info truncated.off", ""},
+      {"render missing.obj -o o.png", "o.png"},
+      {"render nan.off -o o.png", "o.png"},
+      {"swatch chainmail --rows 0 -o o.obj", "o.obj"},
+      {"swatch chainmail -o nodir/o.obj", "nodir/o.obj"},
+  };
+  const std::vector<std::string> before = listing(dir);
+  for (const Case& c : cases) {
+    for (const bool existing : {false, true}) {
+      if (existing && c.out.empty()) continue;
+      const std::string path = dir + "/" + c.out;
+      if (existing) {
+        if (!fs::exists(fs::path(path).parent_path())) continue;
+        spit(path, "sentinel");
+      }
+      const CliRun r = meshquilt(dir, c.args);
+      SCOPED_TRACE(c.args + (existing ? " (existing output)" : ""));
+      EXPECT_FALSE(r.signaled);
+      EXPECT_NE(r.status, 0);
+      EXPECT_LT(r.status, 128);
+      const auto lines = r.err_lines();
+      EXPECT_EQ(lines.size(), 1u) << r.err;
+      if (!lines.empty()) {
+        EXPECT_EQ(lines[0].rfind("meshquilt", 0), 0u) << lines[0];
+      }
+      if (!c.out.empty()) {
+        if (existing) {
+          EXPECT_TRUE(slurp(path) == "sentinel") << "the existing output was modified";
+          fs::remove(path);
+        } else {
+          EXPECT_FALSE(fs::exists(path));
+        }
+      }
+      EXPECT_EQ(listing(dir), before);
+    }
+  }
+}
+
+TEST(Cli, NonManifoldSwatchDoesNotCrash) {
+  const std::string dir = test::temp_dir();
+  // Three triangles on one edge (a non-manifold fin) next to a closed tetrahedron.
+  spit(dir + "/fin.obj",
+       "v 0 0 0\nv 2 0 0\nv 1 1 0.2\nv 1 -1 0.2\nv 1 0.3 -0.2\n"
+       "f 1 2 3\nf 2 1 4\nf 1 2 5\n"
+       "v 3 0 0\nv 4 0 0\nv 3.5 1 0\nv 3.5 0.4 0.4\n"
+       "f 6 8 7\nf 6 7 9\nf 7 8 9\nf 8 6 9\n");
+  const CliRun r = meshquilt(dir, "plane --swatch fin.obj --size 6 4 -o o.obj --quiet");
+  EXPECT_FALSE(r.signaled);
+  EXPECT_LT(r.status, 128);
+  if (r.status == 0) {
+    EXPECT_TRUE(fs::exists(dir + "/o.obj"));
+  } else {
+    const auto lines = r.err_lines();
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_EQ(lines[0].rfind("meshquilt", 0), 0u);
+    EXPECT_FALSE(fs::exists(dir + "/o.obj"));
+  }
+}
+
+TEST(Cli, QuietPrintsNothing) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const CliRun r = meshquilt(dir, "plane --swatch " + sw + " --size 6 6 -o o.obj --quiet");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+  EXPECT_TRUE(fs::exists(dir + "/o.obj"));
+}
+
+TEST(Cli, ProgressLinesOnStderrWhenNotATerminal) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const CliRun r = meshquilt(dir, "plane --swatch " + sw + " --size 8 7 -o o.obj");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto lines = r.err_lines();
+  ASSERT_FALSE(lines.empty());
+  // Plain lines (no carriage returns: stderr is a file), ending with the stage at 100%.
+  EXPECT_EQ(r.err.find('\r'), std::string::npos);
+  for (const std::string& line : lines) EXPECT_EQ(line.rfind("[", 0), 0u) << line;
+  EXPECT_NE(lines.back().find("quilting 100%"), std::string::npos) << lines.back();
+  // The summary goes to stdout, not stderr.
+  EXPECT_NE(r.out.find("iterations"), std::string::npos) << r.out;
+}
+
+TEST(Cli, RenderWritesAPng) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const CliRun r = meshquilt(dir, "render " + sw + " -o pic.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string png = slurp(dir + "/pic.png");
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // IHDR: width and height big-endian at bytes 16 and 20.
+  auto be32 = [&](size_t at) {
+    return (static_cast<unsigned char>(png[at]) << 24) |
+           (static_cast<unsigned char>(png[at + 1]) << 16) |
+           (static_cast<unsigned char>(png[at + 2]) << 8) | static_cast<unsigned char>(png[at + 3]);
+  };
+  EXPECT_EQ(be32(16), 64u);
+  EXPECT_EQ(be32(20), 48u);
+}
+
+TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const std::string common = "plane --swatch " + sw + " --size 8 7 --variety 0.2 --seed 5 --quiet";
+  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 1 -o t1.obj").status, 0);
+  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 2 -o t2.obj").status, 0);
+  const std::string t1 = slurp(dir + "/t1.obj");
+  ASSERT_FALSE(t1.empty());
+  EXPECT_TRUE(t1 == slurp(dir + "/t2.obj")) << "--threads 1 and 2 differ";
+  if (!opencl_platform_present()) GTEST_SKIP() << "clinfo -l lists no OpenCL platform";
+  const CliRun g = meshquilt(dir, common + " --device opencl --threads 2 -o cl.obj");
+  ASSERT_EQ(g.status, 0) << g.err;
+  EXPECT_TRUE(t1 == slurp(dir + "/cl.obj")) << "--device cpu and opencl differ";
+}
+
+}  // namespace
+}  // namespace mq

@@ -1,0 +1,204 @@
+// Geometry matching (paper section 2.4): the offset chosen by choose_offset on a periodic swatch.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <utility>
+
+#include "core/errors.h"
+#include "core/geometry_matching.h"
+#include "core/geometry_measures.h"
+#include "core/swatch_generators.h"
+
+namespace mq {
+namespace {
+
+// A small chain mail sheet: periods 2.5 (x) and 1.25 (y), cells of a quarter / half period.
+struct PeriodicFixture {
+  ChainMailOptions options;
+  TriMesh swatch;
+  double cell = 0.625;
+  PeriodicFixture() {
+    options.rows = 4;
+    options.cols = 4;
+    options.ring_segments = 24;
+    options.wire_segments = 8;
+    swatch = chainmail_4in1(options);
+  }
+  double px() const { return chainmail_period_x(options); }
+  double py() const { return chainmail_period_y(options); }
+
+  // Face centroids (with exact face normals) of the swatch inside [x0,x1] x [y0,y1], moved by
+  // `shift`: an output sub-patch that the swatch matches exactly at t = shift (+ periods).
+  void subpatch(double x0, double x1, double y0, double y1, const Vector3d& shift, MatrixX3d& P,
+                MatrixX3d& NP) const {
+    const MatrixX3d FN = face_normals(swatch.V, swatch.F);
+    std::vector<int> faces;
+    for (int f = 0; f < swatch.num_faces(); ++f) {
+      const Vector3d c = centroid(f);
+      if (c.x() >= x0 && c.x() <= x1 && c.y() >= y0 && c.y() <= y1) faces.push_back(f);
+    }
+    P.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    NP.resize(P.rows(), 3);
+    for (size_t i = 0; i < faces.size(); ++i) {
+      P.row(static_cast<Eigen::Index>(i)) = (centroid(faces[i]) + shift).transpose();
+      NP.row(static_cast<Eigen::Index>(i)) = FN.row(faces[i]);
+    }
+  }
+  Vector3d centroid(int f) const {
+    return (swatch.V.row(swatch.F(f, 0)) + swatch.V.row(swatch.F(f, 1)) +
+            swatch.V.row(swatch.F(f, 2)))
+               .transpose() /
+           3.0;
+  }
+  // Whole-cell offsets kx * cell, ky * cell for kx, ky in [lo, hi].
+  MatrixX3d candidates(int lo, int hi) const {
+    const int n = hi - lo + 1;
+    MatrixX3d T(n * n, 3);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) T.row(j * n + i) << (lo + i) * cell, (lo + j) * cell, 0.0;
+    return T;
+  }
+};
+
+// Distance from a to the nearest b + (i px, j py).
+double periodic_distance(const Vector3d& a, const Vector3d& b, double px, double py) {
+  const double dx = a.x() - b.x(), dy = a.y() - b.y();
+  const double rx = dx - px * std::round(dx / px), ry = dy - py * std::round(dy / py);
+  return std::sqrt(rx * rx + ry * ry + (a.z() - b.z()) * (a.z() - b.z()));
+}
+
+TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatrixX3d P, NP;
+  const Vector3d shift(fx.px(), fx.py(), 0);  // 4 and 2 cells
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, shift, P, NP);
+  ASSERT_GT(P.rows(), 50);
+  MatchingOptions options;
+  options.lambda = 1.0 / fx.cell;
+  options.refine_to = 0;  // whole cells only
+  std::mt19937_64 rng(1);
+  const MatrixX3d T = fx.candidates(-2, 8);
+  const OffsetChoice c = choose_offset(grid, cpu, P, NP, T, Vector2d(-2, -2) * fx.cell,
+                                       Vector2d(8, 8) * fx.cell, fx.cell, options, rng);
+  EXPECT_EQ(c.candidates, T.rows());
+  EXPECT_EQ(c.point_offsets, T.rows() * P.rows());
+  EXPECT_LT(periodic_distance(c.offset, shift, fx.px(), fx.py()), 1e-9) << c.offset.transpose();
+  // Every point lies on a face with the same normal: each Eq. (2) term is exactly 1.
+  EXPECT_NEAR(c.cost, static_cast<double>(P.rows()), 1e-6 * P.rows());
+  // And the offsets off the period cost clearly more (the test has a real choice to make).
+  TranslationCostProblem pb;
+  pb.points = P;
+  pb.point_normals = NP;
+  pb.lambda = options.lambda;
+  pb.offsets = T;
+  const Eigen::VectorXd costs = cpu.evaluate(grid, pb);
+  int off_period = 0;
+  for (Eigen::Index i = 0; i < T.rows(); ++i)
+    if (periodic_distance(T.row(i).transpose(), shift, fx.px(), fx.py()) > 1e-9) {
+      ++off_period;
+      EXPECT_GT(costs(i), 1.05 * c.cost) << "offset " << T.row(i);
+    }
+  EXPECT_GT(off_period, 100);
+}
+
+TEST(GeometryMatching, RefinementRecoversASubCellShift) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatrixX3d P, NP;
+  const Vector3d shift(fx.px() + 0.2, fx.py() - 0.15, 0);  // +0.32 and -0.24 of a cell
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, shift, P, NP);
+  MatchingOptions options;
+  options.lambda = 1.0 / fx.cell;
+  options.refine_to = 1e-3;
+  std::mt19937_64 rng(1);
+  const OffsetChoice c =
+      choose_offset(grid, cpu, P, NP, fx.candidates(-2, 8), Vector2d(-2, -2) * fx.cell,
+                    Vector2d(8, 8) * fx.cell, fx.cell, options, rng);
+  EXPECT_GT(c.evaluations, c.candidates);  // the refinement ran
+  EXPECT_LT(periodic_distance(c.offset, shift, fx.px(), fx.py()), 0.01 * fx.cell)
+      << c.offset.transpose();
+  EXPECT_EQ(c.offset.z(), 0.0);
+  // Without refinement the best is the nearest whole cell, off by a third of a cell.
+  options.refine_to = 0;
+  const OffsetChoice whole =
+      choose_offset(grid, cpu, P, NP, fx.candidates(-2, 8), Vector2d(-2, -2) * fx.cell,
+                    Vector2d(8, 8) * fx.cell, fx.cell, options, rng);
+  EXPECT_GT(periodic_distance(whole.offset, shift, fx.px(), fx.py()), 0.25 * fx.cell);
+}
+
+TEST(GeometryMatching, RefinementStaysInTheAdmissibleRange) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatrixX3d P, NP;
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, Vector3d(fx.px() + 0.2, fx.py() - 0.15, 0), P, NP);
+  MatchingOptions options;
+  options.lambda = 1.0 / fx.cell;
+  std::mt19937_64 rng(1);
+  // The true shift lies outside this range: the search must stop at its border.
+  const Vector2d lo(0, 0), hi(fx.px(), fx.py());
+  const OffsetChoice c =
+      choose_offset(grid, cpu, P, NP, fx.candidates(0, 2), lo, hi, fx.cell, options, rng);
+  EXPECT_GE(c.offset.x(), lo.x());
+  EXPECT_GE(c.offset.y(), lo.y());
+  EXPECT_LE(c.offset.x(), hi.x());
+  EXPECT_LE(c.offset.y(), hi.y());
+}
+
+TEST(GeometryMatching, VarietyIsSeededAndStaysNearTheMinimum) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatrixX3d P, NP;
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, Vector3d(fx.px(), fx.py(), 0), P, NP);
+  const MatrixX3d T = fx.candidates(2, 6);
+  TranslationCostProblem pb;
+  pb.points = P;
+  pb.point_normals = NP;
+  pb.lambda = 1.0 / fx.cell;
+  pb.offsets = T;
+  const Eigen::VectorXd costs = cpu.evaluate(grid, pb);
+  MatchingOptions options;
+  options.lambda = pb.lambda;
+  options.epsilon = 1.0;
+  options.refine_to = 0;
+  auto pick = [&](uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    return choose_offset(grid, cpu, P, NP, T, Vector2d(2, 2) * fx.cell, Vector2d(6, 6) * fx.cell,
+                         fx.cell, options, rng);
+  };
+  std::set<std::pair<double, double>> distinct;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    const OffsetChoice a = pick(seed), b = pick(seed);
+    EXPECT_EQ(a.offset, b.offset) << "seed " << seed;  // same seed, same choice
+    EXPECT_LE(a.cost, (1 + options.epsilon) * costs.minCoeff() * (1 + 1e-12));
+    distinct.insert({a.offset.x(), a.offset.y()});
+  }
+  EXPECT_GE(distinct.size(), 2u) << "epsilon > 0 never varied the choice";
+}
+
+TEST(GeometryMatching, EdgeCases) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  std::mt19937_64 rng(1);
+  MatchingOptions options;
+  MatrixX3d P, NP;
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, Vector3d::Zero(), P, NP);
+  EXPECT_THROW(choose_offset(grid, cpu, P, NP, MatrixX3d(0, 3), Vector2d(0, 0), Vector2d(1, 1),
+                             fx.cell, options, rng),
+               InvalidInput);
+  // No output points: the first admissible placement.
+  const MatrixX3d T = fx.candidates(1, 3);
+  const OffsetChoice c = choose_offset(grid, cpu, MatrixX3d(0, 3), MatrixX3d(0, 3), T,
+                                       Vector2d(0, 0), Vector2d(3, 3), fx.cell, options, rng);
+  EXPECT_EQ(c.offset, Vector3d(T.row(0).transpose()));
+}
+
+}  // namespace
+}  // namespace mq
