@@ -4,6 +4,7 @@
 #include "core/closest_point_query.h"
 #include "core/element_cut.h"
 #include "core/element_stitch.h"
+#include "core/errors.h"
 #include "core/laplacian_deformation.h"
 #include "core/mesh_topology.h"
 
@@ -114,7 +115,14 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
     return fail(StitchFailure::NothingCut);
   StitchOptions stitch_options;
   stitch_options.max_loop_distance = options.max_loop_distance * mean_edge_length;
-  const std::optional<StitchResult> stitched = stitch_cut_elements(a, b, stitch_options);
+  std::optional<StitchResult> stitched;
+  try {
+    stitched = stitch_cut_elements(a, b, stitch_options);
+  } catch (const TopologyError&) {
+    // The min cut may leave a bow-tie or an edge shared by several kept faces; keeping one
+    // element whole is the documented fallback rather than aborting the whole synthesis.
+    return fail(StitchFailure::NonManifoldCut);
+  }
   if (!stitched) return fail(StitchFailure::LoopsUnpaired);
   std::vector<int> fc;
   if (connected_components(stitched->mesh.F, stitched->mesh.num_vertices(), fc) != 1)

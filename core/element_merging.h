@@ -26,7 +26,17 @@ struct MergeOptions {
 bool elements_coincide(const Element& a, const Element& b, double tolerance);
 
 // Why a cut-and-stitch was refused (for stats and messages).
-enum class StitchFailure { None, EmptyCut, NothingCut, LoopsUnpaired, NotOneComponent, OpenSeam };
+// NonManifoldCut: a kept part's cut boundary is non-manifold (e.g. faces meeting at one vertex),
+// so its seam loops are undefined.
+enum class StitchFailure {
+  None,
+  EmptyCut,
+  NothingCut,
+  NonManifoldCut,
+  LoopsUnpaired,
+  NotOneComponent,
+  OpenSeam
+};
 
 // Cuts the output element `out` and the swatch element `in` (already in the output frame) along
 // min-cut seams (Eq. (7) weights, infinite SOURCE links outside the overlapping region, SINK
@@ -36,6 +46,7 @@ enum class StitchFailure { None, EmptyCut, NothingCut, LoopsUnpaired, NotOneComp
 // inputs already had), or nullopt with the reason in `failure`.
 std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
                                       const OverlapRegion& region, double mean_edge_length,
-                                      const MergeOptions& options, StitchFailure* failure = nullptr);
+                                      const MergeOptions& options,
+                                      StitchFailure* failure = nullptr);
 
 }  // namespace mq
