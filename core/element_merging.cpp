@@ -212,6 +212,8 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   const int allowed = count_boundary_edges(out.F, static_cast<int>(out.V.rows())) +
                       count_boundary_edges(in.F, static_cast<int>(in.V.rows()));
   if (boundary > allowed) return fail(StitchFailure::OpenSeam);
+  if (topology_report(stitched->mesh).num_non_manifold_edges > 0)
+    return fail(StitchFailure::BadSeam);
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;

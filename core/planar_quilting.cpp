@@ -243,13 +243,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     }
     const Vector3d t = choice.offset;
     const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
-    // A snapshot of the processed cells: merging must see the output as it was before.
-    std::vector<unsigned char> processed(grid.num_cells());
-    for (int i = 0; i < grid.num_cells(); ++i) processed[i] = grid.processed(grid.cell(i));
-    const OverlapRegion region(patch_lo, patch_hi, [&grid, processed](double x, double y) {
-      const Cell c = grid.cell_of(x, y);
-      return grid.contains(c) && processed[grid.index(c)] != 0;
-    });
+    const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
 
     // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
     quilt_patch(output, swatch, *swatch_query, t, region, in_domain, patch_options, patch_counts,

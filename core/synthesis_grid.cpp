@@ -24,6 +24,15 @@ Cell SynthesisGrid::cell_of(double x, double y) const {
           static_cast<int>(std::floor((y - origin_.y()) / cell_size_))};
 }
 
+OverlapRegion::ProcessedTest SynthesisGrid::processed_snapshot() const {
+  return [origin = origin_, cell = cell_size_, nx = nx_, ny = ny_,
+          flags = processed_](double x, double y) {
+    const int cx = static_cast<int>(std::floor((x - origin.x()) / cell));
+    const int cy = static_cast<int>(std::floor((y - origin.y()) / cell));
+    return cx >= 0 && cy >= 0 && cx < nx && cy < ny && flags[cy * nx + cx] != 0;
+  };
+}
+
 int SynthesisGrid::num_processed() const {
   return static_cast<int>(std::count(processed_.begin(), processed_.end(), 1));
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "core/overlap_region.h"
 
 namespace mq {
 
@@ -33,6 +34,9 @@ class SynthesisGrid {
   Cell cell_of(double x, double y) const;
 
   bool processed(const Cell& c) const { return processed_[index(c)] != 0; }
+  // A copy of the processed flags as a point predicate (points outside the grid: false), for
+  // the overlapping region of the patch being merged (it must not see cells marked later).
+  OverlapRegion::ProcessedTest processed_snapshot() const;
   void set_processed(const Cell& c) { processed_[index(c)] = 1; }
   int num_processed() const;
 

@@ -8,6 +8,7 @@
 
 #include "core/element_correspondence.h"
 #include "core/mesh_topology.h"
+#include "core/synthesis_grid.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -34,7 +35,8 @@ struct TwoTori {
     return out;
   }
   Correspondences find(const std::vector<Element>& output, const CorrespondenceOptions& o = {}) {
-    const OverlapRegion region(grid, t.head<2>(), t.head<2>() + swatch.size.head<2>());
+    const OverlapRegion region(t.head<2>(), t.head<2>() + swatch.size.head<2>(),
+                               grid.processed_snapshot());
     std::vector<int> candidates(output.size());
     for (size_t i = 0; i < output.size(); ++i) candidates[i] = static_cast<int>(i);
     return find_correspondences(output, candidates, region, swatch, *query, t, o);

@@ -6,6 +6,7 @@
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
+#include "core/synthesis_grid.h"
 #include "tests/core/cut_fixtures.h"
 #include "tests/test_support.h"
 
@@ -64,7 +65,7 @@ struct OverlappingTubes {
 
 TEST(ElementMerging, CutAndStitchJoinsTwoOverlappingCappedTubes) {
   OverlappingTubes fx;
-  const OverlapRegion region(fx.grid, Vector2d(4, -2), Vector2d(10, 2));
+  const OverlapRegion region(Vector2d(4, -2), Vector2d(10, 2), fx.grid.processed_snapshot());
   StitchFailure why = StitchFailure::BadSeam;
   const std::optional<Element> joined =
       cut_and_stitch(fx.out, fx.in, region, fx.mean_edge, MergeOptions{}, &why);
@@ -99,7 +100,7 @@ TEST(ElementMerging, CutAndStitchRefusesUnrelatedElements) {
   // The swatch tube moved sideways, out of reach of the output's: nothing to join.
   Element far = fx.in;
   far.translate(Vector3d(0, 0, 3.0));
-  const OverlapRegion region(fx.grid, Vector2d(4, -2), Vector2d(10, 2));
+  const OverlapRegion region(Vector2d(4, -2), Vector2d(10, 2), fx.grid.processed_snapshot());
   StitchFailure why = StitchFailure::None;
   EXPECT_FALSE(cut_and_stitch(fx.out, far, region, fx.mean_edge, MergeOptions{}, &why));
   EXPECT_NE(why, StitchFailure::None);

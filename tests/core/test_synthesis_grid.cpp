@@ -138,7 +138,7 @@ TEST(OverlapRegion, ProcessedCellsInsideThePatchOnly) {
   SynthesisGrid g(Vector2d(0, 0), 1.0, 6, 6);
   for (int y = 0; y < 6; ++y)
     for (int x = 0; x < 3; ++x) g.set_processed({x, y});
-  const OverlapRegion r(g, Vector2d(1.5, 1.5), Vector2d(4.5, 4.5));
+  const OverlapRegion r(Vector2d(1.5, 1.5), Vector2d(4.5, 4.5), g.processed_snapshot());
   EXPECT_TRUE(r.contains(2.5, 2.5));   // processed, in the patch
   EXPECT_FALSE(r.contains(0.5, 2.5));  // processed, outside the patch
   EXPECT_FALSE(r.contains(3.5, 2.5));  // in the patch, not processed
