@@ -87,7 +87,12 @@ bool flatten(const MatrixX3d& V, const MatrixX3i& F, Chart& c, double max_distor
   }
   if (!c.uv.allFinite() || count_flipped(patch.F, c.uv) > 0) return false;
   const Eigen::VectorXd d = face_area_distortion(patch.V, patch.F, c.uv);
-  return d.maxCoeff() <= max_distortion;
+  if (!(d.maxCoeff() <= max_distortion)) return false;
+  // No flips still allows the boundary to wrap over the chart: check global overlap.
+  TextureAtlas single;
+  single.UV = c.uv;
+  single.FUV = patch.F;
+  return count_uv_overlaps(single) == 0;
 }
 
 double tri_area2(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
@@ -222,7 +227,8 @@ double atlas_stretch(const MatrixX3d& V, const MatrixX3i& F, const TextureAtlas&
   return std::sqrt(num / a3) * std::sqrt(auv / a3);
 }
 
-int count_uv_overlaps(const TextureAtlas& atlas) {
+int count_uv_overlaps(const TextureAtlas& atlas, std::vector<std::pair<int, int>>* pairs) {
+  if (pairs) pairs->clear();
   const MatrixX2d& UV = atlas.UV;
   const MatrixX3i& T = atlas.FUV;
   const int nt = static_cast<int>(T.rows());
@@ -280,7 +286,10 @@ int count_uv_overlaps(const TextureAtlas& atlas) {
         for (int t : grid[static_cast<std::size_t>(i) * res + j]) {
           if (t <= s || seen[t] == s) continue;
           seen[t] = s;
-          if (!separated(s, t)) ++count;
+          if (!separated(s, t)) {
+            ++count;
+            if (pairs) pairs->emplace_back(s, t);
+          }
         }
   }
   return count;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 #include "core/mesh.h"
@@ -13,7 +14,7 @@ struct TextureAtlasOptions {
   // A face joins a chart only while its normal stays within this cosine of the chart seed's
   // normal (a normal cone of about 60 degrees by default); in (-1, 1).
   double cone_cosine = 0.5;
-  // A chart whose LSCM flips a triangle or whose worst per-face area distortion exceeds this is
+  // A chart whose LSCM flips a triangle, overlaps itself, or whose worst per-face area distortion exceeds this is
   // re-grown with half its face budget (>= 1).
   double max_area_distortion = 3.0;
   int max_chart_faces = 4000;  // face budget of a chart when first grown (>= 1)
@@ -39,8 +40,8 @@ struct TextureAtlas {
 // Builds the atlas: charts grown from seeds by region growing (priority to faces closest in
 // normal to the seed, seeds taken in face order), a face joining only when the chart stays a
 // topological disk (it shares one edge and brings a new vertex, or shares two edges) and its
-// normal stays in the cone; each chart flattened by lscm() and checked (no flips, bounded area
-// distortion; otherwise re-grown smaller, down to single faces which always succeed), then
+// normal stays in the cone; each chart flattened by lscm() and checked (no flips, no self-overlap,
+// bounded area distortion; otherwise re-grown smaller, down to single faces which always succeed), then
 // shelf-packed by bounding box, tallest first. Deterministic, independent of the thread count.
 //   V  #V by 3 finite positions, F  #F by 3 indices, consistently oriented, no zero-area face
 // Throws InvalidInput for bad options, an index out of range, non-finite coordinates, no faces
@@ -58,6 +59,8 @@ double atlas_stretch(const MatrixX3d& V, const MatrixX3i& F, const TextureAtlas&
 // uniform grid over triangle bounding boxes; triangles sharing a UV row are tested for overlap
 // beyond the shared corner or edge by a strict separating-axis test with tolerance 1e-12
 // relative to the domain size. Throws InvalidInput for an index out of range.
-int count_uv_overlaps(const TextureAtlas& atlas);
+//   pairs  optional output: the overlapping pairs (s, t), s < t, ascending
+int count_uv_overlaps(const TextureAtlas& atlas,
+                      std::vector<std::pair<int, int>>* pairs = nullptr);
 
 }  // namespace mq

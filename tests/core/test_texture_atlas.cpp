@@ -30,7 +30,12 @@ void expect_valid_atlas(const TriMesh& m, const TextureAtlas& a, const std::stri
       ASSERT_EQ(c, a.face_chart[f]);
     }
   EXPECT_EQ(count_flipped(a.FUV, a.UV), 0) << name;
-  EXPECT_EQ(count_uv_overlaps(a), 0) << name;
+  std::vector<std::pair<int, int>> pairs;
+  EXPECT_EQ(count_uv_overlaps(a, &pairs), 0) << name;
+  for (std::size_t i = 0; i < std::min<std::size_t>(pairs.size(), 3); ++i)
+    ADD_FAILURE() << "faces " << pairs[i].first << " (chart " << a.face_chart[pairs[i].first]
+                  << ") and " << pairs[i].second << " (chart " << a.face_chart[pairs[i].second]
+                  << ") overlap in UV";
   const double s = atlas_stretch(m.V, m.F, a);
   std::printf("[ atlas    ] %s: %d faces, %d charts, stretch %.4f\n", name.c_str(),
               static_cast<int>(m.F.rows()), a.num_charts, s);
