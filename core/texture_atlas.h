@@ -14,8 +14,8 @@ struct TextureAtlasOptions {
   // A face joins a chart only while its normal stays within this cosine of the chart seed's
   // normal (a normal cone of about 60 degrees by default); in (-1, 1).
   double cone_cosine = 0.5;
-  // A chart whose LSCM flips a triangle, overlaps itself, or whose worst per-face area distortion exceeds this is
-  // re-grown with half its face budget (>= 1).
+  // A chart whose LSCM flips a triangle, overlaps itself, or whose worst per-face area distortion
+  // exceeds this is re-grown with half its face budget (>= 1).
   double max_area_distortion = 3.0;
   int max_chart_faces = 4000;  // face budget of a chart when first grown (>= 1)
   // Empty space between packed chart bounding boxes, relative to sqrt(total 3D area) (>= 0).
@@ -41,8 +41,8 @@ struct TextureAtlas {
 // normal to the seed, seeds taken in face order), a face joining only when the chart stays a
 // topological disk (it shares one edge and brings a new vertex, or shares two edges) and its
 // normal stays in the cone; each chart flattened by lscm() and checked (no flips, no self-overlap,
-// bounded area distortion; otherwise re-grown smaller, down to single faces which always succeed), then
-// shelf-packed by bounding box, tallest first. Deterministic, independent of the thread count.
+// bounded area distortion; otherwise re-grown smaller, down to single faces which always succeed),
+// then shelf-packed by bounding box, tallest first. Deterministic, independent of the thread count.
 //   V  #V by 3 finite positions, F  #F by 3 indices, consistently oriented, no zero-area face
 // Throws InvalidInput for bad options, an index out of range, non-finite coordinates, no faces
 // or a zero-area face.
@@ -60,7 +60,6 @@ double atlas_stretch(const MatrixX3d& V, const MatrixX3i& F, const TextureAtlas&
 // beyond the shared corner or edge by a strict separating-axis test with tolerance 1e-12
 // relative to the domain size. Throws InvalidInput for an index out of range.
 //   pairs  optional output: the overlapping pairs (s, t), s < t, ascending
-int count_uv_overlaps(const TextureAtlas& atlas,
-                      std::vector<std::pair<int, int>>* pairs = nullptr);
+int count_uv_overlaps(const TextureAtlas& atlas, std::vector<std::pair<int, int>>* pairs = nullptr);
 
 }  // namespace mq

