@@ -261,7 +261,7 @@ TEST_P(ShellMapReal, ShellMapAvoidsIntersectionsOfNormalDisplacement) {
   // shell, where normal displacement crosses in concave regions. The shell map is a bijection,
   // so the exact images are disjoint; the straight-edged elements built from the mapped vertices
   // only approximate them, which leaves a few inverted ones where an element straddles strongly
-  // sheared prisms (measured: 1 of 45k on the cup, none on the bunny and the knight).
+  // sheared prisms (measured: 1 of 34k on the cup, none on the bunny and the knight).
   const Case& c = get(GetParam());
   const double H = c.map->height();
   const Elements el = prism_elements(c.map->faces(), H, 2, 0.3, 0.85, 0.95);
