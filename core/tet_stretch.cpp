@@ -58,6 +58,11 @@ inline double stretch_closed_form(const double* s0, const double* s1, const doub
 
 }  // namespace
 
+double tet_stretch(const Vector3d* s, const Vector3d* t) {
+  return stretch_closed_form(s[0].data(), s[1].data(), s[2].data(), s[3].data(), t[0].data(),
+                             t[1].data(), t[2].data(), t[3].data());
+}
+
 void validate_stretch_problem(const StretchProblem& problem) {
   MQ_CHECK(problem.shell_V.rows() == problem.texture_V.rows(), InvalidInput,
            "tet stretch: ", problem.shell_V.rows(), " shell vertices but ",

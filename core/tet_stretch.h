@@ -59,6 +59,11 @@ class TetStretchCpu final : public TetStretchEvaluator {
   std::string name() const override { return "cpu"; }
 };
 
+// Eq. (8) for one tet from its shell corners s[0..3] and texture corners t[0..3], with the same
+// closed form as TetStretchCpu (+infinity when the texture tet is degenerate or its orientation
+// differs from the shell tet's). For local evaluations in an optimiser.
+double tet_stretch(const Vector3d* s, const Vector3d* t);
+
 // Reference: a plain loop with Eigen's 3x3 inverse, J = S * Tt^-1 with S, Tt the edge matrices.
 // Throws InvalidInput like the evaluators.
 Eigen::VectorXd tet_stretch_reference(const StretchProblem& problem);

@@ -1,0 +1,82 @@
+#include "core/base_fold_repair.h"
+
+#include <algorithm>
+
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_topology.h"
+
+namespace mq {
+
+std::vector<int> folded_faces(const MatrixX3d& V, const MatrixX3i& F) {
+  const int n = static_cast<int>(V.rows());
+  const EdgeTopology topo = edge_topology(F, n);  // validates indices
+  const MatrixX3i TT = face_adjacency(topo);
+  const MatrixX3d FN = face_normals(V, F);
+  const Eigen::VectorXd A = face_areas(V, F);
+  const MatrixX3d VN = vertex_normals(V, F);
+  std::vector<char> folded(F.rows(), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    Vector3d s = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (TT(f, k) >= 0) s += A(TT(f, k)) * FN.row(TT(f, k)).transpose();
+    if (s.dot(FN.row(f)) < 0.0) folded[f] = 1;
+    for (int k = 0; k < 3; ++k)
+      if (VN.row(F(f, k)).dot(FN.row(f)) < 0.0) folded[f] = 1;
+  }
+  std::vector<int> out;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (folded[f]) out.push_back(static_cast<int>(f));
+  return out;
+}
+
+FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F, const FoldRepairOptions& options) {
+  MQ_CHECK(options.smoothing_iterations >= 1 && options.max_rounds >= 1, InvalidInput,
+           "fold repair: smoothing_iterations and max_rounds must be >= 1");
+  MQ_CHECK(V.allFinite(), InvalidInput, "fold repair: vertices contain NaN or infinite values");
+  const int n = static_cast<int>(V.rows());
+  FoldRepair out;
+  out.V = V;
+  out.folded_faces = folded_faces(V, F);
+  if (out.folded_faces.empty()) return out;
+  const Adjacency vv = vertex_adjacency(F, n);
+  std::vector<char> relax(n, 0);
+  for (int f : out.folded_faces)
+    for (int k = 0; k < 3; ++k) relax[F(f, k)] = 1;
+  std::vector<int> remaining = out.folded_faces;
+  for (int round = 0; round < options.max_rounds && !remaining.empty(); ++round) {
+    if (round > 0) {  // grow by one ring
+      std::vector<char> grown = relax;
+      for (int i = 0; i < n; ++i)
+        if (relax[i])
+          for (const int* j = vv.begin(i); j != vv.end(i); ++j) grown[*j] = 1;
+      relax.swap(grown);
+      for (int f : remaining)
+        for (int k = 0; k < 3; ++k) relax[F(f, k)] = 1;
+    }
+    for (int it = 0; it < options.smoothing_iterations; ++it) {
+      MatrixX3d next = out.V;
+      for (int i = 0; i < n; ++i) {
+        if (!relax[i] || vv.degree(i) == 0) continue;
+        Vector3d c = Vector3d::Zero();
+        for (const int* j = vv.begin(i); j != vv.end(i); ++j) c += out.V.row(*j).transpose();
+        next.row(i) = c / vv.degree(i);
+      }
+      out.V.swap(next);
+    }
+    remaining = folded_faces(out.V, F);
+  }
+  MQ_CHECK(remaining.empty(), TopologyError, "fold repair: face ",
+           remaining.empty() ? -1 : remaining[0], " still folds after ", options.max_rounds,
+           " rounds of relaxation");
+  for (int i = 0; i < n; ++i) {
+    const double d = (out.V.row(i) - V.row(i)).norm();
+    if (d > 0.0) {
+      out.moved_vertices.push_back(i);
+      out.max_displacement = std::max(out.max_displacement, d);
+    }
+  }
+  return out;
+}
+
+}  // namespace mq

@@ -1,0 +1,99 @@
+// The shell map of paper section 3.2: a piecewise-linear bijection between the shell space
+// (tets between the base surface and its offset) and the texture space (the base's texture
+// atlas extruded by the shell height), and the optimisation of its stretch (Eqs. 8-9).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/base_fold_repair.h"
+#include "core/mesh.h"
+#include "core/offset_surface.h"
+#include "core/tet_mesh.h"
+#include "core/tet_stretch.h"
+#include "core/texture_atlas.h"
+
+namespace mq {
+
+struct ShellMapOptions {
+  double height = 0.0;  // shell height H (> 0); overrides offset.height
+  OffsetOptions offset;
+  TextureAtlasOptions atlas;
+  // When offset_surface rejects the base because it folds (TopologyError), relax the folded
+  // vertices (repair_folds) and build the shell over the repaired base instead of failing.
+  bool repair_folds = true;
+  FoldRepairOptions fold_repair;
+};
+
+struct ShellOptimizeOptions {
+  int max_sweeps = 30;        // iteration budget (>= 0)
+  double tolerance = 1e-4;    // stop when a sweep lowers the total stretch by less (relative)
+  std::uint64_t seed = 1;     // random line-search directions
+  int line_search_steps = 8;  // step sizes tried per direction and sign: L, L/2, ... (>= 1)
+};
+
+struct ShellOptimizeReport {
+  double stretch_before = 0.0;
+  double stretch_after = 0.0;
+  int sweeps = 0;
+  long long accepted_moves = 0;
+  int num_colours = 0;  // independent sets updated in parallel
+  int num_free_vertices = 0;
+};
+
+// The shell map. Vertices of the chart-split tet mesh: UV row j of the atlas is vertex j (its
+// base corner, texture (u, v, 0)) and vertex m + j (its offset corner, texture (u, v, H)),
+// m = #UV. Face f's prism gives tets 3f, 3f + 1, 3f + 2, split like shell_tet_indices, so the
+// shell tets are exactly those of shell_tetrahedra and texture tets of different charts are
+// disjoint.
+class ShellMap {
+ public:
+  // Builds atlas, offset surface and both tet meshes.
+  //   V #V by 3 finite positions, F #F by 3 faces, counter-clockwise seen from outside
+  // Throws InvalidInput for bad options or input (see offset_surface, texture_atlas);
+  // TopologyError when no valid shell exists (even after a fold repair, if enabled).
+  ShellMap(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions& options);
+
+  // Normalised total stretch (Eq. 9, see tet_stretch.h) with the given evaluator, or with the
+  // CPU one. >= 1; +infinity if a texture tet is inverted.
+  double stretch(TetStretchEvaluator& evaluator) const;
+  double stretch() const;
+
+  // Random line search (Sander et al. 2001, as in section 3.2) on the (u, v) of the offset
+  // corners that are not on a chart border or a base boundary (w stays H): each sweep visits
+  // every free vertex once, colour by colour (vertices of one colour share no tet and move in
+  // parallel), tries a random direction with steps +-L 2^-k (L the mean length of the
+  // vertex's texture edges to other offset corners), and keeps the best step only if it lowers
+  // the local stretch sum_t L2(t)^2 |T_s,t| of its tets (the total's normaliser is constant:
+  // borders are fixed) with no texture tet inverted. Directions come from mt19937_64 seeded by
+  // (seed, sweep, vertex): the result does not depend on the thread count. Full evaluations
+  // (before, after each sweep) use `evaluator`.
+  // Throws InvalidInput for bad options; DeviceError from the evaluator.
+  ShellOptimizeReport optimize(TetStretchEvaluator& evaluator,
+                               const ShellOptimizeOptions& options = {});
+
+  // The shell base: the input, or the fold-repaired input (see repaired_vertices()).
+  const MatrixX3d& base_vertices() const { return base_V_; }
+  const MatrixX3i& faces() const { return F_; }
+  const OffsetSurface& offset() const { return offset_; }
+  const TextureAtlas& atlas() const { return atlas_; }
+  double height() const { return height_; }
+  // Chart-split shell and texture tets (shell_V, texture_V, T), 2#UV vertices, 3#F tets.
+  const StretchProblem& problem() const { return problem_; }
+  // Per UV row: true when its offset corner is fixed (chart border or base boundary).
+  const std::vector<char>& fixed() const { return fixed_; }
+  // Vertices moved by the fold repair (empty when the input did not fold).
+  const FoldRepair& fold_repair() const { return repair_; }
+
+ private:
+  MatrixX3d base_V_;
+  MatrixX3i F_;
+  double height_ = 0.0;
+  FoldRepair repair_;
+  OffsetSurface offset_;
+  TextureAtlas atlas_;
+  StretchProblem problem_;
+  std::vector<char> fixed_;
+};
+
+}  // namespace mq
