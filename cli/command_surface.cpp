@@ -8,16 +8,20 @@
 #include "cli/run_context.h"
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
+#include "core/quilt_embedding.h"
 #include "core/surface_quilting.h"
 #include "core/tangent_field.h"
+#include "host/tet_stretch_evaluator.h"
 #include "host/translation_cost_evaluator.h"
 
 namespace mq::cli {
 
 namespace {
 
-void write_stats(const std::string& path, const SurfaceQuiltingStats& s, const std::string& device,
-                 int threads, double wall, const std::string& base, const std::string& swatch) {
+void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
+                 const QuiltEmbeddingStats& em, const std::string& embedding,
+                 const std::string& device, int threads, double wall, const std::string& base,
+                 const std::string& swatch) {
   JsonWriter j;
   j.begin_object()
       .value("command", "surface")
@@ -27,15 +31,22 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s, const s
       .value("threads", threads)
       .value("wall_seconds", wall)
       .value("base_faces", s.base_faces)
+      .value("base_refinement_levels", s.base_refinement_levels)
       .value("swatch_scale", s.swatch_scale)
       .value("shell_height", s.shell_height)
       .value("cell_size", s.cell_size)
       .value("iterations", s.iterations)
       .value("patches_shrunk", s.patches_shrunk)
+      .value("embedding", embedding)
+      .value("stretch_before", em.stretch_before)
+      .value("stretch_after", em.stretch_after)
+      .value("stretch_optimization_sweeps", em.optimization_sweeps)
+      .value("atlas_charts", em.atlas_charts)
+      .value("fold_repaired_vertices", em.fold_repaired_vertices)
       .begin_object("output")
-      .value("faces", s.faces)
-      .value("vertices", s.vertices)
-      .value("elements", s.elements)
+      .value("faces", em.faces)
+      .value("vertices", em.vertices)
+      .value("elements", em.elements)
       .end_object()
       .begin_object("elements")
       .value("added", s.counts.added)
@@ -46,19 +57,20 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s, const s
       .value("stitch_fallbacks", s.counts.stitch_fallbacks)
       .value("rejected_intersecting", s.counts.rejected_intersecting)
       .value("rejected_outside_patch", s.rejected_outside_patch)
-      .value("removed_post", s.removed_post)
+      .value("removed_post", em.removed_intersecting)
       .end_object()
       .begin_object("element_area")
-      .value("mean", s.element_area_mean)
-      .value("cv", s.element_area_cv)
-      .value("min", s.element_area_min)
-      .value("max", s.element_area_max)
+      .value("mean", em.element_area_mean)
+      .value("cv", em.element_area_cv)
+      .value("min", em.element_area_min)
+      .value("max", em.element_area_max)
       .end_object()
       .value("matched_point_offsets", s.matched_point_offsets)
       .value("pairs", s.counts.pairs)
       .value("relations", s.counts.relations)
       .begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
+  for (const auto& [stage, seconds] : em.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
   write_file_atomically(path, j.str());
 }
@@ -90,6 +102,9 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
   cl.option("device", "auto|cpu|opencl", "where the translation cost runs", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
+  cl.flag("no-stretch-opt", "skip the shell map's stretch minimisation (on by default)");
+  cl.option("embedding", "shell|normal",
+            "place the texture through the shell map or by plain normal displacement", "shell");
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
@@ -106,7 +121,14 @@ int run_surface(int argc, char** argv, int first) {
   options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
   options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
   options.patch.deform = !cl.has("no-deform");
-  options.remove_intersecting = !cl.has("keep-intersecting");
+  QuiltEmbeddingOptions embedding;
+  const std::string embedding_name = cl.get("embedding");
+  if (embedding_name != "shell" && embedding_name != "normal")
+    throw UsageError("--embedding expects shell or normal, got '" + embedding_name + "'");
+  embedding.shell_map = embedding_name == "shell";
+  embedding.optimize_stretch = !cl.has("no-stretch-opt");
+  embedding.remove_intersecting = !cl.has("keep-intersecting");
+  embedding.seed = options.seed;
   const Device device = parse_device(cl.get("device"));
 
   RunContext run(cl);
@@ -129,7 +151,9 @@ int run_surface(int argc, char** argv, int first) {
   SurfaceQuiltingStats stats;
   const SurfaceQuilt quilt =
       quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
-  const TriMesh result = embed_by_normal_displacement(base, quilt);
+  std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
+  QuiltEmbeddingStats embedding_stats;
+  const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);
   {
     ScopedStageTimer timer(stats.times, "write");
     write_mesh(out_path, result);
@@ -138,16 +162,21 @@ int run_surface(int argc, char** argv, int first) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!run.stats_path().empty())
-    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("base"),
-                cl.get("swatch"));
+    write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
+                run.threads(), wall, cl.get("base"), cl.get("swatch"));
   if (!run.quiet()) {
     std::printf("wrote %s: %d faces, %d vertices, %d elements (shell height %.4g)\n",
-                out_path.c_str(), stats.faces, stats.vertices, stats.elements, stats.shell_height);
+                out_path.c_str(), embedding_stats.faces, embedding_stats.vertices,
+                embedding_stats.elements, stats.shell_height);
+    if (embedding.shell_map)
+      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n",
+                  embedding_stats.stretch_before, embedding_stats.stretch_after,
+                  embedding_stats.atlas_charts);
     std::printf("%d patches in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
                 "%d added, %d matched, %d removed\n",
                 stats.iterations, wall, evaluator->name().c_str(), run.threads(),
                 stats.counts.stitched, stats.counts.replaced, stats.counts.added,
-                stats.counts.matched, stats.removed_post);
+                stats.counts.matched, embedding_stats.removed_intersecting);
   }
   return 0;
 }

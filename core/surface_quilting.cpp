@@ -13,6 +13,7 @@
 #include "core/local_patch.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
+#include "core/midpoint_subdivision.h"
 #include "core/quilt_elements.h"
 #include "core/tangent_field.h"
 
@@ -269,7 +270,8 @@ Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face
   return p + height * n;
 }
 
-TriMesh embed_by_normal_displacement(const TriMesh& base, const SurfaceQuilt& quilt) {
+TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
+  const TriMesh& base = quilt.base;
   const MatrixX3d N = vertex_normals(base.V, base.F);
   TriMesh out;
   Eigen::Index nv = 0, nf = 0;
@@ -301,11 +303,31 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   validate_base(base_in);
   MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", options.scale);
-  TriMesh base = base_in;
-  remove_unreferenced_vertices(base);
+  MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(),
+           InvalidInput, "the guidance field has ", options.field.rows(), " vectors for ",
+           base_in.num_faces(), " base faces");
+  // Patches are grown from whole triangles, so triangles must be small next to the swatch:
+  // the base is refined by midpoint subdivision (the surface itself is unchanged) until its
+  // mean edge is at most a tenth of the swatch's longer side.
+  TriMesh base;
+  MatrixX3d input_field;
+  {
+    ScopedStageTimer timer(times, "prepare");
+    TriMesh cleaned = base_in;
+    const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
+    int levels = 0;
+    base = refine_to_edge_length(cleaned, options.scale * diagonal / 10.0, 2'000'000, &levels);
+    stats.base_refinement_levels = levels;
+    // The field is per input face; each subdivision level gives a face four children.
+    if (options.field.rows()) {
+      input_field.resize(base.num_faces(), 3);
+      const int children = 1 << (2 * levels);
+      for (int f = 0; f < base.num_faces(); ++f) {
+        input_field.row(f) = options.field.row(f / children);
+      }
+    }
+  }
   const int nf = base.num_faces();
-  MQ_CHECK(options.field.rows() == 0 || options.field.rows() == nf, InvalidInput,
-           "the guidance field has ", options.field.rows(), " vectors for ", nf, " base faces");
   stats.base_faces = nf;
 
   // The swatch at its size on the surface (section 3.1's relative size s).
@@ -326,7 +348,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     stats.swatch_scale = factor;
     distance_grid = std::make_unique<SwatchDistanceGrid>(swatch.mesh.V, swatch.mesh.F);
     swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
-    field = options.field.rows() ? options.field : smooth_tangent_field(base.V, base.F);
+    field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
     topo = edge_topology(base.F, base.num_vertices());
     TT = face_adjacency(topo);
   }
@@ -345,7 +367,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   // elements cut off at the patch border are grown again by a later patch.
   double max_element = 0;
   for (const Element& e : swatch.elements) max_element = std::max(max_element, e.footprint_diameter());
-  const double margin = std::min(max_element, 0.25 * std::min(swatch.size.x(), swatch.size.y()));
+  const double margin =
+      std::min(0.5 * max_element, 0.25 * std::min(swatch.size.x(), swatch.size.y()));
 
   LocalPatchBuilder builder(base, topo, TT);
   SurfaceStore store(nf);
@@ -519,16 +542,16 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         store.index(id);
       }
     }
-    // Mark the patch faces now covered: inside the swatch footprint and away from the borders.
+    // Mark the patch faces now covered: their centroid lies inside the swatch footprint and away
+    // from the patch border by the margin (elements there were placed whole).
     for (size_t f = 0; f < patch.faces.size(); ++f) {
-      bool covered = true;
-      for (int k = 0; k < 3 && covered; ++k) {
-        const Vector2d q = frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k));
-        covered = q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
-                  q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
-                  frame->distance_to_border(q) >= margin;
-      }
-      if (covered) mark(patch.faces[f]);
+      Vector2d q = Vector2d::Zero();
+      for (int k = 0; k < 3; ++k)
+        q += frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k)).transpose() / 3.0;
+      if (q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
+          q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
+          frame->distance_to_border(q) >= margin)
+        mark(patch.faces[f]);
     }
     mark(seed);  // progress is guaranteed
     report_progress(progress, "quilting", num_done, nf);
@@ -536,56 +559,18 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
 
   SurfaceQuilt quilt;
   quilt.shell_height = H;
+  quilt.base = base;
   {
     ScopedStageTimer timer(times, "post-processing");
     for (size_t id = 0; id < store.elements.size(); ++id)
       if (store.alive[id] && !store.elements[id].face.empty())
         quilt.elements.push_back(std::move(store.elements[id]));
-    // Elements that could not be established whole end up intersecting their neighbours once
-    // embedded (tight concave spots): they are removed, later ones first kept out.
-    if (options.remove_intersecting) {
-      const TriMesh embedded = embed_by_normal_displacement(base, quilt);
-      std::vector<int> element_of;
-      for (size_t e = 0; e < quilt.elements.size(); ++e)
-        element_of.insert(element_of.end(), quilt.elements[e].F.rows(), static_cast<int>(e));
-      std::vector<char> drop(quilt.elements.size(), 0);
-      for (const auto& [f, g] : intersecting_face_pairs(embedded.V, embedded.F)) {
-        const int a = element_of[f], b = element_of[g];
-        if (!drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
-      }
-      std::vector<SurfaceElement> kept;
-      for (size_t e = 0; e < quilt.elements.size(); ++e) {
-        if (drop[e]) {
-          ++stats.removed_post;
-          continue;
-        }
-        kept.push_back(std::move(quilt.elements[e]));
-      }
-      quilt.elements = std::move(kept);
-    }
   }
   report_progress(progress, "quilting", 1, 1);
-  const TriMesh embedded = embed_by_normal_displacement(base, quilt);
-  stats.faces = embedded.num_faces();
-  stats.vertices = embedded.num_vertices();
   stats.elements = static_cast<int>(quilt.elements.size());
-  if (!quilt.elements.empty()) {
-    std::vector<double> areas;
-    Eigen::Index f0 = 0;
-    const Eigen::VectorXd A = face_areas(embedded.V, embedded.F);
-    for (const SurfaceElement& e : quilt.elements) {
-      areas.push_back(A.segment(f0, e.F.rows()).sum());
-      f0 += e.F.rows();
-    }
-    double mean = 0, var = 0;
-    for (double a : areas) mean += a;
-    mean /= static_cast<double>(areas.size());
-    for (double a : areas) var += (a - mean) * (a - mean);
-    var /= static_cast<double>(areas.size());
-    stats.element_area_mean = mean;
-    stats.element_area_cv = mean > 0 ? std::sqrt(var) / mean : 0;
-    stats.element_area_min = *std::min_element(areas.begin(), areas.end());
-    stats.element_area_max = *std::max_element(areas.begin(), areas.end());
+  for (const SurfaceElement& e : quilt.elements) {
+    stats.faces += static_cast<int>(e.F.rows());
+    stats.vertices += static_cast<int>(e.face.size());
   }
   if (stats_out) *stats_out = std::move(stats);
   return quilt;

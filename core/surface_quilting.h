@@ -27,6 +27,7 @@ struct SurfaceElement {
 struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
+  TriMesh base;  // the (refined) base mesh the local coordinates refer to
 };
 
 struct SurfaceQuiltingOptions {
@@ -40,17 +41,22 @@ struct SurfaceQuiltingOptions {
   double patch_area_factor = 3.0;
   double max_distortion = 4.0;
   double subpatch_fraction = 0.5;  // as for planar quilting
-  int match_points = 1024;
-  MatchingOptions matching;
+  // Fewer sub-patch points and a coarser sub-cell refinement than on the plane: a conformal
+  // patch is only accurate to a fraction of a cell anyway, and surfaces need many patches.
+  int match_points = 512;
+  MatchingOptions matching = [] {
+    MatchingOptions m;
+    m.refine_to = 1.0 / 16.0;
+    return m;
+  }();
   PatchQuiltingOptions patch;
-  // Elements that intersect others after the final embedding are removed (post-processing).
-  bool remove_intersecting = true;
   uint64_t seed = 1;
 };
 
 struct SurfaceQuiltingStats {
   int iterations = 0;
-  int base_faces = 0;
+  int base_faces = 0;              // after refinement
+  int base_refinement_levels = 0;  // midpoint subdivisions applied to the base
   int patches_shrunk = 0;
   double swatch_scale = 0;     // factor applied to the swatch
   double shell_height = 0;
@@ -58,14 +64,12 @@ struct SurfaceQuiltingStats {
   long long matched_point_offsets = 0;
   PatchCounts counts;
   int rejected_outside_patch = 0;  // swatch elements reaching beyond the flattened patch
-  int removed_post = 0;            // elements not established whole (intersecting after embedding)
-  int faces = 0, vertices = 0, elements = 0;
-  // Spread of element surface areas after embedding (how even the texture is over the surface).
-  double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
+  int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
   StageTimes times;
 };
 
-// Runs mesh quilting over `base`. Throws InvalidInput for an empty or non-finite base or swatch,
+// Runs mesh quilting over `base`. Local coordinates in the result refer to the base refined by
+// refine_to_edge_length(base, scale * diagonal / 10, 2'000'000) (see surface_base()). Throws InvalidInput for an empty or non-finite base or swatch,
 // scale <= 0 or not finite, a field of the wrong size.
 SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
                            const SurfaceQuiltingOptions& options,
@@ -79,7 +83,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
 Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face,
                                const Vector3d& barycentric, double height);
 
-// The whole quilt embedded by normal displacement, elements in order.
-TriMesh embed_by_normal_displacement(const TriMesh& base, const SurfaceQuilt& quilt);
+// The whole quilt embedded by normal displacement over quilt.base, elements in order.
+TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt);
 
 }  // namespace mq

@@ -1,0 +1,130 @@
+#include "core/quilt_embedding.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "core/geometry_measures.h"
+#include "core/mesh_intersections.h"
+#include "core/shell_embedding.h"
+#include "core/shell_map.h"
+
+namespace mq {
+
+TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
+                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats_out) {
+  QuiltEmbeddingStats stats;
+  LocalCoordinates points;
+  Eigen::Index nv = 0, nf = 0;
+  for (const SurfaceElement& e : quilt.elements) {
+    nv += static_cast<Eigen::Index>(e.face.size());
+    nf += e.F.rows();
+  }
+  points.face.resize(nv);
+  points.bary.resize(nv, 3);
+  points.height.resize(nv);
+  TriMesh all;
+  all.F.resize(nf, 3);
+  std::vector<int> element_of(nf);
+  nv = nf = 0;
+  for (size_t k = 0; k < quilt.elements.size(); ++k) {
+    const SurfaceElement& e = quilt.elements[k];
+    for (size_t v = 0; v < e.face.size(); ++v) {
+      points.face(nv + v) = e.face[v];
+      points.bary.row(nv + v) = e.barycentric.row(v);
+      points.height(nv + v) = std::clamp(e.height(v), 0.0, quilt.shell_height);
+    }
+    all.F.middleRows(nf, e.F.rows()) = e.F.array() + static_cast<int>(nv);
+    std::fill(element_of.begin() + nf, element_of.begin() + nf + e.F.rows(), static_cast<int>(k));
+    nv += static_cast<Eigen::Index>(e.face.size());
+    nf += e.F.rows();
+  }
+  if (options.shell_map && nv > 0) {
+    ShellMapOptions map_options;
+    map_options.height = quilt.shell_height;
+    std::unique_ptr<ShellMap> map;
+    {
+      ScopedStageTimer timer(stats.times, "shell map");
+      map = std::make_unique<ShellMap>(quilt.base.V, quilt.base.F, map_options);
+      stats.atlas_charts = map->atlas().num_charts;
+      stats.fold_repaired_vertices = static_cast<int>(map->fold_repair().moved_vertices.size());
+    }
+    {
+      ScopedStageTimer timer(stats.times, "stretch optimization");
+      stats.stretch_before = stats.stretch_after = map->stretch(stretch);
+      if (options.optimize_stretch) {
+        ShellOptimizeOptions o;
+        o.seed = options.seed;
+        const ShellOptimizeReport report = map->optimize(stretch, o);
+        stats.stretch_after = report.stretch_after;
+        stats.optimization_sweeps = report.sweeps;
+      }
+    }
+    ScopedStageTimer timer(stats.times, "embedding");
+    all.V = ShellEmbedding(*map).embed(points);
+  } else {
+    ScopedStageTimer timer(stats.times, "embedding");
+    all.V = normal_displacement(quilt.base.V, quilt.base.F, points);
+  }
+
+  // Post-processing: of two intersecting elements the later one goes.
+  std::vector<char> drop(quilt.elements.size(), 0);
+  if (options.remove_intersecting) {
+    ScopedStageTimer timer(stats.times, "post-processing");
+    for (const auto& [f, g] : intersecting_face_pairs(all.V, all.F)) {
+      const int a = element_of[f], b = element_of[g];
+      if (!drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
+    }
+  }
+  TriMesh out;
+  std::vector<double> areas;
+  {
+    Eigen::Index kv = 0, kf = 0, v0 = 0, f0 = 0;
+    for (size_t k = 0; k < quilt.elements.size(); ++k) {
+      const Eigen::Index ev = static_cast<Eigen::Index>(quilt.elements[k].face.size());
+      const Eigen::Index ef = quilt.elements[k].F.rows();
+      if (!drop[k]) {
+        kv += ev;
+        kf += ef;
+      }
+      v0 += ev;
+      f0 += ef;
+    }
+    out.V.resize(kv, 3);
+    out.F.resize(kf, 3);
+    kv = kf = v0 = f0 = 0;
+    for (size_t k = 0; k < quilt.elements.size(); ++k) {
+      const SurfaceElement& e = quilt.elements[k];
+      const Eigen::Index ev = static_cast<Eigen::Index>(e.face.size()), ef = e.F.rows();
+      if (drop[k]) {
+        ++stats.removed_intersecting;
+      } else {
+        out.V.middleRows(kv, ev) = all.V.middleRows(v0, ev);
+        out.F.middleRows(kf, ef) = e.F.array() + static_cast<int>(kv);
+        areas.push_back(face_areas(all.V.middleRows(v0, ev), e.F).sum());
+        kv += ev;
+        kf += ef;
+      }
+      v0 += ev;
+      f0 += ef;
+    }
+  }
+  stats.faces = out.num_faces();
+  stats.vertices = out.num_vertices();
+  stats.elements = static_cast<int>(areas.size());
+  if (!areas.empty()) {
+    double mean = 0, var = 0;
+    for (const double a : areas) mean += a;
+    mean /= static_cast<double>(areas.size());
+    for (const double a : areas) var += (a - mean) * (a - mean);
+    var /= static_cast<double>(areas.size());
+    stats.element_area_mean = mean;
+    stats.element_area_cv = mean > 0 ? std::sqrt(var) / mean : 0;
+    stats.element_area_min = *std::min_element(areas.begin(), areas.end());
+    stats.element_area_max = *std::max_element(areas.begin(), areas.end());
+  }
+  if (stats_out) *stats_out = std::move(stats);
+  return out;
+}
+
+}  // namespace mq

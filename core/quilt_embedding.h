@@ -1,0 +1,37 @@
+// The final embedding of a surface quilt (paper section 3.2): output vertices, stored in local
+// coordinates over the base, are placed in 3D through the stretch-minimised shell map (default)
+// or by plain normal displacement; elements that cannot be embedded whole without intersecting
+// their neighbours are then removed (post-processing).
+#pragma once
+
+#include "core/surface_quilting.h"
+#include "core/tet_stretch.h"
+
+namespace mq {
+
+struct QuiltEmbeddingOptions {
+  bool shell_map = true;            // false: plain normal displacement
+  bool optimize_stretch = true;     // random line search on the shell map (section 3.2)
+  bool remove_intersecting = true;  // post-processing
+  std::uint64_t seed = 1;
+};
+
+struct QuiltEmbeddingStats {
+  double stretch_before = 0, stretch_after = 0;  // Eq. (9), 1.0 the lower bound
+  int optimization_sweeps = 0;
+  int atlas_charts = 0;
+  int fold_repaired_vertices = 0;
+  int removed_intersecting = 0;
+  int faces = 0, vertices = 0, elements = 0;
+  // Spread of element surface areas (how even the texture is over the surface).
+  double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
+  StageTimes times;
+};
+
+// Embeds the quilt. `stretch` evaluates per-tetrahedron stretch for the shell map (CPU or
+// OpenCL); it is unused for normal displacement. Throws TopologyError when no valid shell exists
+// over the base, DeviceError from the evaluator.
+TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
+                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats = nullptr);
+
+}  // namespace mq
