@@ -37,7 +37,8 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("cell_size", s.cell_size)
       .value("iterations", s.iterations)
       .value("patches_shrunk", s.patches_shrunk)
-      .value("embedding", embedding)
+      .value("embedding", em.shell_map_failure.empty() ? embedding : std::string("normal"))
+      .value("shell_map_failure", em.shell_map_failure)
       .value("stretch_before", em.stretch_before)
       .value("stretch_after", em.stretch_after)
       .value("stretch_optimization_sweeps", em.optimization_sweeps)
@@ -168,15 +169,19 @@ int run_surface(int argc, char** argv, int first) {
     std::printf("wrote %s: %d faces, %d vertices, %d elements (shell height %.4g)\n",
                 out_path.c_str(), embedding_stats.faces, embedding_stats.vertices,
                 embedding_stats.elements, stats.shell_height);
-    if (embedding.shell_map)
+    if (!embedding_stats.shell_map_failure.empty())
+      std::printf("shell map unavailable (%s): placed by normal displacement\n",
+                  embedding_stats.shell_map_failure.c_str());
+    else if (embedding.shell_map)
       std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n",
                   embedding_stats.stretch_before, embedding_stats.stretch_after,
                   embedding_stats.atlas_charts);
-    std::printf("%d patches in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-                "%d added, %d matched, %d removed\n",
-                stats.iterations, wall, evaluator->name().c_str(), run.threads(),
-                stats.counts.stitched, stats.counts.replaced, stats.counts.added,
-                stats.counts.matched, embedding_stats.removed_intersecting);
+    std::printf(
+        "%d patches in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+        "%d added, %d matched, %d removed\n",
+        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.counts.stitched,
+        stats.counts.replaced, stats.counts.added, stats.counts.matched,
+        embedding_stats.removed_intersecting);
   }
   return 0;
 }

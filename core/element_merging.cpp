@@ -55,9 +55,9 @@ std::vector<int> dual_depth(const MatrixX3i& TT, const std::vector<int>& seeds) 
 }
 
 // Labels for cutting the output element (section 2.7). SOURCE: faces of the old output outside
-// the new patch. SINK: the far end, seen from the SOURCE faces, of the band of faces that the swatch
-// element covers: the part the swatch element continues and replaces (a thread's end cap, the
-// half of a ring lying over the new patch). The paper marks the faces around vertices whose
+// the new patch. SINK: the far end, seen from the SOURCE faces, of the band of faces that the
+// swatch element covers: the part the swatch element continues and replaces (a thread's end cap,
+// the half of a ring lying over the new patch). The paper marks the faces around vertices whose
 // partner face lies at the rim of the matched area; on closed tubes that rim can fall between
 // two vertex rings and be missed, while the far end of the covered band is always defined.
 std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery& query_in,
@@ -99,8 +99,8 @@ std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery&
 // closes the loop; faces outside the overlapping region are always kept.
 std::vector<CutLabel> swatch_labels(const Element& in, const Element& out,
                                     const std::vector<bool>& keep_out,
-                                    const ClosestPointQuery& query_out,
-                                    const OverlapRegion& region, double cover) {
+                                    const ClosestPointQuery& query_out, const OverlapRegion& region,
+                                    double cover) {
   const int nf = static_cast<int>(in.F.rows());
   const MatrixX3i TT_out = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
   // Output faces within two rings of the output's cut are "near the seam".
@@ -144,15 +144,24 @@ TriMesh kept_part(const Element& e, const std::vector<bool>& keep) {
 
 const char* stitch_failure_name(StitchFailure f) {
   switch (f) {
-    case StitchFailure::None: return "none";
-    case StitchFailure::EmptyCut: return "empty_cut";
-    case StitchFailure::NothingCut: return "nothing_cut";
-    case StitchFailure::BadSeam: return "bad_seam";
-    case StitchFailure::LoopsUnpaired: return "loops_unpaired";
-    case StitchFailure::NotOneComponent: return "not_one_component";
-    case StitchFailure::OpenSeam: return "open_seam";
-    case StitchFailure::Distorted: return "distorted";
-    case StitchFailure::SelfIntersecting: return "self_intersecting";
+    case StitchFailure::None:
+      return "none";
+    case StitchFailure::EmptyCut:
+      return "empty_cut";
+    case StitchFailure::NothingCut:
+      return "nothing_cut";
+    case StitchFailure::BadSeam:
+      return "bad_seam";
+    case StitchFailure::LoopsUnpaired:
+      return "loops_unpaired";
+    case StitchFailure::NotOneComponent:
+      return "not_one_component";
+    case StitchFailure::OpenSeam:
+      return "open_seam";
+    case StitchFailure::Distorted:
+      return "distorted";
+    case StitchFailure::SelfIntersecting:
+      return "self_intersecting";
   }
   return "unknown";
 }
@@ -187,9 +196,8 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   const MatrixX3d out_V = out.V / unit, in_V = in.V / unit;
   const std::vector<bool> keep_out = graph_cut_keep_faces(
       out_V, out.F, dist_out / unit, output_labels(out, query_in, region, cover));
-  const std::vector<bool> keep_in =
-      graph_cut_keep_faces(in_V, in.F, dist_in / unit,
-                           swatch_labels(in, out, keep_out, query_out, region, cover));
+  const std::vector<bool> keep_in = graph_cut_keep_faces(
+      in_V, in.F, dist_in / unit, swatch_labels(in, out, keep_out, query_out, region, cover));
   const TriMesh a = kept_part(out, keep_out), b = kept_part(in, keep_in);
   if (a.F.rows() == 0 || b.F.rows() == 0) return fail(StitchFailure::EmptyCut);
   if (a.F.rows() == out.F.rows() || b.F.rows() == in.F.rows())

@@ -162,8 +162,8 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
       // Coincident seams are glued vertex to vertex: b's loop vertices are replaced by a's.
       for (size_t k = 0; k < welded.size(); ++k) {
         replace[lb.vertices[k]] = welded[k];
-        result.constraints.push_back(LinearConstraint::point(
-            welded[k], 0.5 * (row(V, welded[k]) + row(V, lb.vertices[k]))));
+        result.constraints.push_back(
+            LinearConstraint::point(welded[k], 0.5 * (row(V, welded[k]) + row(V, lb.vertices[k]))));
       }
       ++result.bridged_loops;
       continue;

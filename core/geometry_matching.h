@@ -27,9 +27,9 @@ struct MatchingOptions {
 
 struct OffsetChoice {
   Vector3d offset = Vector3d::Zero();
-  double cost = 0;          // E(t) at the chosen offset
-  int candidates = 0;       // whole-cell offsets evaluated
-  int evaluations = 0;      // all offsets evaluated, refinement included
+  double cost = 0;              // E(t) at the chosen offset
+  int candidates = 0;           // whole-cell offsets evaluated
+  int evaluations = 0;          // all offsets evaluated, refinement included
   long long point_offsets = 0;  // (point, offset) pairs evaluated
 };
 

@@ -106,6 +106,12 @@ void LocalPatchBuilder::flatten(LocalPatch& patch, size_t num_faces) {
   patch.uv = lscm(patch.mesh.V, patch.mesh.F);
   const Eigen::VectorXd d = face_area_distortion(patch.mesh.V, patch.mesh.F, patch.uv);
   patch.max_distortion = d.maxCoeff();
+  // The patch is judged by its 95th percentile: a few slivers at the rim of a good patch must
+  // not shrink it (their distortion explodes first as the rim curls away).
+  std::vector<double> sorted(d.data(), d.data() + d.size());
+  const size_t k = std::min(sorted.size() - 1, sorted.size() * 95 / 100);
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+  patch.distortion = sorted[k];
 }
 
 LocalPatch LocalPatchBuilder::grow(int seed_face, const LocalPatchOptions& options) {
@@ -165,8 +171,7 @@ LocalPatch LocalPatchBuilder::grow(int seed_face, const LocalPatchOptions& optio
   }
 
   flatten(patch, patch.faces.size());
-  while ((patch.max_distortion > options.max_distortion ||
-          count_flipped(patch.mesh.F, patch.uv) > 0) &&
+  while ((patch.distortion > options.max_distortion || count_flipped(patch.mesh.F, patch.uv) > 0) &&
          patch.faces.size() > 1) {
     // Halve the area: the longest growth-order prefix within half of it (at least the seed).
     const double target = 0.5 * patch.area;

@@ -14,7 +14,8 @@ namespace mq {
 struct LocalPatchOptions {
   double max_area = 0;        // stop growing once the patch area reaches this (0: unlimited)
   int max_depth = 1 << 30;    // breadth-first layers around the seed (0: the seed alone)
-  double max_distortion = 4;  // shrink while the worst face area distortion exceeds this (>= 1)
+  // Shrink while the 95th percentile of the face area distortions exceeds this (>= 1).
+  double max_distortion = 4;
 };
 
 struct LocalPatch {
@@ -23,6 +24,7 @@ struct LocalPatch {
   std::vector<int> vertex_map;  // patch vertex -> base vertex
   MatrixX2d uv;                 // LSCM of the patch, #patch V by 2, area-matched to 3D
   double max_distortion = 1;    // worst face area distortion of uv
+  double distortion = 1;  // 95th percentile of the face area distortions (what is bounded)
   int shrink_steps = 0;         // how many times the patch was halved
   double area = 0;              // 3D area of the patch
 };
@@ -44,7 +46,7 @@ class LocalPatchBuilder {
   // patch stays a topological disk: it shares one edge with the patch and brings a new vertex,
   // or it shares two edges and closes a notch; faces with zero area or a repeated vertex are
   // never added. Faces refused in a layer are retried after the rest of it. The patch is then
-  // flattened with lscm; while the worst face area distortion exceeds options.max_distortion or
+  // flattened with lscm; while the 95th percentile face area distortion exceeds max_distortion or
   // a UV triangle is flipped, the patch is cut to the longest prefix of its growth order with at
   // most half its area (every prefix is a disk) and flattened again.
   // Guarantees: one boundary loop, Euler characteristic 1, the seed is faces[0], area <

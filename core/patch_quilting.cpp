@@ -77,8 +77,8 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
       frame.push_back(output.element(near[k]));
       local[k] = static_cast<int>(k);
     }
-    corr = find_correspondences(frame, local, region, swatch, swatch_query, t,
-                                options.correspondence);
+    corr =
+        find_correspondences(frame, local, region, swatch, swatch_query, t, options.correspondence);
     counts.pairs += static_cast<long long>(corr.pairs.size());
     counts.relations += static_cast<long long>(corr.relations.size());
   }

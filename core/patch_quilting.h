@@ -36,14 +36,14 @@ struct PatchQuiltingOptions {
 
 // What one patch did, added to running totals by the caller.
 struct PatchCounts {
-  long long pairs = 0;          // vertex-face pairs kept
-  long long relations = 0;      // element relations kept
-  int added = 0;                // swatch elements without partner added as they are
-  int replaced = 0;             // output elements inside the overlap replaced by swatch ones
-  int stitched = 0;             // cut-and-stitch merges
-  int matched = 0;              // partners that are the same element: output kept
-  int dropped = 0;              // swatch elements inside the overlap or with ambiguous partners
-  int stitch_fallbacks = 0;     // cut-and-stitch refused: output kept whole
+  long long pairs = 0;            // vertex-face pairs kept
+  long long relations = 0;        // element relations kept
+  int added = 0;                  // swatch elements without partner added as they are
+  int replaced = 0;               // output elements inside the overlap replaced by swatch ones
+  int stitched = 0;               // cut-and-stitch merges
+  int matched = 0;                // partners that are the same element: output kept
+  int dropped = 0;                // swatch elements inside the overlap or with ambiguous partners
+  int stitch_fallbacks = 0;       // cut-and-stitch refused: output kept whole
   int rejected_intersecting = 0;  // candidates that would intersect existing elements
   std::array<int, kStitchFailureKinds> stitch_failures{};  // fallbacks by StitchFailure
 };

@@ -7,9 +7,9 @@
 #include <memory>
 
 #include "core/closest_point_query.h"
-#include "core/patch_quilting.h"
 #include "core/errors.h"
 #include "core/mesh_topology.h"
+#include "core/patch_quilting.h"
 #include "core/synthesis_grid.h"
 
 namespace mq {
@@ -111,8 +111,8 @@ void validate(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
            "every element of the swatch is larger than the requested ", o.length, " x ", o.width,
            " domain (smallest element spans ", smallest, ")");
   // Output size estimate from the swatch's face density, to refuse jobs that cannot fit.
-  const double faces = static_cast<double>(s.mesh.F.rows()) * o.length * o.width /
-                       (s.size.x() * s.size.y());
+  const double faces =
+      static_cast<double>(s.mesh.F.rows()) * o.length * o.width / (s.size.x() * s.size.y());
   MQ_CHECK(faces < 2e8, InvalidInput, "a ", o.length, " x ", o.width,
            " layer of this swatch would have about ", faces,
            " faces, more than this tool can hold; choose a smaller size");
@@ -132,11 +132,11 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     validate(swatch, options);
   }
   const double cell = options.cell_size > 0 ? options.cell_size : auto_cell_size(swatch);
-  MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ",
-           cell, " is larger than the swatch's footprint");
+  MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ", cell,
+           " is larger than the swatch's footprint");
   const double cells_estimate = std::ceil(options.length / cell) * std::ceil(options.width / cell);
-  MQ_CHECK(cells_estimate <= double(1 << 26), InvalidInput, "the grid would have ",
-           cells_estimate, " cells; use a larger --cell");
+  MQ_CHECK(cells_estimate <= double(1 << 26), InvalidInput, "the grid would have ", cells_estimate,
+           " cells; use a larger --cell");
   SynthesisGrid grid(Vector2d::Zero(), cell, static_cast<int>(std::ceil(options.length / cell)),
                      static_cast<int>(std::ceil(options.width / cell)));
   stats.cell_size = cell;
@@ -144,10 +144,10 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   stats.grid_ny = grid.ny();
   const int swatch_cells_x = static_cast<int>(std::floor(swatch.size.x() / cell + 1e-9));
   const int swatch_cells_y = static_cast<int>(std::floor(swatch.size.y() / cell + 1e-9));
-  const int window = std::max(
-      1, std::min({static_cast<int>(options.subpatch_fraction * std::min(swatch_cells_x,
-                                                                          swatch_cells_y)),
-                   swatch_cells_x, swatch_cells_y}));
+  const int window =
+      std::max(1, std::min({static_cast<int>(options.subpatch_fraction *
+                                             std::min(swatch_cells_x, swatch_cells_y)),
+                            swatch_cells_x, swatch_cells_y}));
   const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
 
   std::unique_ptr<SwatchDistanceGrid> distance_grid;
@@ -199,7 +199,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     const int half = window / 2;
     const int px0 = std::max(0, std::min(seed.x - half, grid.nx() - window));
     const int py0 = std::max(0, std::min(seed.y - half, grid.ny() - window));
-    const int px1 = std::min(grid.nx(), px0 + window) - 1, py1 = std::min(grid.ny(), py0 + window) - 1;
+    const int px1 = std::min(grid.nx(), px0 + window) - 1,
+              py1 = std::min(grid.ny(), py0 + window) - 1;
     const Vector2d sub_lo(px0 * cell, py0 * cell), sub_hi((px1 + 1) * cell, (py1 + 1) * cell);
     const Vector2d t_min = sub_hi - swatch.size.head<2>(), t_max = sub_lo;
     OffsetChoice choice;
@@ -237,8 +238,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       for (size_t i = 0; i < offsets.size(); ++i) T.row(i) = offsets[i].transpose();
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
-      choice = choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching,
-                             rng);
+      choice =
+          choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;

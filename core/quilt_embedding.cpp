@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/shell_embedding.h"
@@ -30,8 +31,13 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   for (size_t k = 0; k < quilt.elements.size(); ++k) {
     const SurfaceElement& e = quilt.elements[k];
     for (size_t v = 0; v < e.face.size(); ++v) {
-      points.face(nv + v) = e.face[v];
-      points.bary.row(nv + v) = e.barycentric.row(v);
+      // The shell is built over the base as given; local coordinates on its refinement are
+      // converted exactly.
+      int face = e.face[v];
+      Vector3d b = e.barycentric.row(v).transpose();
+      to_input_base(quilt, face, b);
+      points.face(nv + v) = face;
+      points.bary.row(nv + v) = b.transpose();
       points.height(nv + v) = std::clamp(e.height(v), 0.0, quilt.shell_height);
     }
     all.F.middleRows(nf, e.F.rows()) = e.F.array() + static_cast<int>(nv);
@@ -39,16 +45,22 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     nv += static_cast<Eigen::Index>(e.face.size());
     nf += e.F.rows();
   }
+  std::unique_ptr<ShellMap> map;
   if (options.shell_map && nv > 0) {
     ShellMapOptions map_options;
     map_options.height = quilt.shell_height;
-    std::unique_ptr<ShellMap> map;
-    {
-      ScopedStageTimer timer(stats.times, "shell map");
-      map = std::make_unique<ShellMap>(quilt.base.V, quilt.base.F, map_options);
+    ScopedStageTimer timer(stats.times, "shell map");
+    try {
+      map = std::make_unique<ShellMap>(quilt.input_base.V, quilt.input_base.F, map_options);
       stats.atlas_charts = map->atlas().num_charts;
       stats.fold_repaired_vertices = static_cast<int>(map->fold_repair().moved_vertices.size());
+    } catch (const TopologyError& e) {
+      // No valid shell of this height over this base (a fold that relaxation cannot undo):
+      // the texture is still placed, by normal displacement, and the reason is reported.
+      stats.shell_map_failure = e.what();
     }
+  }
+  if (map) {
     {
       ScopedStageTimer timer(stats.times, "stretch optimization");
       stats.stretch_before = stats.stretch_after = map->stretch(stretch);
@@ -64,7 +76,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     all.V = ShellEmbedding(*map).embed(points);
   } else {
     ScopedStageTimer timer(stats.times, "embedding");
-    all.V = normal_displacement(quilt.base.V, quilt.base.F, points);
+    all.V = normal_displacement(quilt.input_base.V, quilt.input_base.F, points);
   }
 
   // Post-processing: of two intersecting elements the later one goes.

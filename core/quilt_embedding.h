@@ -4,6 +4,8 @@
 // their neighbours are then removed (post-processing).
 #pragma once
 
+#include <string>
+
 #include "core/surface_quilting.h"
 #include "core/tet_stretch.h"
 
@@ -22,6 +24,8 @@ struct QuiltEmbeddingStats {
   int atlas_charts = 0;
   int fold_repaired_vertices = 0;
   int removed_intersecting = 0;
+  // Non-empty when the shell map could not be built and normal displacement was used instead.
+  std::string shell_map_failure;
   int faces = 0, vertices = 0, elements = 0;
   // Spread of element surface areas (how even the texture is over the surface).
   double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
@@ -29,8 +33,9 @@ struct QuiltEmbeddingStats {
 };
 
 // Embeds the quilt. `stretch` evaluates per-tetrahedron stretch for the shell map (CPU or
-// OpenCL); it is unused for normal displacement. Throws TopologyError when no valid shell exists
-// over the base, DeviceError from the evaluator.
+// OpenCL); it is unused for normal displacement. When no valid shell exists over the base, falls
+// back to normal displacement and says why in stats->shell_map_failure. Throws DeviceError from
+// the evaluator.
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
                     TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats = nullptr);
 

@@ -113,8 +113,8 @@ class PatchFrame {
           if (std::max(std::abs(x - cx), std::abs(y - cy)) != r) continue;
           if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
           for (const int f : cells_[y * nx_ + x]) {
-            const Vector3d w = triangle_barycentric_2d(q, uv_.row(F(f, 0)), uv_.row(F(f, 1)),
-                                                       uv_.row(F(f, 2)));
+            const Vector3d w =
+                triangle_barycentric_2d(q, uv_.row(F(f, 0)), uv_.row(F(f, 1)), uv_.row(F(f, 2)));
             const double outside = -w.minCoeff();
             if (outside <= 1e-9) {
               face = f;
@@ -138,8 +138,8 @@ class PatchFrame {
     double best = std::numeric_limits<double>::infinity();
     for (const auto& [i, j] : border_) {
       const Vector2d a = uv_.row(i), b = uv_.row(j), d = b - a;
-      const double t = d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0)
-                                           : 0.0;
+      const double t =
+          d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
       best = std::min(best, (a + t * d - q).norm());
     }
     return best;
@@ -259,8 +259,25 @@ void validate_base(const TriMesh& base) {
 
 }  // namespace
 
-Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face,
-                               const Vector3d& b, double height) {
+void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& b) {
+  // Corners of the children of (a, b, c), in the parent's barycentric coordinates; the order
+  // matches midpoint_subdivide.
+  static const double corner[4][3][3] = {{{1, 0, 0}, {.5, .5, 0}, {.5, 0, .5}},
+                                         {{.5, .5, 0}, {0, 1, 0}, {0, .5, .5}},
+                                         {{.5, 0, .5}, {0, .5, .5}, {0, 0, 1}},
+                                         {{.5, .5, 0}, {0, .5, .5}, {.5, 0, .5}}};
+  for (int l = 0; l < quilt.refinement_levels; ++l) {
+    const int k = face % 4;
+    Vector3d parent = Vector3d::Zero();
+    for (int i = 0; i < 3; ++i)
+      parent += b(i) * Vector3d(corner[k][i][0], corner[k][i][1], corner[k][i][2]);
+    b = parent;
+    face /= 4;
+  }
+}
+
+Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face, const Vector3d& b,
+                               double height) {
   Vector3d p = Vector3d::Zero(), n = Vector3d::Zero();
   for (int k = 0; k < 3; ++k) {
     p += b(k) * base.V.row(base.F(face, k)).transpose();
@@ -284,9 +301,9 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
   nv = nf = 0;
   for (const SurfaceElement& e : quilt.elements) {
     for (size_t v = 0; v < e.face.size(); ++v)
-      out.V.row(nv + v) = displace_along_normal(base, N, e.face[v],
-                                                e.barycentric.row(v).transpose(), e.height(v))
-                              .transpose();
+      out.V.row(nv + v) =
+          displace_along_normal(base, N, e.face[v], e.barycentric.row(v).transpose(), e.height(v))
+              .transpose();
     out.F.middleRows(nf, e.F.rows()) = e.F.array() + static_cast<int>(nv);
     nv += static_cast<Eigen::Index>(e.face.size());
     nf += e.F.rows();
@@ -303,9 +320,9 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   validate_base(base_in);
   MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", options.scale);
-  MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(),
-           InvalidInput, "the guidance field has ", options.field.rows(), " vectors for ",
-           base_in.num_faces(), " base faces");
+  MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
+           "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
+           " base faces");
   // Patches are grown from whole triangles, so triangles must be small next to the swatch:
   // the base is refined by midpoint subdivision (the surface itself is unchanged) until its
   // mean edge is at most a tenth of the swatch's longer side.
@@ -357,16 +374,16 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   const double cell = std::min(0.5 * swatch.mean_element_diameter,
                                std::min(swatch.size.x(), swatch.size.y()) / 8.0);
   stats.cell_size = cell;
-  const int swatch_cells = static_cast<int>(std::floor(
-      std::min(swatch.size.x(), swatch.size.y()) / cell + 1e-9));
-  const int window =
-      std::max(1, std::min(swatch_cells, static_cast<int>(options.subpatch_fraction *
-                                                          swatch_cells)));
+  const int swatch_cells =
+      static_cast<int>(std::floor(std::min(swatch.size.x(), swatch.size.y()) / cell + 1e-9));
+  const int window = std::max(
+      1, std::min(swatch_cells, static_cast<int>(options.subpatch_fraction * swatch_cells)));
   const double footprint_area = swatch.size.x() * swatch.size.y();
   // Faces are marked synthesised only this far inside both the swatch and the patch, so that
   // elements cut off at the patch border are grown again by a later patch.
   double max_element = 0;
-  for (const Element& e : swatch.elements) max_element = std::max(max_element, e.footprint_diameter());
+  for (const Element& e : swatch.elements)
+    max_element = std::max(max_element, e.footprint_diameter());
   const double margin =
       std::min(0.5 * max_element, 0.25 * std::min(swatch.size.x(), swatch.size.y()));
 
@@ -480,8 +497,10 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;
       // The first patch has nothing to match: the swatch is centred on the seed.
-      if (P.rows() == 0) T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
-      choice = choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+      if (P.rows() == 0)
+        T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
+      choice =
+          choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;
@@ -560,6 +579,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   SurfaceQuilt quilt;
   quilt.shell_height = H;
   quilt.base = base;
+  quilt.input_base = base_in;
+  quilt.refinement_levels = stats.base_refinement_levels;
   {
     ScopedStageTimer timer(times, "post-processing");
     for (size_t id = 0; id < store.elements.size(); ++id)

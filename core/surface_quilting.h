@@ -18,17 +18,23 @@ namespace mq {
 // base face `face[i]`, at the point with barycentric coordinates `barycentric.row(i)` of that
 // face, at height `height[i]` in [0, shell height] along the surface normal.
 struct SurfaceElement {
-  MatrixX3i F;                     // #F by 3, indices into the element's vertices
-  std::vector<int> face;           // #V base faces
-  MatrixX3d barycentric;           // #V by 3
-  Eigen::VectorXd height;          // #V
+  MatrixX3i F;             // #F by 3, indices into the element's vertices
+  std::vector<int> face;   // #V base faces
+  MatrixX3d barycentric;   // #V by 3
+  Eigen::VectorXd height;  // #V
 };
 
 struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
-  TriMesh base;  // the (refined) base mesh the local coordinates refer to
+  TriMesh base;               // the (refined) base mesh the local coordinates refer to
+  TriMesh input_base;         // the base as given
+  int refinement_levels = 0;  // midpoint subdivisions from input_base to base
 };
+
+// Local coordinates on the refined base expressed on the input base: midpoint subdivision
+// children are affine pieces of their parent (child 4f+k of face f), so this is exact.
+void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& barycentric);
 
 struct SurfaceQuiltingOptions {
   // The swatch is scaled uniformly so that its longer footprint side is `scale` times the base
@@ -37,8 +43,9 @@ struct SurfaceQuiltingOptions {
   // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
   MatrixX3d field;
   // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
-  // threshold"); a patch whose area distortion exceeds max_distortion is shrunk (paper: 4).
-  double patch_area_factor = 3.0;
+  // threshold"); a patch whose area distortion exceeds max_distortion is shrunk (paper: 4),
+  // judged by the 95th percentile of its faces' distortion.
+  double patch_area_factor = 1.5;
   double max_distortion = 4.0;
   double subpatch_fraction = 0.5;  // as for planar quilting
   // Fewer sub-patch points and a coarser sub-cell refinement than on the plane: a conformal
@@ -58,24 +65,24 @@ struct SurfaceQuiltingStats {
   int base_faces = 0;              // after refinement
   int base_refinement_levels = 0;  // midpoint subdivisions applied to the base
   int patches_shrunk = 0;
-  double swatch_scale = 0;     // factor applied to the swatch
+  double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;
   double cell_size = 0;
   long long matched_point_offsets = 0;
   PatchCounts counts;
-  int rejected_outside_patch = 0;  // swatch elements reaching beyond the flattened patch
+  int rejected_outside_patch = 0;             // swatch elements reaching beyond the flattened patch
   int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
   StageTimes times;
 };
 
 // Runs mesh quilting over `base`. Local coordinates in the result refer to the base refined by
-// refine_to_edge_length(base, scale * diagonal / 10, 2'000'000) (see surface_base()). Throws InvalidInput for an empty or non-finite base or swatch,
-// scale <= 0 or not finite, a field of the wrong size.
+// refine_to_edge_length(base, scale * diagonal / 10, 2'000'000) (see surface_base()). Throws
+// InvalidInput for an empty or non-finite base or swatch, scale <= 0 or not finite, a field of the
+// wrong size.
 SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
                            const SurfaceQuiltingOptions& options,
                            TranslationCostEvaluator& evaluator,
-                           SurfaceQuiltingStats* stats = nullptr,
-                           ProgressSink* progress = nullptr);
+                           SurfaceQuiltingStats* stats = nullptr, ProgressSink* progress = nullptr);
 
 // 3D positions of local coordinates by plain normal displacement: the base point plus height
 // times the interpolated unit vertex normal.

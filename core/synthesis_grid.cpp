@@ -12,10 +12,9 @@ SynthesisGrid::SynthesisGrid(Vector2d origin, double cell_size, int nx, int ny)
   MQ_CHECK(std::isfinite(cell_size) && cell_size > 0, InvalidInput,
            "grid cell size must be positive and finite, got ", cell_size);
   MQ_CHECK(origin.allFinite(), InvalidInput, "grid origin is not finite");
-  MQ_CHECK(nx > 0 && ny > 0, InvalidInput, "grid must have at least one cell, got ", nx, " x ",
-           ny);
-  MQ_CHECK(static_cast<long long>(nx) * ny <= (1LL << 26), InvalidInput, "grid of ", nx, " x ",
-           ny, " cells is too large; use a larger cell size");
+  MQ_CHECK(nx > 0 && ny > 0, InvalidInput, "grid must have at least one cell, got ", nx, " x ", ny);
+  MQ_CHECK(static_cast<long long>(nx) * ny <= (1LL << 26), InvalidInput, "grid of ", nx, " x ", ny,
+           " cells is too large; use a larger cell size");
   processed_.assign(static_cast<size_t>(nx) * ny, 0);
 }
 
@@ -25,8 +24,8 @@ Cell SynthesisGrid::cell_of(double x, double y) const {
 }
 
 OverlapRegion::ProcessedTest SynthesisGrid::processed_snapshot() const {
-  return [origin = origin_, cell = cell_size_, nx = nx_, ny = ny_,
-          flags = processed_](double x, double y) {
+  return [origin = origin_, cell = cell_size_, nx = nx_, ny = ny_, flags = processed_](double x,
+                                                                                       double y) {
     const int cx = static_cast<int>(std::floor((x - origin.x()) / cell));
     const int cy = static_cast<int>(std::floor((y - origin.y()) / cell));
     return cx >= 0 && cy >= 0 && cx < nx && cy < ny && flags[cy * nx + cx] != 0;

@@ -1,0 +1,82 @@
+#include <gtest/gtest.h>
+
+#include "core/closest_point_query.h"
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_io.h"
+#include "core/mesh_topology.h"
+#include "core/midpoint_subdivision.h"
+#include "core/surface_quilting.h"
+#include "core/swatch_generators.h"
+#include "core/translation_cost.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+TriMesh tiny_chainmail() {
+  ChainMailOptions o;
+  o.rows = 3;
+  o.cols = 3;
+  o.ring_segments = 16;
+  o.wire_segments = 6;
+  return chainmail_4in1(o);
+}
+
+TEST(SurfaceQuilting, InvalidParametersThrow) {
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  TranslationCostCpu cost;
+  SurfaceQuiltingOptions o;
+  o.scale = 0;
+  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  o.scale = std::nan("");
+  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  o.scale = 0.2;
+  o.field = MatrixX3d::Zero(3, 3);
+  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  o.field.resize(0, 3);
+  TriMesh nan_base = base;
+  nan_base.V(0, 0) = std::nan("");
+  EXPECT_THROW(quilt_surface(nan_base, tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(TriMesh(), tiny_chainmail(), o, cost), InvalidInput);
+}
+
+TEST(MidpointSubdivision, KeepsTheSurfaceAndTopology) {
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  const TriMesh fine = midpoint_subdivide(base);
+  EXPECT_EQ(fine.num_faces(), 4 * base.num_faces());
+  EXPECT_NEAR(surface_area(fine.V, fine.F), surface_area(base.V, base.F), 1e-9);
+  EXPECT_TRUE(topology_report(fine).closed());
+  EXPECT_LE(point_mesh_distance(fine.V, base.V, base.F).maxCoeff(), 1e-12);
+  int levels = -1;
+  const TriMesh r =
+      refine_to_edge_length(base, 0.26 * mean_edge_length(base.V, base.F), 1 << 20, &levels);
+  EXPECT_EQ(levels, 2);
+  EXPECT_EQ(r.num_faces(), 16 * base.num_faces());
+}
+
+TEST(SurfaceQuilting, LocalCoordinatesMapBackToTheInputBase) {
+  // A point given on the refined base and converted to the input base is the same 3D point.
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  SurfaceQuilt quilt;
+  quilt.input_base = base;
+  quilt.base = refine_to_edge_length(base, 0.2 * mean_edge_length(base.V, base.F), 1 << 22,
+                                     &quilt.refinement_levels);
+  ASSERT_EQ(quilt.refinement_levels, 3);
+  for (int f = 0; f < quilt.base.num_faces(); f += 97) {
+    const Vector3d b0(0.2, 0.3, 0.5);
+    Vector3d p = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += b0(k) * quilt.base.V.row(quilt.base.F(f, k)).transpose();
+    int face = f;
+    Vector3d b = b0;
+    to_input_base(quilt, face, b);
+    Vector3d q = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) q += b(k) * base.V.row(base.F(face, k)).transpose();
+    EXPECT_LT((p - q).norm(), 1e-12) << f;
+    EXPECT_NEAR(b.sum(), 1.0, 1e-12);
+    EXPECT_GE(b.minCoeff(), -1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace mq

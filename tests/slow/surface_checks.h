@@ -1,0 +1,80 @@
+// Property checks of a surface quilting result, shared by the fast tests (tests/core) and the
+// realistic-size runs (tests/slow).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include "core/closest_point_query.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_intersections.h"
+#include "core/mesh_topology.h"
+#include "core/quilt_embedding.h"
+#include "core/surface_quilting.h"
+#include "core/tet_stretch.h"
+#include "core/translation_cost.h"
+#include "tests/core/planar_checks.h"
+
+namespace mq::test {
+
+struct SurfaceRun {
+  SurfaceQuilt quilt;
+  SurfaceQuiltingStats stats;
+  QuiltEmbeddingStats embedding_stats;
+  TriMesh output;
+};
+
+inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double scale,
+                              bool shell_map = true, const MatrixX3d& field = MatrixX3d()) {
+  SurfaceRun run;
+  SurfaceQuiltingOptions options;
+  options.scale = scale;
+  options.field = field;
+  TranslationCostCpu cost;
+  run.quilt = quilt_surface(base, swatch, options, cost, &run.stats);
+  QuiltEmbeddingOptions embedding;
+  embedding.shell_map = shell_map;
+  TetStretchCpu stretch;
+  run.output = embed_quilt(run.quilt, embedding, stretch, &run.embedding_stats);
+  return run;
+}
+
+// Fraction of the base's area (sampled at face centroids and vertices, area weighted) that has
+// output geometry within `radius` (the issue's 1.5 shell heights).
+inline double surface_coverage(const TriMesh& base, const TriMesh& output, double radius) {
+  const ClosestPointQuery query(output.V, output.F);
+  const Eigen::VectorXd A = face_areas(base.V, base.F);
+  double covered = 0;
+  for (int f = 0; f < base.num_faces(); ++f) {
+    const Vector3d c =
+        (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
+            .transpose() /
+        3.0;
+    if (query.closest(c, radius).face >= 0) covered += A(f);
+  }
+  return covered / A.sum();
+}
+
+// The properties issue 4 asks of every surface result.
+inline void expect_valid_surface_quilt(const TriMesh& base, const SurfaceRun& run,
+                                       double min_coverage) {
+  const TriMesh& out = run.output;
+  ASSERT_GT(out.num_faces(), 0);
+  // Every element closed and manifold.
+  int bad = 0;
+  for (const TriMesh& part : components(out)) {
+    const TopologyReport r = topology_report(part);
+    bad += !(r.closed() && r.manifold());
+  }
+  EXPECT_EQ(bad, 0) << "elements not closed or not manifold";
+  // No two elements intersect.
+  EXPECT_EQ(intersecting_face_pairs(out.V, out.F).size(), 0u);
+  // Every output vertex within the shell: no farther from the base than the shell height.
+  const double H = run.quilt.shell_height;
+  const Eigen::VectorXd d = point_mesh_distance(out.V, run.quilt.base.V, run.quilt.base.F);
+  EXPECT_LE(d.maxCoeff(), 1.05 * H + 1e-9) << "a vertex leaves the shell";
+  // Coverage: base points with output geometry within 1.5 shell heights.
+  EXPECT_GE(surface_coverage(base, out, 1.5 * H), min_coverage);
+  EXPECT_GT(run.embedding_stats.element_area_mean, 0);
+}
+
+}  // namespace mq::test

@@ -1,0 +1,81 @@
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include "core/errors.h"
+#include "core/mesh_io.h"
+#include "core/midpoint_subdivision.h"
+#include "core/tangent_field.h"
+#include "tests/slow/surface_checks.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+// A coarse swatch of 2 x 2 rings keeps these runs to seconds; the realistic sizes are in
+// tests/slow.
+TriMesh tiny_chainmail() {
+  ChainMailOptions o;
+  o.rows = 3;
+  o.cols = 3;
+  o.ring_segments = 16;
+  o.wire_segments = 6;
+  return chainmail_4in1(o);
+}
+
+// Issue 4's checks on chain mail over the knight, at a scale where rings are about 4% of the
+// bounding-box diagonal: closed manifold elements, no intersections, every vertex inside the
+// shell, at least 95% of the surface within 1.5 shell heights of the texture.
+TEST(SurfaceQuilting, ChainMailOverTheKnight) {
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.12);
+  test::expect_valid_surface_quilt(base, run, 0.95);
+  EXPECT_GT(run.stats.iterations, 1);
+  // The shell map was built (no fallback) and its optimisation did not increase the stretch.
+  EXPECT_TRUE(run.embedding_stats.shell_map_failure.empty())
+      << run.embedding_stats.shell_map_failure;
+  EXPECT_GT(run.embedding_stats.stretch_before, 1.0);
+  EXPECT_LE(run.embedding_stats.stretch_after, run.embedding_stats.stretch_before);
+}
+
+TEST(SurfaceQuilting, BaseWithBoundaryAndSeveralComponents) {
+  // The teapot is four open patches; the lily a sheet with one boundary loop.
+  for (const char* name : {"base/teapot_6k.obj", "base/lilium_7k.obj"}) {
+    const TriMesh base = read_mesh(test::shared_data(name));
+    const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.15, false);
+    EXPECT_GT(run.output.num_faces(), 0) << name;
+    EXPECT_EQ(intersecting_face_pairs(run.output.V, run.output.F).size(), 0u) << name;
+    // The boundary is respected: every vertex lies over the base (in local coordinates of
+    // some base face), within the shell height of it.
+    const Eigen::VectorXd d = point_mesh_distance(run.output.V, run.quilt.base.V, run.quilt.base.F);
+    EXPECT_LE(d.maxCoeff(), 1.05 * run.quilt.shell_height + 1e-9) << name;
+  }
+}
+
+TEST(SurfaceQuilting, DeterministicAcrossThreadCounts) {
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  TriMesh a, b;
+  {
+    tbb::task_arena one(1);
+    one.execute([&] { a = test::run_surface(base, tiny_chainmail(), 0.2, false).output; });
+  }
+  {
+    tbb::task_arena two(2);
+    two.execute([&] { b = test::run_surface(base, tiny_chainmail(), 0.2, false).output; });
+  }
+  ASSERT_EQ(a.V.rows(), b.V.rows());
+  EXPECT_TRUE(a.V == b.V);
+  EXPECT_TRUE(a.F == b.F);
+}
+
+TEST(SurfaceQuilting, GuidanceFieldOrientsTheSwatch) {
+  // With a constant field the quilt differs from the default field's, and it runs.
+  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
+  const MatrixX3d field = tangent_field_from_direction(base.V, base.F, Vector3d(0, 0, 1));
+  const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.2, false, field);
+  EXPECT_GT(run.output.num_faces(), 0);
+  const test::SurfaceRun plain = test::run_surface(base, tiny_chainmail(), 0.2, false);
+  EXPECT_FALSE(run.output.V.rows() == plain.output.V.rows() && run.output.V == plain.output.V);
+}
+
+}  // namespace
+}  // namespace mq
