@@ -14,4 +14,10 @@ $mq plane --swatch out/chainmail_swatch.obj --size 30 30 -o out/chainmail_plane.
   --stats out/chainmail_plane.json
 $mq info out/chainmail_plane.obj
 $mq render out/chainmail_plane.obj -o out/chainmail_plane.png
-echo "setup: done; results in out/ (chainmail_plane.obj, .json, .png)"
+# ... and over a shipped base mesh (Keenan Crane's Spot, CC0), through the shell map.
+$mq swatch chainmail --rows 3 --cols 3 --detail 16 -o out/chainmail_small.obj
+$mq surface --base data/spot_6k.obj --swatch out/chainmail_small.obj --scale 0.15 \
+  -o out/spot_chainmail.obj --stats out/spot_chainmail.json
+$mq info out/spot_chainmail.obj
+$mq render out/spot_chainmail.obj -o out/spot_chainmail.png
+echo "setup: done; results in out/ (chainmail_plane.*, spot_chainmail.*)"
