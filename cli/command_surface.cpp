@@ -76,13 +76,6 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
   write_file_atomically(path, j.str());
 }
 
-Device parse_device(const std::string& name) {
-  if (name == "auto") return Device::Auto;
-  if (name == "cpu") return Device::Cpu;
-  if (name == "opencl") return Device::OpenCL;
-  throw UsageError("--device expects auto, cpu or opencl, got '" + name + "'");
-}
-
 }  // namespace
 
 int run_surface(int argc, char** argv, int first) {

@@ -8,6 +8,13 @@
 
 namespace mq::cli {
 
+Device parse_device(const std::string& name) {
+  if (name == "auto") return Device::Auto;
+  if (name == "cpu") return Device::Cpu;
+  if (name == "opencl") return Device::OpenCL;
+  throw UsageError("--device expects auto, cpu or opencl, got '" + name + "'");
+}
+
 void add_run_options(CommandLine& cl) {
   cl.flag("quiet", "print nothing but errors (no progress, no summary)");
   cl.option("stats", "FILE.json", "write counts and per-stage timings as JSON");

@@ -8,8 +8,12 @@
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
+#include "host/device.h"
 
 namespace mq::cli {
+
+// The --device choice ("auto", "cpu" or "opencl"); throws UsageError otherwise.
+Device parse_device(const std::string& name);
 
 // Declares the shared options on a command line.
 void add_run_options(CommandLine& cl);

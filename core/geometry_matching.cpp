@@ -1,10 +1,45 @@
 #include "core/geometry_matching.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.h"
 
 namespace mq {
+
+void gather_subpatch(const std::vector<const Element*>& elements, const Vector2d& lo,
+                     const Vector2d& hi, int max_points, MatrixX3d& P, MatrixX3d& NP) {
+  std::vector<std::pair<const Element*, int>> inside;
+  for (const Element* e : elements)
+    for (int v = 0; v < e->V.rows(); ++v) {
+      const double x = e->V(v, 0), y = e->V(v, 1);
+      if (x >= lo.x() && x <= hi.x() && y >= lo.y() && y <= hi.y()) inside.emplace_back(e, v);
+    }
+  const size_t n =
+      max_points > 0 ? std::min(inside.size(), static_cast<size_t>(max_points)) : inside.size();
+  P.resize(static_cast<Eigen::Index>(n), 3);
+  NP.resize(static_cast<Eigen::Index>(n), 3);
+  for (size_t i = 0; i < n; ++i) {
+    const auto [e, v] = inside[i * inside.size() / n];
+    P.row(static_cast<Eigen::Index>(i)) = e->V.row(v);
+    NP.row(static_cast<Eigen::Index>(i)) = e->N.row(v);
+  }
+}
+
+MatrixX3d whole_cell_offsets(const Vector2d& t_min, const Vector2d& t_max, double cell) {
+  const int kx0 = static_cast<int>(std::ceil(t_min.x() / cell - 1e-9));
+  const int ky0 = static_cast<int>(std::ceil(t_min.y() / cell - 1e-9));
+  const int kx1 = static_cast<int>(std::floor(t_max.x() / cell + 1e-9));
+  const int ky1 = static_cast<int>(std::floor(t_max.y() / cell + 1e-9));
+  std::vector<Vector3d> offsets;
+  for (int ky = ky0; ky <= ky1; ++ky)
+    for (int kx = kx0; kx <= kx1; ++kx) offsets.emplace_back(kx * cell, ky * cell, 0.0);
+  if (offsets.empty()) offsets.emplace_back(t_max.x(), t_max.y(), 0.0);
+  MatrixX3d T(static_cast<Eigen::Index>(offsets.size()), 3);
+  for (size_t i = 0; i < offsets.size(); ++i)
+    T.row(static_cast<Eigen::Index>(i)) = offsets[i].transpose();
+  return T;
+}
 
 OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
                            const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,

@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "core/quilt_elements.h"
 #include "core/translation_cost.h"
 
 namespace mq {
@@ -32,6 +33,16 @@ struct OffsetChoice {
   int evaluations = 0;          // all offsets evaluated, refinement included
   long long point_offsets = 0;  // (point, offset) pairs evaluated
 };
+
+// The sub-patch points of Eq. (3): vertices (#P by 3, with their unit normals NP) of the given
+// elements lying in [lo, hi] (xy), at most max_points of them (an evenly strided subset, in
+// element then vertex order; 0 = all).
+void gather_subpatch(const std::vector<const Element*>& elements, const Vector2d& lo,
+                     const Vector2d& hi, int max_points, MatrixX3d& P, MatrixX3d& NP);
+
+// The whole-cell translations (multiples of cell, t_z = 0) in [t_min, t_max], y-major; when the
+// range holds none, t_max alone. #T by 3.
+MatrixX3d whole_cell_offsets(const Vector2d& t_min, const Vector2d& t_max, double cell);
 
 // Picks the swatch translation t for the sub-patch points P (#P by 3, unit normals NP #P by 3)
 // among `candidates` (#T by 3, whole-cell offsets, at least one). The refinement keeps the xy

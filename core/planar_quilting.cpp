@@ -206,36 +206,11 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     OffsetChoice choice;
     {
       ScopedStageTimer timer(times, "matching");
-      std::vector<Vector3d> points, normals;
-      for (const int id : output.query(sub_lo, sub_hi)) {
-        const Element& e = output[id];
-        for (int v = 0; v < e.V.rows(); ++v) {
-          const double x = e.V(v, 0), y = e.V(v, 1);
-          if (x >= sub_lo.x() && x <= sub_hi.x() && y >= sub_lo.y() && y <= sub_hi.y()) {
-            points.push_back(e.V.row(v).transpose());
-            normals.push_back(e.N.row(v).transpose());
-          }
-        }
-      }
-      const size_t n = options.match_points > 0
-                           ? std::min(points.size(), static_cast<size_t>(options.match_points))
-                           : points.size();
-      MatrixX3d P(n, 3), NP(n, 3);
-      for (size_t i = 0; i < n; ++i) {
-        const size_t k = i * points.size() / n;
-        P.row(i) = points[k].transpose();
-        NP.row(i) = normals[k].transpose();
-      }
-      const int kx0 = static_cast<int>(std::ceil(t_min.x() / cell - 1e-9));
-      const int ky0 = static_cast<int>(std::ceil(t_min.y() / cell - 1e-9));
-      const int kx1 = static_cast<int>(std::floor(t_max.x() / cell + 1e-9));
-      const int ky1 = static_cast<int>(std::floor(t_max.y() / cell + 1e-9));
-      std::vector<Vector3d> offsets;
-      for (int ky = ky0; ky <= ky1; ++ky)
-        for (int kx = kx0; kx <= kx1; ++kx) offsets.emplace_back(kx * cell, ky * cell, 0.0);
-      if (offsets.empty()) offsets.emplace_back(t_max.x(), t_max.y(), 0.0);
-      MatrixX3d T(offsets.size(), 3);
-      for (size_t i = 0; i < offsets.size(); ++i) T.row(i) = offsets[i].transpose();
+      std::vector<const Element*> near;
+      for (const int id : output.query(sub_lo, sub_hi)) near.push_back(&output[id]);
+      MatrixX3d P, NP;
+      gather_subpatch(near, sub_lo, sub_hi, options.match_points, P, NP);
+      const MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
       choice =

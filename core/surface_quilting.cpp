@@ -466,34 +466,14 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     {
       ScopedStageTimer timer(times, "matching");
       const double half = 0.5 * window * cell;
-      std::vector<Vector3d> points, normals;
-      for (const auto& [id, e] : flat)
-        for (int v = 0; v < e.V.rows(); ++v)
-          if (std::abs(e.V(v, 0)) <= half && std::abs(e.V(v, 1)) <= half) {
-            points.push_back(e.V.row(v).transpose());
-            normals.push_back(e.N.row(v).transpose());
-          }
-      const size_t n = options.match_points > 0
-                           ? std::min(points.size(), static_cast<size_t>(options.match_points))
-                           : points.size();
-      MatrixX3d P(n, 3), NP(n, 3);
-      for (size_t i = 0; i < n; ++i) {
-        const size_t k = i * points.size() / n;
-        P.row(i) = points[k].transpose();
-        NP.row(i) = normals[k].transpose();
-      }
+      std::vector<const Element*> near;
+      for (const auto& [id, e] : flat) near.push_back(&e);
+      MatrixX3d P, NP;
+      gather_subpatch(near, Vector2d::Constant(-half), Vector2d::Constant(half),
+                      options.match_points, P, NP);
       const Vector2d t_min = Vector2d::Constant(half) - swatch.size.head<2>();
       const Vector2d t_max = Vector2d::Constant(-half);
-      std::vector<Vector3d> offsets;
-      const int kx0 = static_cast<int>(std::ceil(t_min.x() / cell - 1e-9));
-      const int ky0 = static_cast<int>(std::ceil(t_min.y() / cell - 1e-9));
-      const int kx1 = static_cast<int>(std::floor(t_max.x() / cell + 1e-9));
-      const int ky1 = static_cast<int>(std::floor(t_max.y() / cell + 1e-9));
-      for (int ky = ky0; ky <= ky1; ++ky)
-        for (int kx = kx0; kx <= kx1; ++kx) offsets.emplace_back(kx * cell, ky * cell, 0.0);
-      if (offsets.empty()) offsets.emplace_back(t_max.x(), t_max.y(), 0.0);
-      MatrixX3d T(offsets.size(), 3);
-      for (size_t i = 0; i < offsets.size(); ++i) T.row(i) = offsets[i].transpose();
+      MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;
       // The first patch has nothing to match: the swatch is centred on the seed.

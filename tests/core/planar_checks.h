@@ -26,6 +26,15 @@ inline TriMesh small_chainmail(int rings = 3) {
   o.wire_segments = 8;
   return chainmail_4in1(o);
 }
+// Coarser still (3 x 3 rings, 16 x 6 segments), for surface runs.
+inline TriMesh tiny_chainmail() {
+  ChainMailOptions o;
+  o.rows = 3;
+  o.cols = 3;
+  o.ring_segments = 16;
+  o.wire_segments = 6;
+  return chainmail_4in1(o);
+}
 inline TriMesh small_weave() {
   WeaveOptions o;
   o.threads_x = 4;

@@ -9,36 +9,28 @@
 #include "core/surface_quilting.h"
 #include "core/swatch_generators.h"
 #include "core/translation_cost.h"
+#include "tests/core/planar_checks.h"
 #include "tests/test_support.h"
 
 namespace mq {
 namespace {
-
-TriMesh tiny_chainmail() {
-  ChainMailOptions o;
-  o.rows = 3;
-  o.cols = 3;
-  o.ring_segments = 16;
-  o.wire_segments = 6;
-  return chainmail_4in1(o);
-}
 
 TEST(SurfaceQuilting, InvalidParametersThrow) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
   TranslationCostCpu cost;
   SurfaceQuiltingOptions o;
   o.scale = 0;
-  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(base, test::tiny_chainmail(), o, cost), InvalidInput);
   o.scale = std::nan("");
-  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(base, test::tiny_chainmail(), o, cost), InvalidInput);
   o.scale = 0.2;
   o.field = MatrixX3d::Zero(3, 3);
-  EXPECT_THROW(quilt_surface(base, tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(base, test::tiny_chainmail(), o, cost), InvalidInput);
   o.field.resize(0, 3);
   TriMesh nan_base = base;
   nan_base.V(0, 0) = std::nan("");
-  EXPECT_THROW(quilt_surface(nan_base, tiny_chainmail(), o, cost), InvalidInput);
-  EXPECT_THROW(quilt_surface(TriMesh(), tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(nan_base, test::tiny_chainmail(), o, cost), InvalidInput);
+  EXPECT_THROW(quilt_surface(TriMesh(), test::tiny_chainmail(), o, cost), InvalidInput);
 }
 
 TEST(MidpointSubdivision, KeepsTheSurfaceAndTopology) {

@@ -1,35 +1,25 @@
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
-#include <tbb/task_arena.h>
 
 #include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/midpoint_subdivision.h"
 #include "core/tangent_field.h"
+#include "tests/core/planar_checks.h"
 #include "tests/slow/surface_checks.h"
 #include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
-// A coarse swatch of 2 x 2 rings keeps these runs to seconds; the realistic sizes are in
-// tests/slow.
-TriMesh tiny_chainmail() {
-  ChainMailOptions o;
-  o.rows = 3;
-  o.cols = 3;
-  o.ring_segments = 16;
-  o.wire_segments = 6;
-  return chainmail_4in1(o);
-}
-
 // Issue 4's checks on chain mail over the knight, at a scale where rings are about 4% of the
 // bounding-box diagonal: closed manifold elements, no intersections, every vertex inside the
 // shell, at least 95% of the surface within 1.5 shell heights of the texture.
 TEST(SurfaceQuilting, ChainMailOverTheKnight) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
-  const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.12);
+  const test::SurfaceRun run = test::run_surface(base, test::tiny_chainmail(), 0.12);
   test::expect_valid_surface_quilt(base, run, 0.95);
   EXPECT_GT(run.stats.iterations, 1);
   // The shell map was built (no fallback) and its optimisation did not increase the stretch.
@@ -48,7 +38,7 @@ TEST(SurfaceQuilting, BaseWithBoundaryAndSeveralComponents) {
   TriMesh second = base;
   second.V.col(0).array() += 6.0;
   append_mesh(base, second);
-  const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.12, false);
+  const test::SurfaceRun run = test::run_surface(base, test::tiny_chainmail(), 0.12, false);
   ASSERT_GT(run.output.num_faces(), 0);
   EXPECT_EQ(intersecting_face_pairs(run.output.V, run.output.F).size(), 0u);
   // Every vertex lies within the shell over the base (never beyond its boundary).
@@ -68,11 +58,11 @@ TEST(SurfaceQuilting, DeterministicAcrossThreadCounts) {
   TriMesh a, b;
   {
     tbb::task_arena one(1);
-    one.execute([&] { a = test::run_surface(base, tiny_chainmail(), 0.25, false).output; });
+    one.execute([&] { a = test::run_surface(base, test::tiny_chainmail(), 0.25, false).output; });
   }
   {
     tbb::task_arena two(2);
-    two.execute([&] { b = test::run_surface(base, tiny_chainmail(), 0.25, false).output; });
+    two.execute([&] { b = test::run_surface(base, test::tiny_chainmail(), 0.25, false).output; });
   }
   ASSERT_EQ(a.V.rows(), b.V.rows());
   EXPECT_TRUE(a.V == b.V);
@@ -83,9 +73,9 @@ TEST(SurfaceQuilting, GuidanceFieldOrientsTheSwatch) {
   // With a constant field the quilt differs from the default field's, and it runs.
   const TriMesh base = test::torus(2.0, 0.8, 48, 24);
   const MatrixX3d field = tangent_field_from_direction(base.V, base.F, Vector3d(1, 1, 0));
-  const test::SurfaceRun run = test::run_surface(base, tiny_chainmail(), 0.25, false, field);
+  const test::SurfaceRun run = test::run_surface(base, test::tiny_chainmail(), 0.25, false, field);
   EXPECT_GT(run.output.num_faces(), 0);
-  const test::SurfaceRun plain = test::run_surface(base, tiny_chainmail(), 0.25, false);
+  const test::SurfaceRun plain = test::run_surface(base, test::tiny_chainmail(), 0.25, false);
   EXPECT_FALSE(run.output.V.rows() == plain.output.V.rows() && run.output.V == plain.output.V);
 }
 
