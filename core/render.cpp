@@ -4,16 +4,15 @@
 #include <png.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <limits>
 #include <memory>
 #include <system_error>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
@@ -371,28 +370,27 @@ void write_png(const std::string& path, const Image& image) {
                image.rgb.size() == 3 * static_cast<size_t>(image.width) * image.height,
            InvalidInput, "write_png: image size ", image.width, "x", image.height,
            " does not match its ", image.rgb.size(), " bytes");
-  const std::string tmp = path + ".tmp" + std::to_string(static_cast<long>(::getpid()));
   png_image png;
   std::memset(&png, 0, sizeof(png));
   png.version = PNG_IMAGE_VERSION;
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = PNG_FORMAT_RGB;
-  const int ok =
-      png_image_write_to_file(&png, tmp.c_str(), 0, image.rgb.data(), 3 * image.width, nullptr);
+  // Encoded in memory (first pass sizes the buffer), then written like every other output.
+  png_alloc_size_t size = 0;
+  std::string bytes;
+  int ok = png_image_write_to_memory(&png, nullptr, &size, 0, image.rgb.data(), 3 * image.width,
+                                     nullptr);
+  if (ok) {
+    bytes.resize(size);
+    ok = png_image_write_to_memory(&png, bytes.data(), &size, 0, image.rgb.data(),
+                                   3 * image.width, nullptr);
+    bytes.resize(size);
+  }
   const std::string message = png.message;
   png_image_free(&png);
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    MQ_THROW(Error, "cannot write PNG '", path, "': ", message);
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    MQ_THROW(Error, "cannot write PNG '", path, "': ", ec.message());
-  }
+  if (!ok) MQ_THROW(Error, "cannot encode PNG '", path, "': ", message);
+  write_file_atomically(path, bytes);
 }
 
 }  // namespace mq
