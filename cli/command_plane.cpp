@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "cli/json_writer.h"
 #include "cli/run_context.h"
+#include "cli/stats_json.h"
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
 #include "core/planar_quilting.h"
@@ -35,26 +36,11 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
       .value("vertices", s.vertices)
       .value("elements", s.elements)
       .end_object()
-      .begin_object("elements")
-      .value("added", s.elements_added)
-      .value("replaced", s.elements_replaced)
-      .value("stitched", s.elements_stitched)
-      .value("matched", s.elements_matched)
-      .value("dropped", s.elements_dropped)
-      .value("stitch_fallbacks", s.stitch_fallbacks)
-      .value("rejected_intersecting", s.rejected_intersecting)
-      .value("removed_post", s.removed_post)
-      .value("trimmed", s.trimmed)
-      .end_object()
-      .begin_object("stitch_failures");
-  for (int k = 1; k < kStitchFailureKinds; ++k)
-    j.value(stitch_failure_name(static_cast<StitchFailure>(k)), s.stitch_failures[k]);
-  j.value("intersecting", s.stitch_failures[0])
-      .end_object()
-      .value("matched_point_offsets", s.matched_point_offsets)
-      .value("pairs", s.pairs)
-      .value("relations", s.relations)
-      .begin_object("stage_seconds");
+      .begin_object("elements");
+  write_element_counts(j, s.counts);
+  j.value("removed_post", s.removed_post).value("trimmed", s.trimmed).end_object();
+  write_match_counts(j, s.counts);
+  j.value("matched_point_offsets", s.matched_point_offsets).begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
   write_file_atomically(path, j.str());
@@ -120,8 +106,8 @@ int run_plane(int argc, char** argv, int first) {
     std::printf(
         "%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
         "%d added, %d matched, %d removed\n",
-        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.elements_stitched,
-        stats.elements_replaced, stats.elements_added, stats.elements_matched, stats.removed_post);
+        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.counts.stitched,
+        stats.counts.replaced, stats.counts.added, stats.counts.matched, stats.removed_post);
   }
   return 0;
 }

@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "cli/json_writer.h"
 #include "cli/run_context.h"
+#include "cli/stats_json.h"
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
 #include "core/quilt_embedding.h"
@@ -49,15 +50,9 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("vertices", em.vertices)
       .value("elements", em.elements)
       .end_object()
-      .begin_object("elements")
-      .value("added", s.counts.added)
-      .value("replaced", s.counts.replaced)
-      .value("stitched", s.counts.stitched)
-      .value("matched", s.counts.matched)
-      .value("dropped", s.counts.dropped)
-      .value("stitch_fallbacks", s.counts.stitch_fallbacks)
-      .value("rejected_intersecting", s.counts.rejected_intersecting)
-      .value("rejected_outside_patch", s.rejected_outside_patch)
+      .begin_object("elements");
+  write_element_counts(j, s.counts);
+  j.value("rejected_outside_patch", s.rejected_outside_patch)
       .value("removed_post", em.removed_intersecting)
       .end_object()
       .begin_object("element_area")
@@ -66,10 +61,9 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("min", em.element_area_min)
       .value("max", em.element_area_max)
       .end_object()
-      .value("matched_point_offsets", s.matched_point_offsets)
-      .value("pairs", s.counts.pairs)
-      .value("relations", s.counts.relations)
-      .begin_object("stage_seconds");
+      .value("matched_point_offsets", s.matched_point_offsets);
+  write_match_counts(j, s.counts);
+  j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   for (const auto& [stage, seconds] : em.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();

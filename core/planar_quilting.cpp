@@ -168,7 +168,6 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   patch_options.correspondence = options.correspondence;
   patch_options.merging = options.merging;
   patch_options.deform = options.deform;
-  PatchCounts patch_counts;
   // Marks the cells lying entirely inside the patch footprint [lo, hi].
   auto mark_patch = [&](const Vector2d& lo, const Vector2d& hi) {
     const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x() / cell - 1e-9)));
@@ -185,7 +184,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     for (const Element& e : swatch.elements)
       if (in_domain(e)) {
         output.add(e);
-        ++stats.elements_added;
+        ++stats.counts.added;
       }
     mark_patch(Vector2d::Zero(), swatch.size.head<2>());
     stats.iterations = 1;
@@ -222,7 +221,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
 
     // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
-    quilt_patch(output, swatch, *swatch_query, t, region, in_domain, patch_options, patch_counts,
+    quilt_patch(output, swatch, *swatch_query, t, region, in_domain, patch_options, stats.counts,
                 times);
     mark_patch(patch_lo, patch_hi);
     grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
@@ -266,16 +265,6 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     }
     for (const Element& e : trimmed) kept.push_back(&e);
   }
-  stats.pairs = patch_counts.pairs;
-  stats.relations = patch_counts.relations;
-  stats.elements_added += patch_counts.added;
-  stats.elements_replaced = patch_counts.replaced;
-  stats.elements_stitched = patch_counts.stitched;
-  stats.elements_matched = patch_counts.matched;
-  stats.elements_dropped = patch_counts.dropped;
-  stats.stitch_fallbacks = patch_counts.stitch_fallbacks;
-  stats.rejected_intersecting = patch_counts.rejected_intersecting;
-  stats.stitch_failures = patch_counts.stitch_failures;
   TriMesh result = merge_elements(kept);
   // Back to the swatch's own axes (the thickness axis returns to where it was).
   const Eigen::Matrix3d back = swatch.rotation.transpose();

@@ -8,15 +8,16 @@
 #include "core/element_correspondence.h"
 #include "core/element_merging.h"
 #include "core/geometry_matching.h"
+#include "core/patch_quilting.h"
 #include "core/progress.h"
 #include "core/stage_timer.h"
 
 namespace mq {
 
 struct PlanarQuiltingOptions {
-  double length = 0;      // L: output extent along x (swatch units)
-  double width = 0;       // W: output extent along y
-  double cell_size = 0;   // grid cell side; 0 derives it from the swatch's element size
+  double length = 0;     // L: output extent along x (swatch units)
+  double width = 0;      // W: output extent along y
+  double cell_size = 0;  // grid cell side; 0 derives it from the swatch's element size
   // Side of the output sub-patch P_out as a fraction of the swatch's shorter side (section 2.4
   // only asks that it be smaller than the swatch); larger values match more context.
   double subpatch_fraction = 0.5;
@@ -37,18 +38,9 @@ struct PlanarQuiltingStats {
   double cell_size = 0;
   int grid_nx = 0, grid_ny = 0;
   long long matched_point_offsets = 0;  // (point, offset) evaluations of Eq. (2)
-  long long pairs = 0;           // vertex-face pairs kept over all iterations
-  long long relations = 0;       // element relations kept over all iterations
-  int elements_added = 0;        // swatch elements without partner added as they are
-  int elements_replaced = 0;     // output elements inside the overlap replaced by swatch ones
-  int elements_stitched = 0;     // cut-and-stitch merges
-  int elements_matched = 0;      // partners that coincided: output kept, no cut needed
-  int elements_dropped = 0;      // swatch elements inside the overlap, or refused merges
-  int stitch_fallbacks = 0;      // cut-and-stitch refused; output element kept whole
-  std::array<int, kStitchFailureKinds> stitch_failures{};  // fallbacks by StitchFailure
-  int rejected_intersecting = 0; // candidates dropped because they would intersect
-  int removed_post = 0;          // removed in post-processing (outside the domain)
-  int trimmed = 0;               // elements cut open at the border (trim_border)
+  PatchCounts counts;    // steps 3-5 over all patches; the first patch's elements count as added
+  int removed_post = 0;  // removed in post-processing (outside the domain)
+  int trimmed = 0;       // elements cut open at the border (trim_border)
   int faces = 0, vertices = 0, elements = 0;
   StageTimes times;
 };

@@ -61,7 +61,7 @@ TEST(PlanarQuilting, WeaveThreadsContinueAcrossSeams) {
   test::QuiltExpectations expect;
   expect.check_diameters = false;  // stitched threads are longer than the swatch's
   test::expect_valid_quilt(swatch, out, L, W, expect);
-  EXPECT_GT(stats.elements_stitched, 0);
+  EXPECT_GT(stats.counts.stitched, 0);
   // Threads are joined across the seams into longer ones: the mean thread footprint is well
   // above the swatch's thread length.
   const std::vector<double> in = test::footprint_diameters(test::components(swatch));

@@ -47,7 +47,7 @@ TEST(PlanarQuiltingSlow, WeaveDefaultSwatch) {
   test::QuiltExpectations expect;
   expect.check_diameters = false;
   test::expect_valid_quilt(swatch, out, L, W, expect);
-  EXPECT_GT(stats.elements_stitched, 0);
+  EXPECT_GT(stats.counts.stitched, 0);
   double mean_in = 0, mean_out = 0;
   const auto in = test::footprint_diameters(test::components(swatch));
   const auto got = test::footprint_diameters(test::components(out));
