@@ -3,28 +3,10 @@
 #include <limits>
 
 #include "core/errors.h"
-#include "host/opencl_check.h"
+#include "host/opencl_buffers.h"
 #include "kernels/tet_stretch_cl.h"
 
 namespace mq {
-
-namespace {
-
-cl::Buffer make_buffer(cl_context context, cl_mem_flags flags, std::size_t bytes,
-                       const void* data) {
-  cl_int err = CL_SUCCESS;
-  cl::Buffer b(clCreateBuffer(context, flags | (data ? CL_MEM_COPY_HOST_PTR : 0), bytes,
-                              const_cast<void*>(data), &err));
-  MQ_CL_CHECK(err);
-  return b;
-}
-
-template <typename T>
-void set_arg(cl_kernel kernel, cl_uint index, const T& value) {
-  MQ_CL_CHECK(clSetKernelArg(kernel, index, sizeof(T), &value));
-}
-
-}  // namespace
 
 TetStretchOpenCL::TetStretchOpenCL(std::shared_ptr<cl::Runtime> runtime)
     : runtime_(std::move(runtime)) {
@@ -53,10 +35,10 @@ Eigen::VectorXd TetStretchOpenCL::per_tet(const StretchProblem& pb) {
                           T_.rows() == pb.T.rows() && shell_V_ == pb.shell_V && T_ == pb.T;
   if (!same_shell) {
     const std::size_t tbytes = sizeof(int) * 4 * nt;
-    shell_buffer_ = make_buffer(ctx, CL_MEM_READ_ONLY, vbytes, pb.shell_V.data());
-    tets_buffer_ = make_buffer(ctx, CL_MEM_READ_ONLY, tbytes, pb.T.data());
-    texture_buffer_ = make_buffer(ctx, CL_MEM_READ_ONLY, vbytes, nullptr);
-    out_buffer_ = make_buffer(ctx, CL_MEM_WRITE_ONLY, sizeof(double) * nt, nullptr);
+    shell_buffer_ = cl::create_buffer(ctx, CL_MEM_READ_ONLY, vbytes, pb.shell_V.data());
+    tets_buffer_ = cl::create_buffer(ctx, CL_MEM_READ_ONLY, tbytes, pb.T.data());
+    texture_buffer_ = cl::create_buffer(ctx, CL_MEM_READ_ONLY, vbytes, nullptr);
+    out_buffer_ = cl::create_buffer(ctx, CL_MEM_WRITE_ONLY, sizeof(double) * nt, nullptr);
     shell_V_ = pb.shell_V;
     T_ = pb.T;
     ++num_shell_uploads_;
@@ -64,11 +46,11 @@ Eigen::VectorXd TetStretchOpenCL::per_tet(const StretchProblem& pb) {
   MQ_CL_CHECK(clEnqueueWriteBuffer(queue, texture_buffer_.get(), CL_FALSE, 0, vbytes,
                                    pb.texture_V.data(), 0, nullptr, nullptr));
   const cl_kernel k = kernel_.get();
-  set_arg(k, 0, shell_buffer_.get());
-  set_arg(k, 1, texture_buffer_.get());
-  set_arg(k, 2, tets_buffer_.get());
-  set_arg(k, 3, cl_int(nt));
-  set_arg(k, 4, out_buffer_.get());
+  cl::set_arg(k, 0, shell_buffer_.get());
+  cl::set_arg(k, 1, texture_buffer_.get());
+  cl::set_arg(k, 2, tets_buffer_.get());
+  cl::set_arg(k, 3, cl_int(nt));
+  cl::set_arg(k, 4, out_buffer_.get());
   const std::size_t global = nt;
   MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr));
   MQ_CL_CHECK(clEnqueueReadBuffer(queue, out_buffer_.get(), CL_TRUE, 0, sizeof(double) * nt,

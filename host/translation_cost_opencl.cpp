@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "core/errors.h"
-#include "host/opencl_check.h"
+#include "host/opencl_buffers.h"
 #include "kernels/translation_cost_cl.h"
 
 namespace mq {
@@ -16,20 +16,10 @@ constexpr std::size_t kMaxCachedGrids = 4;
 // Bound on #P * (offsets per launch), i.e. on the minima buffer (8 bytes each).
 constexpr std::size_t kMaxMinimaPerLaunch = std::size_t(1) << 23;
 
+// A read-only device copy of count values.
 template <typename T>
-cl::Buffer make_buffer(cl_context context, const T* data, std::size_t count) {
-  cl_int err = CL_SUCCESS;
-  // OpenCL rejects zero-sized buffers; a one-element buffer is never read in that case.
-  const std::size_t bytes = sizeof(T) * std::max<std::size_t>(count, 1);
-  cl::Buffer b(clCreateBuffer(context, CL_MEM_READ_ONLY | (count ? CL_MEM_COPY_HOST_PTR : 0), bytes,
-                              count ? const_cast<T*>(data) : nullptr, &err));
-  MQ_CL_CHECK(err);
-  return b;
-}
-
-template <typename T>
-void set_arg(cl_kernel kernel, cl_uint index, const T& value) {
-  MQ_CL_CHECK(clSetKernelArg(kernel, index, sizeof(T), &value));
+cl::Buffer upload_array(cl_context context, const T* data, std::size_t count) {
+  return cl::create_buffer(context, CL_MEM_READ_ONLY, sizeof(T) * count, data);
 }
 
 }  // namespace
@@ -52,11 +42,12 @@ const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
   if (grids_.size() >= kMaxCachedGrids) grids_.clear();
   const cl_context ctx = runtime_->context();
   DeviceGrid d;
-  d.triangles = make_buffer(ctx, grid.triangles().data(), grid.triangles().size());
-  d.face_normals = make_buffer(ctx, grid.face_normals().data(), grid.face_normals().size());
-  d.cell_start = make_buffer(ctx, grid.cell_start().data(), grid.cell_start().size());
-  d.cell_faces = make_buffer(ctx, grid.cell_faces().data(), grid.cell_faces().size());
-  d.cell_cones = make_buffer(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
+  d.triangles = upload_array(ctx, grid.triangles().data(), grid.triangles().size());
+  d.face_normals = upload_array(ctx, grid.face_normals().data(), grid.face_normals().size());
+  d.cell_start = upload_array(ctx, grid.cell_start().data(), grid.cell_start().size());
+  d.cell_faces = upload_array(ctx, grid.cell_faces().data(), grid.cell_faces().size());
+  d.cell_cones =
+      upload_array(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
   return grids_.emplace(grid.fingerprint(), std::move(d)).first->second;
 }
 
@@ -72,38 +63,37 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
   const DeviceGrid& dg = upload(grid);
   const cl_context ctx = runtime_->context();
   const cl_command_queue queue = runtime_->queue();
-  const cl::Buffer points = make_buffer(ctx, problem.points.data(), problem.points.size());
+  const cl::Buffer points = upload_array(ctx, problem.points.data(), problem.points.size());
   const cl::Buffer normals =
-      make_buffer(ctx, problem.point_normals.data(), problem.point_normals.size());
+      upload_array(ctx, problem.point_normals.data(), problem.point_normals.size());
   const std::size_t chunk = std::min(T, std::max<std::size_t>(1, kMaxMinimaPerLaunch / P));
-  cl_int err = CL_SUCCESS;
-  cl::Buffer out(clCreateBuffer(ctx, CL_MEM_WRITE_ONLY, sizeof(double) * P * chunk, nullptr, &err));
-  MQ_CL_CHECK(err);
+  const cl::Buffer out =
+      cl::create_buffer(ctx, CL_MEM_WRITE_ONLY, sizeof(double) * P * chunk, nullptr);
 
   const cl_kernel k = kernel_.get();
-  set_arg(k, 0, points.get());
-  set_arg(k, 1, normals.get());
-  set_arg(k, 3, dg.triangles.get());
-  set_arg(k, 4, dg.face_normals.get());
-  set_arg(k, 5, dg.cell_start.get());
-  set_arg(k, 6, dg.cell_faces.get());
-  set_arg(k, 7, dg.cell_cones.get());
-  set_arg(k, 8, grid.origin()(0));
-  set_arg(k, 9, grid.origin()(1));
-  set_arg(k, 10, grid.origin()(2));
-  set_arg(k, 11, grid.cell_size());
-  set_arg(k, 12, cl_int(grid.dims()(0)));
-  set_arg(k, 13, cl_int(grid.dims()(1)));
-  set_arg(k, 14, cl_int(grid.dims()(2)));
-  set_arg(k, 15, problem.lambda);
-  set_arg(k, 16, cl_int(P));
-  set_arg(k, 17, out.get());
+  cl::set_arg(k, 0, points.get());
+  cl::set_arg(k, 1, normals.get());
+  cl::set_arg(k, 3, dg.triangles.get());
+  cl::set_arg(k, 4, dg.face_normals.get());
+  cl::set_arg(k, 5, dg.cell_start.get());
+  cl::set_arg(k, 6, dg.cell_faces.get());
+  cl::set_arg(k, 7, dg.cell_cones.get());
+  cl::set_arg(k, 8, grid.origin()(0));
+  cl::set_arg(k, 9, grid.origin()(1));
+  cl::set_arg(k, 10, grid.origin()(2));
+  cl::set_arg(k, 11, grid.cell_size());
+  cl::set_arg(k, 12, cl_int(grid.dims()(0)));
+  cl::set_arg(k, 13, cl_int(grid.dims()(1)));
+  cl::set_arg(k, 14, cl_int(grid.dims()(2)));
+  cl::set_arg(k, 15, problem.lambda);
+  cl::set_arg(k, 16, cl_int(P));
+  cl::set_arg(k, 17, out.get());
 
   std::vector<double> minima(P * chunk);
   for (std::size_t t0 = 0; t0 < T; t0 += chunk) {
     const std::size_t nt = std::min(chunk, T - t0);
-    const cl::Buffer offsets = make_buffer(ctx, problem.offsets.data() + 3 * t0, 3 * nt);
-    set_arg(k, 2, offsets.get());
+    const cl::Buffer offsets = upload_array(ctx, problem.offsets.data() + 3 * t0, 3 * nt);
+    cl::set_arg(k, 2, offsets.get());
     const std::size_t global[2] = {P, nt};
     MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 2, nullptr, global, nullptr, 0, nullptr, nullptr));
     MQ_CL_CHECK(clEnqueueReadBuffer(queue, out.get(), CL_TRUE, 0, sizeof(double) * P * nt,
