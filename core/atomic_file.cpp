@@ -1,11 +1,9 @@
 #include "core/atomic_file.h"
 
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 
@@ -13,42 +11,78 @@
 
 namespace mq {
 
-void write_file_atomically(const std::string& path, std::string_view bytes) {
+AtomicOutputFile::AtomicOutputFile(const std::string& path) : path_(path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   MQ_CHECK(!target.filename().empty(), InvalidInput, path, ": not a file name");
   std::error_code ec;
   MQ_CHECK(!fs::is_directory(target, ec), InvalidInput, path, ": is a directory");
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string temp = (dir / ("." + target.filename().string() + ".tmpXXXXXX")).string();
-  const int fd = mkstemp(temp.data());
-  if (fd < 0) MQ_THROW(Error, path, ": cannot create a file there: ", std::strerror(errno));
-  const char* data = bytes.data();
-  size_t left = bytes.size();
-  int err = 0;
-  while (left > 0) {
-    const ssize_t n = ::write(fd, data, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      err = errno;
-      break;
-    }
-    data += n;
-    left -= static_cast<size_t>(n);
+  std::string pattern = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  const int fd = ::mkstemp(pattern.data());
+  if (fd < 0)
+    MQ_THROW(Error, path, ": cannot write: cannot create a file in '", dir.string(),
+             "': ", std::strerror(errno));
+  temp_ = pattern;
+  // mkstemp creates 0600; keep an existing file's mode, else the usual 0644.
+  struct stat st;
+  const mode_t mode = ::stat(path.c_str(), &st) == 0 ? (st.st_mode & 07777) : 0644;
+  ::fchmod(fd, mode);
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    ::close(fd);
+    std::remove(temp_.c_str());
+    MQ_THROW(Error, path, ": cannot write: ", std::strerror(errno));
   }
-  if (!err && ::fsync(fd) != 0) err = errno;
-  // mkstemp creates mode 0600; give the file the usual permissions.
-  if (!err) {
-    const mode_t mask = ::umask(0);
-    ::umask(mask);
-    ::fchmod(fd, 0666 & ~mask);
+  buffer_.resize(kChunk + kSlack);
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (file_) std::fclose(file_);
+  if (!committed_) std::remove(temp_.c_str());
+}
+
+void AtomicOutputFile::commit_bytes(char* end) {
+  used_ = static_cast<size_t>(end - buffer_.data());
+  if (used_ >= kChunk) flush();
+}
+
+void AtomicOutputFile::append(const char* s, size_t n) {
+  if (used_ + n > buffer_.size()) flush();
+  if (n > buffer_.size()) {
+    write_raw(s, n);
+    return;
   }
-  if (::close(fd) != 0 && !err) err = errno;
-  if (!err && std::rename(temp.c_str(), path.c_str()) != 0) err = errno;
-  if (err) {
-    std::remove(temp.c_str());
-    MQ_THROW(Error, path, ": write failed: ", std::strerror(err));
-  }
+  std::memcpy(buffer_.data() + used_, s, n);
+  used_ += n;
+}
+
+void AtomicOutputFile::commit() {
+  flush();
+  const bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
+  const int err = errno;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed) MQ_THROW(Error, path_, ": cannot write: ", std::strerror(ok ? errno : err));
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+    MQ_THROW(Error, path_, ": cannot write: rename failed: ", std::strerror(errno));
+  committed_ = true;
+}
+
+void AtomicOutputFile::flush() {
+  write_raw(buffer_.data(), used_);
+  used_ = 0;
+}
+
+void AtomicOutputFile::write_raw(const char* s, size_t n) {
+  if (n > 0 && std::fwrite(s, 1, n, file_) != n)
+    MQ_THROW(Error, path_, ": cannot write: ", std::strerror(errno));
+}
+
+void write_file_atomically(const std::string& path, std::string_view bytes) {
+  AtomicOutputFile out(path);
+  out.append(bytes);
+  out.commit();
 }
 
 }  // namespace mq

@@ -2,13 +2,48 @@
 // file in the destination directory, which is renamed over the destination only when complete.
 #pragma once
 
+#include <cstdio>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace mq {
 
-// Writes `bytes` to `path` atomically. Throws Error naming the file on any I/O failure, in
-// which case `path` is unchanged and no temporary file remains.
+// Buffered output to a temporary file beside `path`, renamed over it by commit(). The
+// destructor removes the temporary file when commit() was not reached, so `path` is never left
+// partial. A new file gets mode 0644, a replaced one keeps its mode.
+// Throws Error naming `path` on any I/O failure; InvalidInput when `path` is a directory.
+class AtomicOutputFile {
+ public:
+  explicit AtomicOutputFile(const std::string& path);
+  AtomicOutputFile(const AtomicOutputFile&) = delete;
+  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+  ~AtomicOutputFile();
+
+  // Room for at least kSlack bytes at cursor(); advance with commit_bytes().
+  char* cursor() { return buffer_.data() + used_; }
+  void commit_bytes(char* end);
+  void append(const char* s, size_t n);
+  void append(std::string_view s) { append(s.data(), s.size()); }
+  // Flushes, syncs and renames the temporary file over `path`.
+  void commit();
+
+  static constexpr size_t kSlack = 1024;
+
+ private:
+  static constexpr size_t kChunk = size_t(1) << 22;
+  void flush();
+  void write_raw(const char* s, size_t n);
+
+  std::string path_;
+  std::string temp_;
+  std::FILE* file_ = nullptr;
+  std::vector<char> buffer_;
+  size_t used_ = 0;
+  bool committed_ = false;
+};
+
+// Writes `bytes` to `path` atomically (an AtomicOutputFile written at once).
 void write_file_atomically(const std::string& path, std::string_view bytes);
 
 }  // namespace mq

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 
@@ -688,90 +689,6 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
 
 // ---------------------------------------------------------------------------------------------
 // Writing
-
-// Buffered output to a temporary file beside `path`, renamed over it by commit(). The destructor
-// removes the temporary file when commit() was not reached, so `path` is never left partial.
-class AtomicOutputFile {
- public:
-  explicit AtomicOutputFile(const std::string& path) : path_(path) {
-    const std::filesystem::path target(path);
-    const std::filesystem::path dir =
-        target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-    std::string pattern = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
-    const int fd = ::mkstemp(pattern.data());
-    if (fd < 0)
-      MQ_THROW(Error, path, ": cannot write mesh: cannot create a file in '", dir.string(),
-               "': ", std::strerror(errno));
-    temp_ = pattern;
-    // mkstemp creates 0600; keep an existing file's mode, else the usual 0644.
-    struct stat st;
-    const mode_t mode = ::stat(path.c_str(), &st) == 0 ? (st.st_mode & 07777) : 0644;
-    ::fchmod(fd, mode);
-    file_ = ::fdopen(fd, "wb");
-    if (!file_) {
-      ::close(fd);
-      std::remove(temp_.c_str());
-      MQ_THROW(Error, path, ": cannot write mesh: ", std::strerror(errno));
-    }
-    buffer_.resize(kChunk + kSlack);
-  }
-  AtomicOutputFile(const AtomicOutputFile&) = delete;
-  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
-  ~AtomicOutputFile() {
-    if (file_) std::fclose(file_);
-    if (!committed_) std::remove(temp_.c_str());
-  }
-
-  // Room for at least kSlack bytes at cursor(); advance with commit_bytes().
-  char* cursor() { return buffer_.data() + used_; }
-  void commit_bytes(char* end) {
-    used_ = static_cast<size_t>(end - buffer_.data());
-    if (used_ >= kChunk) flush();
-  }
-  void append(const char* s, size_t n) {
-    if (used_ + n > buffer_.size()) flush();
-    if (n > buffer_.size()) {
-      write_raw(s, n);
-      return;
-    }
-    std::memcpy(buffer_.data() + used_, s, n);
-    used_ += n;
-  }
-  void append(const std::string& s) { append(s.data(), s.size()); }
-
-  void commit() {
-    flush();
-    const bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
-    const int err = errno;
-    const bool closed = std::fclose(file_) == 0;
-    file_ = nullptr;
-    if (!ok || !closed)
-      MQ_THROW(Error, path_, ": cannot write mesh: ", std::strerror(ok ? errno : err));
-    if (std::rename(temp_.c_str(), path_.c_str()) != 0)
-      MQ_THROW(Error, path_, ": cannot write mesh: rename failed: ", std::strerror(errno));
-    committed_ = true;
-  }
-
-  static constexpr size_t kSlack = 1024;
-
- private:
-  static constexpr size_t kChunk = size_t(1) << 22;
-  void flush() {
-    write_raw(buffer_.data(), used_);
-    used_ = 0;
-  }
-  void write_raw(const char* s, size_t n) {
-    if (n > 0 && std::fwrite(s, 1, n, file_) != n)
-      MQ_THROW(Error, path_, ": cannot write mesh: ", std::strerror(errno));
-  }
-
-  std::string path_;
-  std::string temp_;
-  std::FILE* file_ = nullptr;
-  std::vector<char> buffer_;
-  size_t used_ = 0;
-  bool committed_ = false;
-};
 
 inline char* put_double(char* out, double v, int precision) {
   // 17 significant digits already round-trip; more only adds noise.
