@@ -61,6 +61,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("min", em.element_area_min)
       .value("max", em.element_area_max)
       .end_object()
+      .value("coverage", em.coverage)
       .value("matched_point_offsets", s.matched_point_offsets);
   write_match_counts(j, s.counts);
   j.begin_object("stage_seconds");
@@ -153,9 +154,11 @@ int run_surface(int argc, char** argv, int first) {
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"));
   if (!run.quiet()) {
-    std::printf("wrote %s: %d faces, %d vertices, %d elements (shell height %.4g)\n",
-                out_path.c_str(), embedding_stats.faces, embedding_stats.vertices,
-                embedding_stats.elements, stats.shell_height);
+    std::printf(
+        "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
+        "covered\n",
+        out_path.c_str(), embedding_stats.faces, embedding_stats.vertices,
+        embedding_stats.elements, stats.shell_height, 100.0 * embedding_stats.coverage);
     if (!embedding_stats.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
                   embedding_stats.shell_map_failure.c_str());

@@ -9,6 +9,7 @@
 #include "core/mesh_intersections.h"
 #include "core/shell_embedding.h"
 #include "core/shell_map.h"
+#include "core/surface_coverage.h"
 
 namespace mq {
 
@@ -134,6 +135,10 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     stats.element_area_cv = mean > 0 ? std::sqrt(var) / mean : 0;
     stats.element_area_min = *std::min_element(areas.begin(), areas.end());
     stats.element_area_max = *std::max_element(areas.begin(), areas.end());
+  }
+  {
+    ScopedStageTimer timer(stats.times, "coverage");
+    stats.coverage = surface_coverage(quilt.input_base, out, 1.5 * quilt.shell_height);
   }
   if (stats_out) *stats_out = std::move(stats);
   return out;

@@ -542,7 +542,10 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       }
     }
     // Mark the patch faces now covered: their centroid lies inside the swatch footprint and away
-    // from the patch border by the margin (elements there were placed whole).
+    // from the patch border by the margin (elements there were placed whole), or under an
+    // element's footprint (it is covered, whichever patch placed the element). Without the
+    // second rule, faces near the margins of earlier patches became seeds of patches that
+    // could only re-match what was there: ~90% of the patches on the knight added nothing.
     for (size_t f = 0; f < patch.faces.size(); ++f) {
       Vector2d q = Vector2d::Zero();
       for (int k = 0; k < 3; ++k)
@@ -551,6 +554,18 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
           q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
           frame->distance_to_border(q) >= margin)
         mark(patch.faces[f]);
+      else if (!framed.elements_near(q, q).empty())
+        mark(patch.faces[f]);
+    }
+    // A patch that added nothing found a hole no swatch element fits into: give up on the
+    // faces around its seed, within half an element, instead of retrying them one by one.
+    if (counts.added + counts.replaced + counts.stitched == 0) {
+      for (size_t f = 0; f < patch.faces.size(); ++f) {
+        Vector2d q = Vector2d::Zero();
+        for (int k = 0; k < 3; ++k)
+          q += frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k)).transpose() / 3.0;
+        if (q.norm() <= 0.5 * max_element) mark(patch.faces[f]);
+      }
     }
     mark(seed);  // progress is guaranteed
     report_progress(progress, "quilting", num_done, nf);

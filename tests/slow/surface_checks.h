@@ -9,6 +9,7 @@
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/quilt_embedding.h"
+#include "core/surface_coverage.h"
 #include "core/surface_quilting.h"
 #include "core/tet_stretch.h"
 #include "core/translation_cost.h"
@@ -36,22 +37,6 @@ inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double
   TetStretchCpu stretch;
   run.output = embed_quilt(run.quilt, embedding, stretch, &run.embedding_stats);
   return run;
-}
-
-// Fraction of the base's area (sampled at face centroids and vertices, area weighted) that has
-// output geometry within `radius` (the issue's 1.5 shell heights).
-inline double surface_coverage(const TriMesh& base, const TriMesh& output, double radius) {
-  const ClosestPointQuery query(output.V, output.F);
-  const Eigen::VectorXd A = face_areas(base.V, base.F);
-  double covered = 0;
-  for (int f = 0; f < base.num_faces(); ++f) {
-    const Vector3d c =
-        (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
-            .transpose() /
-        3.0;
-    if (query.closest(c, radius).face >= 0) covered += A(f);
-  }
-  return covered / A.sum();
 }
 
 // The properties issue 4 asks of every surface result.

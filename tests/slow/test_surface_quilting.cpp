@@ -50,7 +50,7 @@ TEST(SurfaceQuilting, BaseWithBoundaryAndSeveralComponents) {
     (run.output.V(v, 0) < 5.0 ? on_first : on_second)++;
   EXPECT_GT(on_first, 0);
   EXPECT_GT(on_second, 0);
-  EXPECT_GE(test::surface_coverage(base, run.output, 1.5 * run.quilt.shell_height), 0.8);
+  EXPECT_GE(surface_coverage(base, run.output, 1.5 * run.quilt.shell_height), 0.8);
 }
 
 TEST(SurfaceQuilting, DeterministicAcrossThreadCounts) {
