@@ -41,6 +41,22 @@ MatrixX3d whole_cell_offsets(const Vector2d& t_min, const Vector2d& t_max, doubl
   return T;
 }
 
+namespace {
+
+// n evenly strided rows of P and NP (n < #P).
+void strided_subset(const MatrixX3d& P, const MatrixX3d& NP, Eigen::Index n, MatrixX3d& Ps,
+                    MatrixX3d& Ns) {
+  Ps.resize(n, 3);
+  Ns.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index k = i * P.rows() / n;
+    Ps.row(i) = P.row(k);
+    Ns.row(i) = NP.row(k);
+  }
+}
+
+}  // namespace
+
 OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
                            const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,
                            const Vector2d& t_min, const Vector2d& t_max, double cell_size,
@@ -54,13 +70,33 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
     return choice;
   }
   TranslationCostProblem problem;
+  problem.lambda = options.lambda;
+  // The candidates scored on all points: every one, or the best few of a screening pass.
+  MatrixX3d finalists = candidates;
+  if (options.screen_keep > 0 && options.screen_points > 0 &&
+      candidates.rows() > options.screen_keep && P.rows() > options.screen_points) {
+    strided_subset(P, NP, options.screen_points, problem.points, problem.point_normals);
+    problem.offsets = candidates;
+    const Eigen::VectorXd screen = evaluator.evaluate(swatch, problem);
+    choice.evaluations += static_cast<int>(screen.size());
+    choice.point_offsets += static_cast<long long>(screen.size()) * problem.points.rows();
+    std::vector<int> order(static_cast<size_t>(screen.size()));
+    for (int i = 0; i < screen.size(); ++i) order[static_cast<size_t>(i)] = i;
+    // Ties go to the lower index, so the finalists do not depend on the sort's internals.
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return screen(a) < screen(b); });
+    order.resize(static_cast<size_t>(options.screen_keep));
+    std::sort(order.begin(), order.end());  // candidate order, so ties resolve as without it
+    finalists.resize(options.screen_keep, 3);
+    for (int i = 0; i < options.screen_keep; ++i)
+      finalists.row(i) = candidates.row(order[static_cast<size_t>(i)]);
+  }
   problem.points = P;
   problem.point_normals = NP;
-  problem.lambda = options.lambda;
-  problem.offsets = candidates;
+  problem.offsets = finalists;
   const Eigen::VectorXd costs = evaluator.evaluate(swatch, problem);
-  choice.evaluations = static_cast<int>(costs.size());
-  choice.point_offsets = static_cast<long long>(costs.size()) * P.rows();
+  choice.evaluations += static_cast<int>(costs.size());
+  choice.point_offsets += static_cast<long long>(costs.size()) * P.rows();
   int best = best_offset(costs);
   if (options.epsilon > 0) {
     std::vector<int> near;
@@ -68,7 +104,7 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
       if (costs(i) <= costs(best) * (1 + options.epsilon)) near.push_back(i);
     best = near[rng() % near.size()];
   }
-  Vector3d t = candidates.row(best).transpose();
+  Vector3d t = finalists.row(best).transpose();
   double cost = costs(best);
   if (options.refine_to > 0) {
     // Compass search: try the four axis moves of the current step; move to the best improving
@@ -80,15 +116,7 @@ OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEval
     // matches a fixed, evenly strided subset of the sub-patch (its cost is then comparable
     // between the moves, which is all the search needs).
     if (P.rows() > options.refine_points) {
-      const Eigen::Index n = options.refine_points;
-      MatrixX3d Ps(n, 3), Ns(n, 3);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Eigen::Index k = i * P.rows() / n;
-        Ps.row(i) = P.row(k);
-        Ns.row(i) = NP.row(k);
-      }
-      problem.points = std::move(Ps);
-      problem.point_normals = std::move(Ns);
+      strided_subset(P, NP, options.refine_points, problem.points, problem.point_normals);
       problem.offsets = t.transpose();
       cost = evaluator.evaluate(swatch, problem)(0);  // the start point on the subset
       ++choice.evaluations;

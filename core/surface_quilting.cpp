@@ -409,7 +409,17 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   };
   std::mt19937_64 rng(options.seed);
   LocalPatchOptions patch_options;
-  patch_options.max_area = options.patch_area_factor * footprint_area;
+  {
+    // Automatic size: a disk whose radius reaches the farthest swatch corner of any admissible
+    // placement (the sub-patch window around the seed stays inside the swatch), so that the
+    // swatch lands on the patch wherever matching puts it; elements beyond the patch cannot be
+    // stored and are rejected.
+    const double half = 0.5 * window * cell;
+    const double reach = Vector2d(swatch.size.x() - half, swatch.size.y() - half).norm();
+    patch_options.max_area = options.patch_area_factor > 0
+                                 ? options.patch_area_factor * footprint_area
+                                 : 3.14159265358979 * reach * reach;
+  }
   patch_options.max_distortion = options.max_distortion;
   const MatrixX3d base_normals = vertex_normals(base.V, base.F);
   const ClosestPointQuery base_query(base.V, base.F);

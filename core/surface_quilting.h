@@ -43,9 +43,10 @@ struct SurfaceQuiltingOptions {
   // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
   MatrixX3d field;
   // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
-  // threshold"); a patch whose area distortion exceeds max_distortion is shrunk (paper: 4),
-  // judged by the 95th percentile of its faces' distortion.
-  double patch_area_factor = 1.5;
+  // threshold"); 0: a disk reaching the farthest swatch corner of any admissible placement. A
+  // patch whose area distortion exceeds max_distortion is shrunk (paper: 4), judged by the 95th
+  // percentile of its faces' distortion.
+  double patch_area_factor = 0;
   double max_distortion = 4.0;
   double subpatch_fraction = 0.5;  // as for planar quilting
   // Fewer sub-patch points and a coarser sub-cell refinement than on the plane: a conformal

@@ -17,6 +17,7 @@ TetStretchOpenCL::TetStretchOpenCL(std::shared_ptr<cl::Runtime> runtime)
   cl_int err = CL_SUCCESS;
   kernel_ = cl::Kernel(clCreateKernel(program, "tet_stretch", &err));
   MQ_CL_CHECK(err);
+  group_ = cl::work_group_size(kernel_.get(), runtime_->device());
 }
 
 Eigen::VectorXd TetStretchOpenCL::per_tet(const StretchProblem& pb) {
@@ -51,8 +52,8 @@ Eigen::VectorXd TetStretchOpenCL::per_tet(const StretchProblem& pb) {
   cl::set_arg(k, 2, tets_buffer_.get());
   cl::set_arg(k, 3, cl_int(nt));
   cl::set_arg(k, 4, out_buffer_.get());
-  const std::size_t global = nt;
-  MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr));
+  const std::size_t global = cl::padded(nt, group_), local = group_;
+  MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 1, nullptr, &global, &local, 0, nullptr, nullptr));
   MQ_CL_CHECK(clEnqueueReadBuffer(queue, out_buffer_.get(), CL_TRUE, 0, sizeof(double) * nt,
                                   out.data(), 0, nullptr, nullptr));
   return out;

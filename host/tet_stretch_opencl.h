@@ -33,6 +33,7 @@ class TetStretchOpenCL final : public TetStretchEvaluator {
  private:
   std::shared_ptr<cl::Runtime> runtime_;
   cl::Kernel kernel_;
+  std::size_t group_ = 1;  // work-group size
   // Host copies of what the device buffers hold.
   MatrixX3d shell_V_;
   TetIndices T_;

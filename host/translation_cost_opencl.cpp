@@ -33,6 +33,7 @@ TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtim
   cl_int err = CL_SUCCESS;
   kernel_ = cl::Kernel(clCreateKernel(program, "translation_cost_minima", &err));
   MQ_CL_CHECK(err);
+  group_ = cl::work_group_size(kernel_.get(), runtime_->device());
 }
 
 const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
@@ -94,8 +95,9 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
     const std::size_t nt = std::min(chunk, T - t0);
     const cl::Buffer offsets = upload_array(ctx, problem.offsets.data() + 3 * t0, 3 * nt);
     cl::set_arg(k, 2, offsets.get());
-    const std::size_t global[2] = {P, nt};
-    MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 2, nullptr, global, nullptr, 0, nullptr, nullptr));
+    const std::size_t global[2] = {cl::padded(P, group_), nt};
+    const std::size_t local[2] = {group_, 1};
+    MQ_CL_CHECK(clEnqueueNDRangeKernel(queue, k, 2, nullptr, global, local, 0, nullptr, nullptr));
     MQ_CL_CHECK(clEnqueueReadBuffer(queue, out.get(), CL_TRUE, 0, sizeof(double) * P * nt,
                                     minima.data(), 0, nullptr, nullptr));
     // Eq. (3), in point order as on the CPU.

@@ -41,6 +41,7 @@ class TranslationCostOpenCL final : public TranslationCostEvaluator {
 
   std::shared_ptr<cl::Runtime> runtime_;
   cl::Kernel kernel_;
+  std::size_t group_ = 1;  // work-group size along the points
   std::map<std::uint64_t, DeviceGrid> grids_;
 };
 

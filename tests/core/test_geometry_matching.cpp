@@ -79,7 +79,8 @@ TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
   ASSERT_GT(P.rows(), 50);
   MatchingOptions options;
   options.lambda = 1.0 / fx.cell;
-  options.refine_to = 0;  // whole cells only
+  options.refine_to = 0;   // whole cells only
+  options.screen_keep = 0;  // every candidate on every point
   std::mt19937_64 rng(1);
   const MatrixX3d T = fx.candidates(-2, 8);
   const OffsetChoice c = choose_offset(grid, cpu, P, NP, T, Vector2d(-2, -2) * fx.cell,
@@ -103,6 +104,32 @@ TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
       EXPECT_GT(costs(i), 1.05 * c.cost) << "offset " << T.row(i);
     }
   EXPECT_GT(off_period, 100);
+}
+
+TEST(GeometryMatching, ScreeningKeepsTheExhaustiveChoiceAtAFractionOfTheWork) {
+  const PeriodicFixture fx;
+  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatrixX3d P, NP;
+  const Vector3d shift(fx.px(), fx.py(), 0);
+  fx.subpatch(2.0, 4.0, 1.5, 3.0, shift, P, NP);
+  MatchingOptions options;
+  options.lambda = 1.0 / fx.cell;
+  options.refine_to = 0;
+  options.screen_points = 32;
+  options.screen_keep = 4;
+  ASSERT_GT(P.rows(), options.screen_points);
+  const MatrixX3d T = fx.candidates(-2, 8);
+  std::mt19937_64 rng(1);
+  const OffsetChoice screened = choose_offset(grid, cpu, P, NP, T, Vector2d(-2, -2) * fx.cell,
+                                              Vector2d(8, 8) * fx.cell, fx.cell, options, rng);
+  options.screen_keep = 0;
+  const OffsetChoice exhaustive = choose_offset(grid, cpu, P, NP, T, Vector2d(-2, -2) * fx.cell,
+                                                Vector2d(8, 8) * fx.cell, fx.cell, options, rng);
+  EXPECT_EQ(screened.offset, exhaustive.offset);
+  EXPECT_DOUBLE_EQ(screened.cost, exhaustive.cost);  // the finalists are scored on every point
+  EXPECT_EQ(screened.point_offsets, T.rows() * 32 + 4 * P.rows());
+  EXPECT_LT(screened.point_offsets, exhaustive.point_offsets / 5);
 }
 
 TEST(GeometryMatching, RefinementRecoversASubCellShift) {
