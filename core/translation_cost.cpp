@@ -81,12 +81,11 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
            "swatch distance grid: cell size must be finite and >= 0, got ", cell_size);
   num_faces_ = static_cast<int>(F.rows());
 
-  triangles_.resize(9 * F.rows());
+  std::vector<double> triangles(9 * static_cast<std::size_t>(F.rows()));
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a) triangles_[9 * f + 3 * k + a] = V(F(f, k), a);
+      for (int a = 0; a < 3; ++a) triangles[9 * f + 3 * k + a] = V(F(f, k), a);
   const MatrixX3d FN = mq::face_normals(V, F);
-  face_normals_.assign(FN.data(), FN.data() + FN.size());
 
   const BoundingBox box = bounding_box(V, F);
   const Vector3d extent = box.extent();
@@ -111,15 +110,18 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
   for (int a = 0; a < 3; ++a) dims_(a) = static_cast<int>(std::max(1.0, std::ceil(extent(a) / h)));
 
   // Bin each face's bounding box into the cells it meets (CSR, two passes).
-  auto cell_range = [&](Eigen::Index f, Eigen::Vector3i& lo, Eigen::Vector3i& hi) {
+  auto face_box = [&](Eigen::Index f, Vector3d& mn, Vector3d& mx) {
     for (int a = 0; a < 3; ++a) {
-      double mn = kInf, mx = -kInf;
-      for (int k = 0; k < 3; ++k) {
-        mn = std::min(mn, triangles_[9 * f + 3 * k + a]);
-        mx = std::max(mx, triangles_[9 * f + 3 * k + a]);
-      }
-      lo(a) = std::clamp(static_cast<int>(std::floor((mn - origin_(a)) / h)), 0, dims_(a) - 1);
-      hi(a) = std::clamp(static_cast<int>(std::floor((mx - origin_(a)) / h)), 0, dims_(a) - 1);
+      mn(a) = std::min({triangles[9 * f + a], triangles[9 * f + 3 + a], triangles[9 * f + 6 + a]});
+      mx(a) = std::max({triangles[9 * f + a], triangles[9 * f + 3 + a], triangles[9 * f + 6 + a]});
+    }
+  };
+  auto cell_range = [&](Eigen::Index f, Eigen::Vector3i& lo, Eigen::Vector3i& hi) {
+    Vector3d mn, mx;
+    face_box(f, mn, mx);
+    for (int a = 0; a < 3; ++a) {
+      lo(a) = std::clamp(static_cast<int>(std::floor((mn(a) - origin_(a)) / h)), 0, dims_(a) - 1);
+      hi(a) = std::clamp(static_cast<int>(std::floor((mx(a) - origin_(a)) / h)), 0, dims_(a) - 1);
     }
   };
   const int num_cells = dims_.prod();
@@ -142,16 +144,55 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
           cell_faces_[count[(z * dims_(1) + y) * dims_(0) + x]++] = static_cast<int>(f);
   }
 
+  // Per-entry copies of the face data, in cell order.
+  const std::size_t E = cell_faces_.size();
+  entry_triangles_.resize(9 * E);
+  entry_normals_.assign(4 * E, 0.0);
+  entry_spheres_.resize(4 * E);
+  for (std::size_t j = 0; j < E; ++j) {
+    const int f = cell_faces_[j];
+    std::copy_n(&triangles[9 * static_cast<std::size_t>(f)], 9, &entry_triangles_[9 * j]);
+    for (int a = 0; a < 3; ++a) entry_normals_[4 * j + a] = FN(f, a);
+    const double* t = &triangles[9 * static_cast<std::size_t>(f)];
+    const Vector3d pa(t[0], t[1], t[2]), pb(t[3], t[4], t[5]), pc(t[6], t[7], t[8]);
+    const Vector3d m = (pa + pb + pc) / 3.0;
+    const double r = std::max({(pa - m).norm(), (pb - m).norm(), (pc - m).norm()});
+    for (int a = 0; a < 3; ++a) entry_spheres_[4 * j + a] = m(a);
+    // Enlarged so that rounding never lets the sphere bound exceed a true distance.
+    entry_spheres_[4 * j + 3] = r * (1 + 1e-12) + 1e-12 * h;
+  }
+
+  // Per-cell box of its faces' parts and normal cone.
+  cell_boxes_.assign(8 * std::size_t(num_cells), 0.0);
   cell_cones_.assign(4 * std::size_t(num_cells), 0.0);
   for (int c = 0; c < num_cells; ++c) {
+    const int cx = c % dims_(0), cy = (c / dims_(0)) % dims_(1), cz = c / (dims_(0) * dims_(1));
+    const Vector3d cell_lo = origin_ + h * Vector3d(cx, cy, cz);
+    const Vector3d cell_hi = cell_lo + Vector3d::Constant(h);
+    Vector3d bmin = Vector3d::Constant(kInf), bmax = Vector3d::Constant(-kInf);
     Vector3d mean = Vector3d::Zero();
-    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j)
-      mean += Vector3d(&face_normals_[3 * cell_faces_[j]]);
+    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j) {
+      Vector3d mn, mx;
+      face_box(cell_faces_[j], mn, mx);
+      // The face's box clipped to the cell (cells on the grid border keep what lies beyond,
+      // since faces there are clamped in).
+      for (int a = 0; a < 3; ++a) {
+        const int i = a == 0 ? cx : (a == 1 ? cy : cz);
+        const double clo = i == 0 ? -kInf : cell_lo(a), chi = i == dims_(a) - 1 ? kInf : cell_hi(a);
+        bmin(a) = std::min(bmin(a), std::max(mn(a), clo));
+        bmax(a) = std::max(bmax(a), std::min(mx(a), chi));
+      }
+      mean += Vector3d(&entry_normals_[4 * j]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      cell_boxes_[8 * c + a] = bmin(a);
+      cell_boxes_[8 * c + 4 + a] = bmax(a);
+    }
     const double len = mean.norm();
     const Vector3d dir = len > 1e-12 ? Vector3d(mean / len) : Vector3d::Zero();
     double r = 0.0;
     for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j)
-      r = std::max(r, (Vector3d(&face_normals_[3 * cell_faces_[j]]) - dir).norm());
+      r = std::max(r, (Vector3d(&entry_normals_[4 * j]) - dir).norm());
     // Slightly enlarged so that rounding never makes the bound exceed a face's true factor.
     cell_cones_[4 * c + 0] = dir(0);
     cell_cones_[4 * c + 1] = dir(1);
@@ -163,10 +204,12 @@ SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, d
   fnv1a(fp, origin_.data(), sizeof(double) * 3);
   fnv1a(fp, &cell_size_, sizeof(double));
   fnv1a(fp, dims_.data(), sizeof(int) * 3);
-  fnv1a(fp, triangles_.data(), sizeof(double) * triangles_.size());
-  fnv1a(fp, face_normals_.data(), sizeof(double) * face_normals_.size());
   fnv1a(fp, cell_start_.data(), sizeof(int) * cell_start_.size());
   fnv1a(fp, cell_faces_.data(), sizeof(int) * cell_faces_.size());
+  fnv1a(fp, entry_triangles_.data(), sizeof(double) * entry_triangles_.size());
+  fnv1a(fp, entry_normals_.data(), sizeof(double) * entry_normals_.size());
+  fnv1a(fp, entry_spheres_.data(), sizeof(double) * entry_spheres_.size());
+  fnv1a(fp, cell_boxes_.data(), sizeof(double) * cell_boxes_.size());
   fnv1a(fp, cell_cones_.data(), sizeof(double) * cell_cones_.size());
   fingerprint_ = fp;
 }
@@ -184,7 +227,7 @@ double SwatchDistanceGrid::min_face_cost(const Vector3d& q, const Vector3d& n,
   // Distance (in cells) from q to the slab of cell i along axis a.
   auto gap = [&](int a, int i) { return std::max(0.0, std::max(i - g[a], g[a] - (i + 1))); };
   // A tiny slack keeps the bounds below the true distances despite rounding.
-  const double slack = 1e-9;
+  const double slack = 1e-9 * h;
   double best = kInf;
   for (int k = 0;; ++k) {
     if (k > 0) {
@@ -195,14 +238,12 @@ double SwatchDistanceGrid::min_face_cost(const Vector3d& q, const Vector3d& n,
           if (i >= 0 && i < dims_(a)) lb = std::min(lb, gap(a, i));
         }
       if (lb == kInf) break;  // the ring lies outside the grid: every cell was visited
-      if (1.0 + lambda * (lb - slack) * h >= best) break;
+      if (1.0 + lambda * (lb * h - slack) >= best) break;
     }
     const int x0 = std::max(0, c[0] - k), x1 = std::min(dims_(0) - 1, c[0] + k);
     const int y0 = std::max(0, c[1] - k), y1 = std::min(dims_(1) - 1, c[1] + k);
     for (int x = x0; x <= x1; ++x) {
-      const double gx = gap(0, x);
       for (int y = y0; y <= y1; ++y) {
-        const double gy = gap(1, y);
         const bool shell = std::abs(x - c[0]) == k || std::abs(y - c[1]) == k;
         // Inside the ring's x/y shell every z is on the ring; otherwise only the two z caps.
         const int zs[2] = {c[2] - k, c[2] + k};
@@ -211,21 +252,42 @@ double SwatchDistanceGrid::min_face_cost(const Vector3d& q, const Vector3d& n,
         for (int zi = z0; zi <= z1; ++zi) {
           const int z = shell ? zi : zs[zi];
           if (z < 0 || z >= dims_(2)) continue;
-          const double gz = gap(2, z);
-          const double dist_factor =
-              1.0 + lambda * (std::sqrt(gx * gx + gy * gy + gz * gz) - slack) * h;
-          if (dist_factor >= best) continue;
           const int cell = (z * dims_(1) + y) * dims_(0) + x;
+          const int j0 = cell_start_[cell], j1 = cell_start_[cell + 1];
+          if (j0 == j1) continue;
+          const double* bx = &cell_boxes_[8 * cell];
+          double d2 = 0.0;
+          for (int a = 0; a < 3; ++a) {
+            const double e = std::max(0.0, std::max(bx[a] - q(a), q(a) - bx[4 + a]));
+            d2 += e * e;
+          }
+          const double dist_factor = 1.0 + lambda * (std::sqrt(d2) - slack);
+          if (dist_factor >= best) continue;
           const double* cone = &cell_cones_[4 * cell];
           const double cx = n(0) - cone[0], cy = n(1) - cone[1], cz = n(2) - cone[2];
           const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
           if (dist_factor * (1.0 + std::max(0.0, cone_lb)) >= best) continue;
-          for (int j = cell_start_[cell]; j < cell_start_[cell + 1]; ++j) {
-            const int f = cell_faces_[j];
-            const double nf = normal_factor(n, &face_normals_[3 * f]);
-            if (dist_factor * nf >= best) continue;
-            const double d2 = triangle_dist2(q, &triangles_[9 * f]);
-            best = std::min(best, (1.0 + lambda * std::sqrt(d2)) * nf);  // face_cost
+          // Normal factor bound without a square root: skip an entry when
+          // |n - n_f| >= best / df - 1 (updated whenever best improves).
+          double r = best / dist_factor - 1.0;
+          double r2 = r * r * (1.0 + 1e-12);
+          for (int j = j0; j < j1; ++j) {
+            const double* fn = &entry_normals_[4 * j];
+            const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
+            const double dn2 = nx * nx + ny * ny + nz * nz;
+            if (dn2 >= r2) continue;
+            const double nf = 1.0 + std::sqrt(dn2);
+            const double* sp = &entry_spheres_[4 * j];
+            const double sx = q(0) - sp[0], sy = q(1) - sp[1], sz = q(2) - sp[2];
+            const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp[3];
+            if ((1.0 + lambda * (sphere_lb - slack)) * nf >= best) continue;
+            const double dist2 = triangle_dist2(q, &entry_triangles_[9 * j]);
+            const double cost = (1.0 + lambda * std::sqrt(dist2)) * nf;  // face_cost
+            if (cost < best) {
+              best = cost;
+              r = best / dist_factor - 1.0;
+              r2 = r * r * (1.0 + 1e-12);
+            }
           }
         }
       }

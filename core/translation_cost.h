@@ -30,9 +30,11 @@ struct TranslationCostProblem {
 // NaN/inf entries, negative or non-finite lambda).
 void validate_translation_cost_problem(const TranslationCostProblem& problem);
 
-// The swatch side of Eq. (2), precomputed once and queried for many points: faces, unit face
-// normals and a uniform grid whose cells list every face whose bounding box meets them.
-// The flat arrays are laid out for direct upload to an OpenCL device.
+// The swatch side of Eq. (2), precomputed once and queried for many points: a uniform grid whose
+// cells list every face whose bounding box meets them. Each listing ("entry") carries its own
+// copy of the face's corners, unit normal and bounding sphere, in cell order, so that a query
+// streams through memory instead of chasing face indices. The flat arrays are laid out for
+// direct upload to an OpenCL device.
 class SwatchDistanceGrid {
  public:
   // V #V by 3 swatch vertices, F #F by 3 faces (at least one), cell_size > 0 or 0 for an
@@ -45,23 +47,32 @@ class SwatchDistanceGrid {
   // query point q = v - t. Exact: cells are visited ring by ring around q's cell and the
   // search stops once a ring's distance lower bound d satisfies 1 + lambda * d >= best,
   // which no face beyond can beat because the normal factor is >= 1. Within the rings a cell
-  // is skipped when its distance bound times its normal-cone bound cannot beat best, and a
-  // face when the cell's distance bound times the face's exact normal factor cannot.
+  // is skipped when the distance to the box of its faces' parts times its normal-cone bound
+  // cannot beat best; an entry when its normal factor (tested without a square root) times
+  // that distance bound cannot, or when its bounding sphere's distance cannot; only then is
+  // the exact point-triangle distance computed.
   double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda) const;
 
   int num_faces() const { return num_faces_; }
   int num_cells() const { return dims_.prod(); }
+  int num_entries() const { return static_cast<int>(cell_faces_.size()); }
   const Vector3d& origin() const { return origin_; }
   double cell_size() const { return cell_size_; }
   // Cells per axis; cell (ix, iy, iz) has index (iz * ny + iy) * nx + ix.
   const Eigen::Vector3i& dims() const { return dims_; }
-  // #F * 9: the corners a, b, c of face f at [9f, 9f + 9).
-  const std::vector<double>& triangles() const { return triangles_; }
-  // #F * 3: unit face normals (zero for degenerate faces).
-  const std::vector<double>& face_normals() const { return face_normals_; }
-  // #cells + 1: faces of cell c are cell_faces()[cell_start()[c] .. cell_start()[c + 1]).
+  // #cells + 1: the entries of cell c are [cell_start()[c], cell_start()[c + 1]).
   const std::vector<int>& cell_start() const { return cell_start_; }
+  // #entries: the face index of each entry.
   const std::vector<int>& cell_faces() const { return cell_faces_; }
+  // #entries * 9: the corners a, b, c of each entry's face.
+  const std::vector<double>& entry_triangles() const { return entry_triangles_; }
+  // #entries * 4: unit face normal (zero for a degenerate face) and 0 padding.
+  const std::vector<double>& entry_normals() const { return entry_normals_; }
+  // #entries * 4: a sphere (centre, radius) holding the face.
+  const std::vector<double>& entry_spheres() const { return entry_spheres_; }
+  // #cells * 8: per cell the box (min xyz, 0, max xyz, 0) of the parts of its faces' bounding
+  // boxes inside the cell (empty cells: an inverted box, never read).
+  const std::vector<double>& cell_boxes() const { return cell_boxes_; }
   // #cells * 4: per cell a direction c and radius r with |n(f) - c| <= r for its faces, so
   // |n - n(f)| >= |n - c| - r bounds the normal factor of the whole cell.
   const std::vector<double>& cell_normal_cones() const { return cell_cones_; }
@@ -74,10 +85,12 @@ class SwatchDistanceGrid {
   Vector3d origin_ = Vector3d::Zero();
   double cell_size_ = 1.0;
   Eigen::Vector3i dims_ = Eigen::Vector3i::Ones();
-  std::vector<double> triangles_;
-  std::vector<double> face_normals_;
   std::vector<int> cell_start_;
   std::vector<int> cell_faces_;
+  std::vector<double> entry_triangles_;
+  std::vector<double> entry_normals_;
+  std::vector<double> entry_spheres_;
+  std::vector<double> cell_boxes_;
   std::vector<double> cell_cones_;
   std::uint64_t fingerprint_ = 0;
 };

@@ -43,10 +43,12 @@ const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
   if (grids_.size() >= kMaxCachedGrids) grids_.clear();
   const cl_context ctx = runtime_->context();
   DeviceGrid d;
-  d.triangles = upload_array(ctx, grid.triangles().data(), grid.triangles().size());
-  d.face_normals = upload_array(ctx, grid.face_normals().data(), grid.face_normals().size());
+  d.entry_triangles =
+      upload_array(ctx, grid.entry_triangles().data(), grid.entry_triangles().size());
+  d.entry_normals = upload_array(ctx, grid.entry_normals().data(), grid.entry_normals().size());
+  d.entry_spheres = upload_array(ctx, grid.entry_spheres().data(), grid.entry_spheres().size());
   d.cell_start = upload_array(ctx, grid.cell_start().data(), grid.cell_start().size());
-  d.cell_faces = upload_array(ctx, grid.cell_faces().data(), grid.cell_faces().size());
+  d.cell_boxes = upload_array(ctx, grid.cell_boxes().data(), grid.cell_boxes().size());
   d.cell_cones =
       upload_array(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
   return grids_.emplace(grid.fingerprint(), std::move(d)).first->second;
@@ -74,21 +76,22 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
   const cl_kernel k = kernel_.get();
   cl::set_arg(k, 0, points.get());
   cl::set_arg(k, 1, normals.get());
-  cl::set_arg(k, 3, dg.triangles.get());
-  cl::set_arg(k, 4, dg.face_normals.get());
-  cl::set_arg(k, 5, dg.cell_start.get());
-  cl::set_arg(k, 6, dg.cell_faces.get());
-  cl::set_arg(k, 7, dg.cell_cones.get());
-  cl::set_arg(k, 8, grid.origin()(0));
-  cl::set_arg(k, 9, grid.origin()(1));
-  cl::set_arg(k, 10, grid.origin()(2));
-  cl::set_arg(k, 11, grid.cell_size());
-  cl::set_arg(k, 12, cl_int(grid.dims()(0)));
-  cl::set_arg(k, 13, cl_int(grid.dims()(1)));
-  cl::set_arg(k, 14, cl_int(grid.dims()(2)));
-  cl::set_arg(k, 15, problem.lambda);
-  cl::set_arg(k, 16, cl_int(P));
-  cl::set_arg(k, 17, out.get());
+  cl::set_arg(k, 3, dg.entry_triangles.get());
+  cl::set_arg(k, 4, dg.entry_normals.get());
+  cl::set_arg(k, 5, dg.entry_spheres.get());
+  cl::set_arg(k, 6, dg.cell_start.get());
+  cl::set_arg(k, 7, dg.cell_boxes.get());
+  cl::set_arg(k, 8, dg.cell_cones.get());
+  cl::set_arg(k, 9, grid.origin()(0));
+  cl::set_arg(k, 10, grid.origin()(1));
+  cl::set_arg(k, 11, grid.origin()(2));
+  cl::set_arg(k, 12, grid.cell_size());
+  cl::set_arg(k, 13, cl_int(grid.dims()(0)));
+  cl::set_arg(k, 14, cl_int(grid.dims()(1)));
+  cl::set_arg(k, 15, cl_int(grid.dims()(2)));
+  cl::set_arg(k, 16, problem.lambda);
+  cl::set_arg(k, 17, cl_int(P));
+  cl::set_arg(k, 18, out.get());
 
   std::vector<double> minima(P * chunk);
   for (std::size_t t0 = 0; t0 < T; t0 += chunk) {

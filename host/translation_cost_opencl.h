@@ -35,7 +35,7 @@ class TranslationCostOpenCL final : public TranslationCostEvaluator {
 
  private:
   struct DeviceGrid {
-    cl::Buffer triangles, face_normals, cell_start, cell_faces, cell_cones;
+    cl::Buffer entry_triangles, entry_normals, entry_spheres, cell_start, cell_boxes, cell_cones;
   };
   const DeviceGrid& upload(const SwatchDistanceGrid& grid);
 

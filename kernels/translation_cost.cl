@@ -61,17 +61,18 @@ static real triangle_dist2(real3 p, real3 a, real3 b, real3 c) {
 static real cell_gap(real g, int i) { return fmax((real)0, fmax(i - g, g - (i + 1))); }
 
 __kernel void translation_cost_minima(
-    __global const real* points,        // #P * 3
-    __global const real* point_normals, // #P * 3
-    __global const real* offsets,       // #T * 3, starting at this launch's first offset
-    __global const real* triangles,     // #F * 9
-    __global const real* face_normals,  // #F * 3
-    __global const int* cell_start,     // #cells + 1
-    __global const int* cell_faces,
-    __global const real* cell_cones,    // #cells * 4: normal cone (direction, radius)
+    __global const real* points,          // #P * 3
+    __global const real* point_normals,   // #P * 3
+    __global const real* offsets,         // #T * 3, starting at this launch's first offset
+    __global const real* entry_triangles, // #entries * 9, in cell order
+    __global const real* entry_normals,   // #entries * 4: unit face normal, 0
+    __global const real* entry_spheres,   // #entries * 4: centre, radius
+    __global const int* cell_start,       // #cells + 1
+    __global const real* cell_boxes,      // #cells * 8: box of the cell's face parts
+    __global const real* cell_cones,      // #cells * 4: normal cone (direction, radius)
     const real origin_x, const real origin_y, const real origin_z, const real h,
     const int nx, const int ny, const int nz, const real lambda, const int num_points,
-    __global real* out) {                // #T * #P
+    __global real* out) {                  // #T * #P
   const int p = get_global_id(0);
   const int t = get_global_id(1);
   if (p >= num_points) return;
@@ -81,7 +82,7 @@ __kernel void translation_cost_minima(
   const real g[3] = {(q.x - origin_x) / h, (q.y - origin_y) / h, (q.z - origin_z) / h};
   int c[3];
   for (int a = 0; a < 3; ++a) c[a] = (int)clamp(floor(g[a]), (real)0, (real)(dims[a] - 1));
-  const real slack = 1e-9;
+  const real slack = 1e-9 * h;
   real best = INFINITY;
   for (int k = 0;; ++k) {
     if (k > 0) {
@@ -92,36 +93,48 @@ __kernel void translation_cost_minima(
           if (i >= 0 && i < dims[a]) lb = fmin(lb, cell_gap(g[a], i));
         }
       if (lb == INFINITY) break;
-      if (1 + lambda * (lb - slack) * h >= best) break;
+      if (1 + lambda * (lb * h - slack) >= best) break;
     }
     const int x0 = max(0, c[0] - k), x1 = min(nx - 1, c[0] + k);
     const int y0 = max(0, c[1] - k), y1 = min(ny - 1, c[1] + k);
     for (int x = x0; x <= x1; ++x) {
-      const real gx = cell_gap(g[0], x);
       for (int y = y0; y <= y1; ++y) {
-        const real gy = cell_gap(g[1], y);
         const bool shell = abs(x - c[0]) == k || abs(y - c[1]) == k;
         const int z0 = shell ? max(0, c[2] - k) : 0;
         const int z1 = shell ? min(nz - 1, c[2] + k) : (k > 0 ? 1 : 0);
         for (int zi = z0; zi <= z1; ++zi) {
           const int z = shell ? zi : (zi == 0 ? c[2] - k : c[2] + k);
           if (z < 0 || z >= nz) continue;
-          const real gz = cell_gap(g[2], z);
-          const real dist_factor = 1 + lambda * (sqrt(gx * gx + gy * gy + gz * gz) - slack) * h;
-          if (dist_factor >= best) continue;
           const int cell = (z * ny + y) * nx + x;
+          const int j0 = cell_start[cell], j1 = cell_start[cell + 1];
+          if (j0 == j1) continue;
+          const real3 blo = vload3(0, cell_boxes + 8 * cell);
+          const real3 bhi = vload3(0, cell_boxes + 8 * cell + 4);
+          const real3 e = fmax((real3)(0), fmax(blo - q, q - bhi));
+          const real dist_factor = 1 + lambda * (sqrt(e.x * e.x + e.y * e.y + e.z * e.z) - slack);
+          if (dist_factor >= best) continue;
           const real3 dc = n - vload3(0, cell_cones + 4 * cell);
           const real cone_lb = sqrt(dc.x * dc.x + dc.y * dc.y + dc.z * dc.z) - cell_cones[4 * cell + 3];
           if (dist_factor * (1 + fmax((real)0, cone_lb)) >= best) continue;
-          for (int j = cell_start[cell]; j < cell_start[cell + 1]; ++j) {
-            const int f = cell_faces[j];
-            const real3 dn = n - vload3(f, face_normals);
-            const real nf = 1 + sqrt(dn.x * dn.x + dn.y * dn.y + dn.z * dn.z);
-            if (dist_factor * nf >= best) continue;
-            const real d2 = triangle_dist2(q, vload3(3 * f, triangles),
-                                           vload3(3 * f + 1, triangles),
-                                           vload3(3 * f + 2, triangles));
-            best = fmin(best, (1 + lambda * sqrt(d2)) * nf);
+          real r = best / dist_factor - 1;
+          real r2 = r * r * (1 + 1e-12);
+          for (int j = j0; j < j1; ++j) {
+            const real3 dn = n - vload3(0, entry_normals + 4 * j);
+            const real dn2 = dn.x * dn.x + dn.y * dn.y + dn.z * dn.z;
+            if (dn2 >= r2) continue;
+            const real nf = 1 + sqrt(dn2);
+            const real3 ds = q - vload3(0, entry_spheres + 4 * j);
+            const real sphere_lb = sqrt(ds.x * ds.x + ds.y * ds.y + ds.z * ds.z) - entry_spheres[4 * j + 3];
+            if ((1 + lambda * (sphere_lb - slack)) * nf >= best) continue;
+            const real d2 = triangle_dist2(q, vload3(3 * j, entry_triangles),
+                                           vload3(3 * j + 1, entry_triangles),
+                                           vload3(3 * j + 2, entry_triangles));
+            const real cost = (1 + lambda * sqrt(d2)) * nf;
+            if (cost < best) {
+              best = cost;
+              r = best / dist_factor - 1;
+              r2 = r * r * (1 + 1e-12);
+            }
           }
         }
       }
