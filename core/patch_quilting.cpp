@@ -83,18 +83,51 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     counts.relations += static_cast<long long>(corr.relations.size());
   }
 
+  // Partners of each swatch element. Relations carried by only a few pairs next to a strong one
+  // come from elements that merely touch it (crossing threads of a weave, neighbouring rings):
+  // they are not the same element and are ignored.
+  std::map<std::pair<int, int>, int> pair_count;
+  for (const VertexFacePair& p : corr.pairs) ++pair_count[{p.out_element, p.in_element}];
+  std::vector<int> strongest(moved.size(), 0);
+  for (const auto& [rel, n] : pair_count)
+    strongest[rel.second] = std::max(strongest[rel.second], n);
+  std::vector<std::vector<int>> partners(moved.size());
+  for (const auto& [k, i] : corr.relations)
+    if (4 * pair_count[{k, i}] >= strongest[i]) partners[i].push_back(k);
+
+  // Only elements that step 5 may merge need deforming: a swatch element with a live partner that
+  // is not inside the overlap (inside ones are dropped), and an output element that is the one
+  // crossing partner of such a swatch element (a stitch candidate). On chain mail most related
+  // elements are dropped or kept, and deforming them all took as long as everything else.
+  std::vector<char> deform_in(moved.size(), 0), deform_out(frame.size(), 0);
+  for (size_t i = 0; i < moved.size(); ++i) {
+    std::vector<int> crossing;
+    bool any = false;
+    for (const int k : partners[i]) {
+      if (!output.alive(near[k])) continue;
+      any = true;
+      if (!inside(frame[k], region)) crossing.push_back(k);
+    }
+    if (!any || inside(moved[i], region)) continue;
+    deform_in[i] = 1;
+    if (crossing.size() == 1) deform_out[crossing[0]] = 1;
+  }
+
   // Step 4 (section 2.6): deform both sides of every relation towards the averaged points.
   std::map<int, Element> deformed_out;  // local index -> deformed copy
   {
     ScopedStageTimer timer(times, "deformation");
     std::map<int, std::vector<LinearConstraint>> out_constraints, in_constraints;
     for (const VertexFacePair& p : corr.pairs) {
+      if (!deform_out[p.out_element] && !deform_in[p.in_element]) continue;
       const Vector3d v = frame[p.out_element].V.row(p.out_vertex).transpose();
       const Vector3d target = 0.5 * (v + p.closest);
-      out_constraints[p.out_element].push_back(LinearConstraint::point(p.out_vertex, target));
+      if (deform_out[p.out_element])
+        out_constraints[p.out_element].push_back(LinearConstraint::point(p.out_vertex, target));
       const auto& f = swatch.elements[p.in_element].F.row(p.in_face);
-      in_constraints[p.in_element].push_back(
-          LinearConstraint::barycentric(f(0), f(1), f(2), p.barycentric, target));
+      if (deform_in[p.in_element])
+        in_constraints[p.in_element].push_back(
+            LinearConstraint::barycentric(f(0), f(1), f(2), p.barycentric, target));
     }
     if (options.deform) {
       // Section 2.6 aligns elements where they correspond; the rest of a long element (a thread
@@ -129,17 +162,6 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
 
   // Step 5 (section 2.7): merge.
   ScopedStageTimer timer(times, "merging");
-  // Partners of each swatch element. Relations carried by only a few pairs next to a strong one
-  // come from elements that merely touch it (crossing threads of a weave, neighbouring rings):
-  // they are not the same element and are ignored.
-  std::map<std::pair<int, int>, int> pair_count;
-  for (const VertexFacePair& p : corr.pairs) ++pair_count[{p.out_element, p.in_element}];
-  std::vector<int> strongest(moved.size(), 0);
-  for (const auto& [rel, n] : pair_count)
-    strongest[rel.second] = std::max(strongest[rel.second], n);
-  std::vector<std::vector<int>> partners(moved.size());
-  for (const auto& [k, i] : corr.relations)
-    if (4 * pair_count[{k, i}] >= strongest[i]) partners[i].push_back(k);
   // Output elements take their deformed shape once they are merged with a partner.
   auto current = [&](int k) -> const Element& {
     auto it = deformed_out.find(k);
