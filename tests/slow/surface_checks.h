@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstddef>
+
 #include "core/closest_point_query.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
@@ -37,6 +40,41 @@ inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double
   TetStretchCpu stretch;
   run.output = embed_quilt(run.quilt, embedding, stretch, &run.embedding_stats);
   return run;
+}
+
+// Face pairs of different elements that intersect when `quilt` is embedded with the given
+// options but without removing intersecting elements (how much the embedding itself creates).
+inline size_t intersecting_pairs_when_embedded(const SurfaceQuilt& quilt, bool shell_map,
+                                               bool optimize_stretch = true,
+                                               QuiltEmbeddingStats* stats = nullptr) {
+  QuiltEmbeddingOptions options;
+  options.shell_map = shell_map;
+  options.optimize_stretch = optimize_stretch;
+  options.remove_intersecting = false;
+  TetStretchCpu stretch;
+  const TriMesh out = embed_quilt(quilt, options, stretch, stats);
+  return intersecting_face_pairs(out.V, out.F).size();
+}
+
+// Mean face count and mean surface area of the elements (connected components) of a mesh.
+struct ElementSizes {
+  int elements = 0;
+  double mean_faces = 0, mean_area = 0;
+  int max_faces = 0;
+};
+inline ElementSizes element_sizes(const TriMesh& m) {
+  ElementSizes s;
+  for (const TriMesh& part : components(m)) {
+    ++s.elements;
+    s.mean_faces += part.num_faces();
+    s.mean_area += face_areas(part.V, part.F).sum();
+    s.max_faces = std::max(s.max_faces, part.num_faces());
+  }
+  if (s.elements > 0) {
+    s.mean_faces /= s.elements;
+    s.mean_area /= s.elements;
+  }
+  return s;
 }
 
 // The properties issue 4 asks of every surface result.
