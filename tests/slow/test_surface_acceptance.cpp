@@ -62,15 +62,17 @@ std::pair<size_t, size_t> check_chain_mail(const char* name, const test::Surface
 }
 
 // Chain mail over the bunny, the 3 x 3-ring swatch spanning 16% of the bounding-box diagonal.
-// Same quilt, without removal: normal displacement 856 intersecting face pairs (48 elements
-// involved), shell map none (measured). The shell map does not reach zero at every scale: 750 vs
-// 10 pairs at 0.12, 1,120 vs 38 at 0.08.
+// Same quilt, without removal: normal displacement 854 intersecting face pairs (about 48 elements
+// involved), shell map 12 (0 before a change to which elements get deformed: the exact count
+// moves with the quilt, the ratio does not); 750 vs 10 pairs at 0.12, 1,120 vs 38 at 0.08.
+// Asserted as for the cup and the knight: at least 80% fewer. (The final output has none either
+// way: post-processing removes the elements involved; expect_valid_surface_quilt checks it.)
 TEST(SurfaceAcceptance, ChainMailOverTheBunny) {
   const TriMesh base = read_mesh(test::shared_data("base/bunny_igl_7k.off"));
   const test::SurfaceRun run = test::run_surface(base, test::tiny_chainmail(), 0.16);
   test::expect_valid_surface_quilt(base, run, 0.95);
   const auto [normal, shell] = check_chain_mail("bunny", run);
-  EXPECT_EQ(shell, 0u);
+  EXPECT_LE(5 * shell, normal);
 }
 
 // Chain mail over the cup (genus 2, with a handle). The shell map does not reach zero here at any
