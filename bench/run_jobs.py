@@ -276,16 +276,31 @@ def scale_sizes(size, factor):
     return [x * s for x in size]
 
 
+def scaled_argv(job, factor):
+    """The job's argv with k times the output area: plane sizes times sqrt(k), or a surface's
+    --scale (the swatch's size relative to the base) divided by sqrt(k)."""
+    argv = list(job["argv"])
+    values = {}
+    if "size" in job:
+        length, width = scale_sizes(job["size"], factor)
+        values = {"length": "%.6g" % length, "width": "%.6g" % width}
+    elif "--scale" in argv:
+        i = argv.index("--scale") + 1
+        argv[i] = "%.6g" % (float(argv[i]) / math.sqrt(factor))
+    else:
+        raise JobFailed("--scaling needs a plane job with a 'size' or a surface job with "
+                        "--scale (got %s)" % job["name"])
+    return argv, values
+
+
 def run_scaling(meshquilt, job, runs, workdir):
-    if "size" not in job:
-        raise JobFailed("--scaling needs a plane job with a 'size' (got %s)" % job["name"])
     swatch = os.path.join(workdir, job["name"] + "_swatch.obj")
     generate_swatch(meshquilt, job["swatch"], swatch)
+    base_path = os.path.join(REPO, job["base"]) if "base" in job else None
     points = []
     for factor in (1, 2, 4):
-        length, width = scale_sizes(job["size"], factor)
-        argv = substitute(job["argv"], {"swatch": swatch, "length": "%.6g" % length,
-                                        "width": "%.6g" % width})
+        template, values = scaled_argv(job, factor)
+        argv = substitute(template, dict(values, swatch=swatch, base=base_path or ""))
         measured = []
         for i in range(runs):
             r = run_job_once(meshquilt, argv, workdir, "%s_x%d_%d" % (job["name"], factor, i))
@@ -294,10 +309,10 @@ def run_scaling(meshquilt, job, runs, workdir):
                                                         r["max_rss_kib"] // 1024))
             measured.append(r)
         s = summarize_runs(measured)
-        shown = substitute(job["argv"], {"swatch": "SWATCH.obj", "length": "%.6g" % length,
-                                         "width": "%.6g" % width})
-        s.update({"area_factor": factor, "size": [length, width],
-                  "command": "meshquilt " + " ".join(shown)})
+        shown = substitute(template, dict(values, swatch="SWATCH.obj", base=job.get("base", "")))
+        s.update({"area_factor": factor, "command": "meshquilt " + " ".join(shown)})
+        if "size" in job:
+            s["size"] = [float(values["length"]), float(values["width"])]
         points.append(s)
     base = points[0]
     for p in points:

@@ -69,7 +69,6 @@ class PatchFrame {
       uv_.row(v) << q.dot(d), q.x() * -d.y() + q.y() * d.x();
     }
     build_grid();
-    query_ = std::make_unique<ClosestPointQuery>(patch_.mesh.V, patch_.mesh.F);
   }
 
   const LocalPatch& patch() const { return patch_; }
@@ -87,6 +86,8 @@ class PatchFrame {
       const Vector3d p = bary(0) * base_.V.row(base_.F(base_face, 0)).transpose() +
                          bary(1) * base_.V.row(base_.F(base_face, 1)).transpose() +
                          bary(2) * base_.V.row(base_.F(base_face, 2)).transpose();
+      // Built on first use: most patches never need it, and a BVH per patch is not free.
+      if (!query_) query_ = std::make_unique<ClosestPointQuery>(patch_.mesh.V, patch_.mesh.F);
       f = query_->closest(p).face;
       const MatrixX3i& F = patch_.mesh.F;
       w = plane_barycentric(p, patch_.mesh.V.row(F(f, 0)), patch_.mesh.V.row(F(f, 1)),
@@ -183,7 +184,32 @@ class PatchFrame {
   int nx_ = 1, ny_ = 1;
   std::vector<std::vector<int>> cells_;
   std::vector<std::pair<int, int>> border_;
-  std::unique_ptr<ClosestPointQuery> query_;
+  mutable std::unique_ptr<ClosestPointQuery> query_;
+};
+
+// 2D points binned in a uniform hash grid of cell `radius`, answering "is any point within
+// radius of q" by looking at the 3 x 3 cells around q.
+class PointsNear2D {
+ public:
+  explicit PointsNear2D(double radius) : r_(radius) {}
+  void add(const Vector2d& p) { cells_[key(cell_of(p.x()), cell_of(p.y()))].push_back(p); }
+  bool any_within(const Vector2d& q) const {
+    const long long cx = cell_of(q.x()), cy = cell_of(q.y());
+    for (long long y = cy - 1; y <= cy + 1; ++y)
+      for (long long x = cx - 1; x <= cx + 1; ++x) {
+        auto it = cells_.find(key(x, y));
+        if (it == cells_.end()) continue;
+        for (const Vector2d& p : it->second)
+          if ((p - q).squaredNorm() <= r_ * r_) return true;
+      }
+    return false;
+  }
+
+ private:
+  long long cell_of(double v) const { return static_cast<long long>(std::floor(v / r_)); }
+  static long long key(long long x, long long y) { return x * 73856093LL ^ y * 19349663LL; }
+  double r_;
+  std::unordered_map<long long, std::vector<Vector2d>> cells_;
 };
 
 // The output elements in local coordinates, with an index from base faces to the elements that
@@ -318,6 +344,9 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   SurfaceQuiltingStats stats;
   StageTimes& times = stats.times;
   validate_base(base_in);
+  MQ_CHECK(std::isfinite(options.base_edge_fraction) && options.base_edge_fraction > 0,
+           InvalidInput, "base_edge_fraction must be positive and finite, got ",
+           options.base_edge_fraction);
   MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", options.scale);
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
@@ -325,7 +354,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
            " base faces");
   // Patches are grown from whole triangles, so triangles must be small next to the swatch:
   // the base is refined by midpoint subdivision (the surface itself is unchanged) until its
-  // mean edge is at most a tenth of the swatch's longer side.
+  // mean edge is at most base_edge_fraction of the swatch's longer side.
   TriMesh base;
   MatrixX3d input_field;
   {
@@ -333,7 +362,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     TriMesh cleaned = base_in;
     const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
     int levels = 0;
-    base = refine_to_edge_length(cleaned, options.scale * diagonal / 10.0, 2'000'000, &levels);
+    base = refine_to_edge_length(cleaned, options.scale * diagonal * options.base_edge_fraction,
+                                 2'000'000, &levels);
     stats.base_refinement_levels = levels;
     // The field is per input face; each subdivision level gives a face four children.
     if (options.field.rows()) {
@@ -552,19 +582,25 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       }
     }
     // Mark the patch faces now covered: their centroid lies inside the swatch footprint and away
-    // from the patch border by the margin (elements there were placed whole), or under an
-    // element's footprint (it is covered, whichever patch placed the element). Without the
-    // second rule, faces near the margins of earlier patches became seeds of patches that
-    // could only re-match what was there: ~90% of the patches on the knight added nothing.
+    // from the patch border by the margin (elements there were placed whole), or within
+    // 1.5 shell heights of output geometry (issue 4's coverage criterion), whichever patch placed
+    // it. Without the second rule, faces near the margins of earlier patches became seeds of
+    // patches that could only re-match what was there: ~90% of the patches on the knight added
+    // nothing. (Elements' bounding boxes were too generous a test for long diagonal threads.)
+    PointsNear2D geometry(1.5 * H);
+    for (const int id : framed.elements_near(frame->uv().colwise().minCoeff().transpose(),
+                                             frame->uv().colwise().maxCoeff().transpose())) {
+      const Element& e = framed.element(id);
+      for (int v = 0; v < e.V.rows(); ++v) geometry.add(Vector2d(e.V(v, 0), e.V(v, 1)));
+    }
     for (size_t f = 0; f < patch.faces.size(); ++f) {
       Vector2d q = Vector2d::Zero();
       for (int k = 0; k < 3; ++k)
         q += frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k)).transpose() / 3.0;
-      if (q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
-          q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
-          frame->distance_to_border(q) >= margin)
-        mark(patch.faces[f]);
-      else if (!framed.elements_near(q, q).empty())
+      if (geometry.any_within(q) ||
+          (q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
+           q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
+           frame->distance_to_border(q) >= margin))
         mark(patch.faces[f]);
     }
     // A patch that added nothing found a hole no swatch element fits into: give up on the
