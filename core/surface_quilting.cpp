@@ -509,7 +509,12 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       std::vector<const Element*> near;
       for (const auto& [id, e] : flat) near.push_back(&e);
       MatrixX3d P, NP;
-      gather_subpatch(near, Vector2d::Constant(-half), Vector2d::Constant(half),
+      // Seeds lie just beyond the synthesised surface (faces within 1.5 shell heights of
+      // geometry count as synthesised), so the sub-patch reaches half an element further than
+      // the window the swatch must cover: without that it would often hold no output at all and
+      // the swatch would be placed unmatched.
+      const double reach = half + 0.5 * max_element;
+      gather_subpatch(near, Vector2d::Constant(-reach), Vector2d::Constant(reach),
                       options.match_points, P, NP);
       const Vector2d t_min = Vector2d::Constant(half) - swatch.size.head<2>();
       const Vector2d t_max = Vector2d::Constant(-half);
