@@ -510,10 +510,11 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       for (const auto& [id, e] : flat) near.push_back(&e);
       MatrixX3d P, NP;
       // Seeds lie just beyond the synthesised surface (faces within 1.5 shell heights of
-      // geometry count as synthesised), so the sub-patch reaches half an element further than
-      // the window the swatch must cover: without that it would often hold no output at all and
-      // the swatch would be placed unmatched.
-      const double reach = half + 0.5 * max_element;
+      // geometry count as synthesised), so the sub-patch reaches half an element (at most three
+      // shell heights: long vines would pull in the whole patch) further than the window the
+      // swatch must cover: without that it would often hold no output at all and the swatch
+      // would be placed unmatched.
+      const double reach = half + std::min(0.5 * max_element, 3.0 * H);
       gather_subpatch(near, Vector2d::Constant(-reach), Vector2d::Constant(reach),
                       options.match_points, P, NP);
       const Vector2d t_min = Vector2d::Constant(half) - swatch.size.head<2>();
