@@ -72,6 +72,9 @@ Correspondences find_correspondences(const std::vector<Element>& output,
       const Vector3d p = e.V.row(v).transpose();
       if (!region.contains(p)) continue;
       const Vector3d n = e.N.row(v).transpose();
+      // A vertex whose faces all lost their area (squeezed by a deformation, or seen through a
+      // degenerate patch map) has no normal: it cannot be matched by Eq. (1) and is skipped.
+      if (!n.allFinite() || !(n.squaredNorm() > 0)) continue;
       const ClosestPointHit hit = swatch_query.match(p - t, n, options.lambda, max_distance);
       if (hit.face < 0 || hit.distance > max_distance) continue;
       if (n.dot(swatch_query.face_normals().row(hit.face).transpose()) < options.min_normal_dot)

@@ -13,7 +13,9 @@ void gather_subpatch(const std::vector<const Element*>& elements, const Vector2d
   for (const Element* e : elements)
     for (int v = 0; v < e->V.rows(); ++v) {
       const double x = e->V(v, 0), y = e->V(v, 1);
-      if (x >= lo.x() && x <= hi.x() && y >= lo.y() && y <= hi.y()) inside.emplace_back(e, v);
+      // Vertices without a finite normal (all their faces degenerate) cannot enter Eq. (1).
+      if (x >= lo.x() && x <= hi.x() && y >= lo.y() && y <= hi.y() && e->N.row(v).allFinite())
+        inside.emplace_back(e, v);
     }
   const size_t n =
       max_points > 0 ? std::min(inside.size(), static_cast<size_t>(max_points)) : inside.size();

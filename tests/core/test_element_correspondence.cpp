@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -58,6 +59,19 @@ TEST(ElementCorrespondence, IdenticalPlacementPairsEveryVertexWithItsOwnElement)
               1e-9);
     EXPECT_NEAR(p.barycentric.sum(), 1.0, 1e-9);
   }
+}
+
+TEST(ElementCorrespondence, VerticesWithoutANormalAreSkipped) {
+  // A vertex whose faces all collapsed has a zero (or NaN) normal: it is left unpaired instead of
+  // failing the whole patch (seen on a weave over the bunny).
+  TwoTori fx;
+  std::vector<Element> output = fx.placed();
+  output[0].N.row(0).setZero();
+  output[0].N.row(1).setConstant(std::numeric_limits<double>::quiet_NaN());
+  Correspondences c;
+  ASSERT_NO_THROW(c = fx.find(output));
+  EXPECT_EQ(c.pairs.size(), static_cast<size_t>(output[0].V.rows() + output[1].V.rows() - 2));
+  for (const VertexFacePair& p : c.pairs) EXPECT_FALSE(p.out_element == 0 && p.out_vertex < 2);
 }
 
 TEST(ElementCorrespondence, OppositeNormalsArePruned) {
