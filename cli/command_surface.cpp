@@ -157,8 +157,8 @@ int run_surface(int argc, char** argv, int first) {
     std::printf(
         "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
         "covered\n",
-        out_path.c_str(), embedding_stats.faces, embedding_stats.vertices,
-        embedding_stats.elements, stats.shell_height, 100.0 * embedding_stats.coverage);
+        out_path.c_str(), embedding_stats.faces, embedding_stats.vertices, embedding_stats.elements,
+        stats.shell_height, 100.0 * embedding_stats.coverage);
     if (!embedding_stats.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
                   embedding_stats.shell_map_failure.c_str());

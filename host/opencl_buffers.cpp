@@ -16,8 +16,8 @@ Buffer create_buffer(cl_context context, cl_mem_flags flags, std::size_t bytes, 
 
 std::size_t work_group_size(cl_kernel kernel, cl_device_id device, std::size_t preferred) {
   std::size_t max_size = 0;
-  MQ_CL_CHECK(clGetKernelWorkGroupInfo(kernel, device, CL_KERNEL_WORK_GROUP_SIZE,
-                                       sizeof(max_size), &max_size, nullptr));
+  MQ_CL_CHECK(clGetKernelWorkGroupInfo(kernel, device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(max_size),
+                                       &max_size, nullptr));
   return std::max<std::size_t>(1, std::min(preferred, max_size));
 }
 

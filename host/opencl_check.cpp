@@ -78,8 +78,8 @@ std::string error_name(cl_int code) {
 
 void check(cl_int code, const char* call, const char* file, int line) {
   if (code == CL_SUCCESS) return;
-  MQ_THROW(DeviceError, "OpenCL call failed with ", error_name(code), " at ", file, ":", line,
-           ": ", call);
+  MQ_THROW(DeviceError, "OpenCL call failed with ", error_name(code), " at ", file, ":", line, ": ",
+           call);
 }
 
 }  // namespace mq::cl

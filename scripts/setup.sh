@@ -16,7 +16,7 @@ $mq info out/chainmail_plane.obj
 $mq render out/chainmail_plane.obj -o out/chainmail_plane.png
 # ... and over a shipped base mesh (Keenan Crane's Spot, CC0), through the shell map.
 $mq swatch chainmail --rows 3 --cols 3 --detail 16 -o out/chainmail_small.obj
-$mq surface --base data/spot_6k.obj --swatch out/chainmail_small.obj --scale 0.15 \
+$mq surface --base data/spot_6k.obj --swatch out/chainmail_small.obj --scale 0.08 \
   -o out/spot_chainmail.obj --stats out/spot_chainmail.json
 $mq info out/spot_chainmail.obj
 $mq render out/spot_chainmail.obj -o out/spot_chainmail.png

@@ -79,7 +79,7 @@ TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
   ASSERT_GT(P.rows(), 50);
   MatchingOptions options;
   options.lambda = 1.0 / fx.cell;
-  options.refine_to = 0;   // whole cells only
+  options.refine_to = 0;    // whole cells only
   options.screen_keep = 0;  // every candidate on every point
   std::mt19937_64 rng(1);
   const MatrixX3d T = fx.candidates(-2, 8);
