@@ -13,13 +13,6 @@ namespace mq {
 
 namespace {
 
-TriMesh as_mesh(const Element& e) {
-  TriMesh m;
-  m.V = e.V;
-  m.F = e.F;
-  return m;
-}
-
 int count_boundary_edges(const MatrixX3i& F, int nv) {
   const EdgeTopology topo = edge_topology(F, nv);
   int n = 0;
@@ -137,7 +130,7 @@ TriMesh kept_part(const Element& e, const std::vector<bool>& keep) {
   std::vector<int> faces;
   for (size_t f = 0; f < keep.size(); ++f)
     if (keep[f]) faces.push_back(static_cast<int>(f));
-  return extract_faces(as_mesh(e), faces);
+  return extract_faces(e.mesh(), faces);
 }
 
 }  // namespace

@@ -10,13 +10,6 @@ namespace mq {
 
 namespace {
 
-TriMesh as_mesh(const Element& e) {
-  TriMesh m;
-  m.V = e.V;
-  m.F = e.F;
-  return m;
-}
-
 bool boxes_overlap(const Element& a, const Element& b) {
   return a.lo.x() <= b.hi.x() && b.lo.x() <= a.hi.x() && a.lo.y() <= b.hi.y() &&
          b.lo.y() <= a.hi.y() && a.z_lo <= b.z_hi && b.z_lo <= a.z_hi;
@@ -24,11 +17,11 @@ bool boxes_overlap(const Element& a, const Element& b) {
 
 // Whether e may join the output: it intersects no live element other than those in `ignore`.
 bool fits(const PatchOutput& output, const Element& e, const std::vector<int>& ignore) {
-  const TriMesh m = as_mesh(e);
+  const TriMesh m = e.mesh();
   for (const int id : output.elements_near(e.lo, e.hi)) {
     if (std::find(ignore.begin(), ignore.end(), id) != ignore.end()) continue;
     const Element& other = output.element(id);
-    if (boxes_overlap(other, e) && meshes_intersect(as_mesh(other), m)) return false;
+    if (boxes_overlap(other, e) && meshes_intersect(other.mesh(), m)) return false;
   }
   return true;
 }

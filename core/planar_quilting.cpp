@@ -16,13 +16,6 @@ namespace mq {
 
 namespace {
 
-TriMesh as_mesh(const Element& e) {
-  TriMesh m;
-  m.V = e.V;
-  m.F = e.F;
-  return m;
-}
-
 // The growing output: elements with a per-cell index of their footprints for local queries.
 class OutputStore final : public PatchOutput {
  public:
@@ -252,7 +245,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
               c.y() <= domain_hi.y())
             faces.push_back(f);
         }
-        const TriMesh part = extract_faces(as_mesh(e), faces);
+        const TriMesh part = extract_faces(e.mesh(), faces);
         Element t;
         t.V = part.V;
         t.F = part.F;

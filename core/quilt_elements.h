@@ -21,6 +21,13 @@ struct Element {
   // Translates by t, keeping normals.
   void translate(const Vector3d& t);
   double footprint_diameter() const { return (hi - lo).norm(); }
+  // The element as a plain mesh (V and F copied, no normals).
+  TriMesh mesh() const {
+    TriMesh m;
+    m.V = V;
+    m.F = F;
+    return m;
+  }
 };
 
 // Splits a mesh into elements, in order of each component's first face.

@@ -21,13 +21,6 @@ Element element_of(const TriMesh& m) {
   return e;
 }
 
-TriMesh as_mesh(const Element& e) {
-  TriMesh m;
-  m.V = e.V;
-  m.F = e.F;
-  return m;
-}
-
 TEST(ElementMerging, ElementsCoincide) {
   const Element a = element_of(test::torus(1.0, 0.3, 24, 12));
   const double tol = 0.05;
@@ -42,7 +35,7 @@ TEST(ElementMerging, ElementsCoincide) {
   std::vector<int> half;
   for (int f = 0; f < a.F.rows(); ++f)
     if (a.V(a.F(f, 0), 0) > 0 && a.V(a.F(f, 1), 0) > 0 && a.V(a.F(f, 2), 0) > 0) half.push_back(f);
-  const Element h = element_of(extract_faces(as_mesh(a), half));
+  const Element h = element_of(extract_faces(a.mesh(), half));
   EXPECT_FALSE(elements_coincide(a, h, tol));
   EXPECT_FALSE(elements_coincide(h, a, tol));
 }
@@ -71,7 +64,7 @@ TEST(ElementMerging, CutAndStitchJoinsTwoOverlappingCappedTubes) {
       cut_and_stitch(fx.out, fx.in, region, fx.mean_edge, MergeOptions{}, &why);
   ASSERT_TRUE(joined.has_value()) << "refused: " << stitch_failure_name(why);
   EXPECT_EQ(why, StitchFailure::None);
-  const TriMesh m = as_mesh(*joined);
+  const TriMesh m = joined->mesh();
   const TopologyReport r = topology_report(m);
   EXPECT_EQ(r.num_components, 1);
   EXPECT_TRUE(r.closed());
