@@ -92,6 +92,9 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
   // is not inside the overlap (inside ones are dropped), and an output element that is the one
   // crossing partner of such a swatch element (a stitch candidate). On chain mail most related
   // elements are dropped or kept, and deforming them all took as long as everything else.
+  // Which output elements lie wholly in the overlap (used here and by step 5).
+  std::vector<char> frame_inside(frame.size());
+  for (size_t k = 0; k < frame.size(); ++k) frame_inside[k] = inside(frame[k], region);
   std::vector<char> deform_in(moved.size(), 0), deform_out(frame.size(), 0);
   for (size_t i = 0; i < moved.size(); ++i) {
     std::vector<int> crossing;
@@ -99,7 +102,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     for (const int k : partners[i]) {
       if (!output.alive(near[k])) continue;
       any = true;
-      if (!inside(frame[k], region)) crossing.push_back(k);
+      if (!frame_inside[k]) crossing.push_back(k);
     }
     if (!any || inside(moved[i], region)) continue;
     deform_in[i] = 1;
@@ -182,8 +185,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
       continue;
     }
     std::vector<int> replaced, crossing;
-    for (const int k : related)
-      (inside(frame[k], region) && !busy[k] ? replaced : crossing).push_back(k);
+    for (const int k : related) (frame_inside[k] && !busy[k] ? replaced : crossing).push_back(k);
     std::vector<int> replaced_ids;
     for (const int k : replaced) replaced_ids.push_back(near[k]);
     if (crossing.empty()) {

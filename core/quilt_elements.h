@@ -40,13 +40,13 @@ TriMesh merge_elements(const std::vector<const Element*>& elements);
 // bounding-box minimum at the origin, so its footprint is [0, size.x] x [0, size.y].
 struct PreparedSwatch {
   std::vector<Element> elements;
-  TriMesh mesh;           // all elements, same vertex order as the elements concatenated
+  TriMesh mesh;                   // all elements, same vertex order as the elements concatenated
   std::vector<int> face_element;  // #F: element of each face of mesh
   std::vector<int> element_first_face;  // first face of each element in mesh
   std::vector<int> element_first_vertex;
   Vector3d size = Vector3d::Zero();
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // input frame -> synthesis frame
-  Vector3d translation = Vector3d::Zero();                  // applied after rotation
+  Vector3d translation = Vector3d::Zero();                 // applied after rotation
   double mean_edge_length = 0;
   double mean_element_diameter = 0;  // mean footprint diameter of the elements
 };

@@ -134,6 +134,12 @@ class PatchFrame {
     return false;
   }
 
+  // Frame position of the centroid of patch face f.
+  Vector2d face_centroid(int f) const {
+    const MatrixX3i& F = patch_.mesh.F;
+    return (uv_.row(F(f, 0)) + uv_.row(F(f, 1)) + uv_.row(F(f, 2))).transpose() / 3.0;
+  }
+
   // Minimum distance from q to the patch's boundary in the frame.
   double distance_to_border(const Vector2d& q) const {
     double best = std::numeric_limits<double>::infinity();
@@ -600,9 +606,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       for (int v = 0; v < e.V.rows(); ++v) geometry.add(Vector2d(e.V(v, 0), e.V(v, 1)));
     }
     for (size_t f = 0; f < patch.faces.size(); ++f) {
-      Vector2d q = Vector2d::Zero();
-      for (int k = 0; k < 3; ++k)
-        q += frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k)).transpose() / 3.0;
+      const Vector2d q = frame->face_centroid(static_cast<int>(f));
       if (geometry.any_within(q) ||
           (q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
            q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
@@ -613,10 +617,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     // faces around its seed, within half an element, instead of retrying them one by one.
     if (counts.added + counts.replaced + counts.stitched == 0) {
       for (size_t f = 0; f < patch.faces.size(); ++f) {
-        Vector2d q = Vector2d::Zero();
-        for (int k = 0; k < 3; ++k)
-          q += frame->uv().row(patch.mesh.F(static_cast<Eigen::Index>(f), k)).transpose() / 3.0;
-        if (q.norm() <= 0.5 * max_element) mark(patch.faces[f]);
+        if (frame->face_centroid(static_cast<int>(f)).norm() <= 0.5 * max_element)
+          mark(patch.faces[f]);
       }
     }
     mark(seed);  // progress is guaranteed
