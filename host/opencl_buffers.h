@@ -1,4 +1,4 @@
-// Checked buffer creation and kernel arguments shared by the kernel launchers.
+// Checked buffer creation, kernel arguments and launch sizes shared by the kernel launchers.
 #pragma once
 
 #include <cstddef>
