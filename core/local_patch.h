@@ -13,7 +13,9 @@ namespace mq {
 
 struct LocalPatchOptions {
   double max_area = 0;        // stop growing once the patch area reaches this (0: unlimited)
-  int max_depth = 1 << 30;    // breadth-first layers around the seed (0: the seed alone)
+  // stop at faces whose centroid lies farther than this from the seed's, measured along the
+  // surface as in LocalPatchBuilder::grow (0: unlimited)
+  double max_radius = 0;
   // Shrink while the 95th percentile of the face area distortions exceeds this (>= 1).
   double max_distortion = 4;
 };
@@ -41,11 +43,13 @@ class LocalPatchBuilder {
   // TT = face_adjacency(topo). Throws InvalidInput when their sizes do not match base.
   LocalPatchBuilder(const TriMesh& base, const EdgeTopology& topo, const MatrixX3i& TT);
 
-  // Grows a patch from seed_face across manifold edges (TT), layer by layer, until its area
-  // reaches options.max_area or options.max_depth layers are done. A face is added only when the
-  // patch stays a topological disk: it shares one edge with the patch and brings a new vertex,
-  // or it shares two edges and closes a notch; faces with zero area or a repeated vertex are
-  // never added. Faces refused in a layer are retried after the rest of it. The patch is then
+  // Grows a patch from seed_face across manifold edges (TT), nearest faces first (distance from
+  // the seed's centroid unfolded along the path that reached the face, at least the straight
+  // distance; ties by face id), until its area reaches
+  // options.max_area or the next face lies beyond options.max_radius. A face is added only when
+  // the patch stays a topological disk: it shares one edge with the patch and brings a new
+  // vertex, or it shares two edges and closes a notch; faces with zero area or a repeated vertex
+  // are never added. A refused face is retried whenever a neighbour of it joins the patch. The patch is then
   // flattened with lscm; while the 95th percentile face area distortion exceeds max_distortion or
   // a UV triangle is flipped, the patch is cut to the longest prefix of its growth order with at
   // most half its area (every prefix is a disk) and flattened again.
@@ -53,7 +57,7 @@ class LocalPatchBuilder {
   // max_area + area of one face (when max_area > 0). The result may still exceed max_distortion
   // only when it is down to the seed alone.
   // Throws InvalidInput for a seed out of range or degenerate, or bad options (max_area < 0 or
-  // not finite, max_depth < 0, max_distortion < 1 or NaN); SolverFailure from lscm.
+  // not finite, max_radius < 0 or not finite, max_distortion < 1 or NaN); SolverFailure from lscm.
   LocalPatch grow(int seed_face, const LocalPatchOptions& options = {});
 
   const TriMesh& base() const { return *base_; }
@@ -61,6 +65,7 @@ class LocalPatchBuilder {
  private:
   void init();
   bool can_add(int f) const;
+  Vector3d unfold_across(int f, int k, int g, const Vector3d& p) const;
   void flatten(LocalPatch& patch, size_t num_faces);
   uint32_t next_tick();
 
@@ -68,9 +73,14 @@ class LocalPatchBuilder {
   EdgeTopology topo_;
   MatrixX3i TT_;
   Eigen::VectorXd area_;
+  MatrixX3d centroid_;
+  // Per base face, valid when face_seen_ == patch tick: distance from the seed and the seed's
+  // centroid unfolded into the face's plane.
+  std::vector<double> distance_;
+  MatrixX3d seed_image_;
   std::vector<char> usable_;             // per base face: non-degenerate
   std::vector<uint32_t> face_in_patch_;  // == patch tick when in the current patch
-  std::vector<uint32_t> face_seen_;      // == layer tick when queued in the current layer
+  std::vector<uint32_t> face_seen_;      // == patch tick when distance_ is set for this patch
   std::vector<uint32_t> vertex_in_patch_;
   std::vector<uint32_t> vertex_local_tick_;
   std::vector<int> vertex_local_;

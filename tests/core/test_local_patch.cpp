@@ -92,7 +92,7 @@ TEST_P(LocalPatchOnRealMeshes, PatchesAreFlattenedDisks) {
     if (face_areas(base.V, base.F)(seed) <= 0) continue;
     expect_valid_patch(base, builder.grow(seed, big), seed, big, "big");
     LocalPatchOptions shallow;
-    shallow.max_depth = 3;
+    shallow.max_radius = 3 * std::sqrt(mean_area);
     expect_valid_patch(base, builder.grow(seed, shallow), seed, shallow, "shallow");
   }
 }
@@ -108,18 +108,46 @@ INSTANTIATE_TEST_SUITE_P(Bases, LocalPatchOnRealMeshes,
                            return n.substr(0, n.find('_'));
                          });
 
-TEST(LocalPatch, DepthLimits) {
+TEST(LocalPatch, RadiusLimits) {
   const TriMesh grid = test::plane_grid(1, 1, 10, 10);
   LocalPatchBuilder builder(grid);
   LocalPatchOptions o;
-  o.max_depth = 0;
+  o.max_radius = 1e-9;
   EXPECT_EQ(builder.grow(57, o).faces, std::vector<int>{57});
-  o.max_depth = 1;
+  // Centroids of edge neighbours lie 0.047 away (the diagonal neighbour) or 0.075 (the others);
+  // no other face's centroid is nearer than 0.1.
+  o.max_radius = 0.08;
   const LocalPatch p = builder.grow(57, o);
   EXPECT_EQ(p.faces.size(), 4u);  // the seed and its three edge neighbours
   const MatrixX3i TT = face_adjacency(edge_topology(grid.F, grid.num_vertices()));
   for (size_t i = 1; i < p.faces.size(); ++i) EXPECT_TRUE((TT.row(57).array() == p.faces[i]).any());
   EXPECT_NEAR(p.max_distortion, 1.0, 1e-9);
+  // Every face of a larger radius patch lies within it along the surface (here: in the plane).
+  o.max_radius = 0.3;
+  const LocalPatch q = builder.grow(57, o);
+  const Eigen::RowVector3d c0 = (grid.V.row(grid.F(57, 0)) + grid.V.row(grid.F(57, 1)) +
+                                 grid.V.row(grid.F(57, 2))) / 3.0;
+  for (const int f : q.faces) {
+    const Eigen::RowVector3d c =
+        (grid.V.row(grid.F(f, 0)) + grid.V.row(grid.F(f, 1)) + grid.V.row(grid.F(f, 2))) / 3.0;
+    EXPECT_LE((c - c0).norm(), 0.3 + 1e-12);
+  }
+  EXPECT_GT(q.faces.size(), 20u);
+}
+
+// Patches follow distance, not adjacency steps: on a grid of thin triangles (cells ten times
+// longer than wide) an area-limited patch is still round, not a strip along the long side.
+TEST(LocalPatch, PatchesAreRoundOnThinTriangles) {
+  const TriMesh strip = test::plane_grid(4, 4, 20, 200);  // cells 0.2 x 0.02
+  LocalPatchBuilder builder(strip);
+  LocalPatchOptions o;
+  o.max_area = 3.14159 * 0.8 * 0.8;
+  const int seed = 2 * (100 * 20 + 10);  // a face at the centre
+  const LocalPatch p = builder.grow(seed, o);
+  const Eigen::Vector2d extent =
+      (p.mesh.V.leftCols<2>().colwise().maxCoeff() - p.mesh.V.leftCols<2>().colwise().minCoeff())
+          .transpose();
+  EXPECT_LT(extent.maxCoeff() / extent.minCoeff(), 1.6) << extent.transpose();
 }
 
 TEST(LocalPatch, UnlimitedGrowthCoversADiskAndStopsShortOfClosing) {
@@ -182,7 +210,7 @@ TEST(LocalPatch, RejectsBadSeedsAndOptions) {
   o.max_distortion = 0.5;
   EXPECT_THROW(builder.grow(0, o), InvalidInput);
   o = {};
-  o.max_depth = -1;
+  o.max_radius = -1;
   EXPECT_THROW(builder.grow(0, o), InvalidInput);
   TriMesh degenerate = grid;
   degenerate.F(4, 1) = degenerate.F(4, 0);
