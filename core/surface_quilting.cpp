@@ -16,6 +16,7 @@
 #include "core/midpoint_subdivision.h"
 #include "core/quilt_elements.h"
 #include "core/tangent_field.h"
+#include "core/weld_vertices.h"
 
 namespace mq {
 
@@ -361,11 +362,13 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   // Patches are grown from whole triangles, so triangles must be small next to the swatch:
   // the base is refined by midpoint subdivision (the surface itself is unchanged) until its
   // mean edge is at most base_edge_fraction of the swatch's longer side.
-  TriMesh base;
+  TriMesh cleaned, base;
   MatrixX3d input_field;
   {
     ScopedStageTimer timer(times, "prepare");
-    TriMesh cleaned = base_in;
+    // Exporters split vertices along hard edges; welded, a box's sides form one surface and
+    // patches (and elements) can wrap around its edges.
+    cleaned = weld_vertices(base_in, &stats.welded_vertices);
     const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
     int levels = 0;
     base = refine_to_edge_length(cleaned, options.scale * diagonal * options.base_edge_fraction,
@@ -628,7 +631,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   SurfaceQuilt quilt;
   quilt.shell_height = H;
   quilt.base = base;
-  quilt.input_base = base_in;
+  quilt.input_base = std::move(cleaned);
   quilt.refinement_levels = stats.base_refinement_levels;
   {
     ScopedStageTimer timer(times, "post-processing");

@@ -28,7 +28,7 @@ struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
   TriMesh base;               // the (refined) base mesh the local coordinates refer to
-  TriMesh input_base;         // the base as given
+  TriMesh input_base;         // the base as given, coincident vertices welded
   int refinement_levels = 0;  // midpoint subdivisions from input_base to base
 };
 
@@ -69,6 +69,7 @@ struct SurfaceQuiltingStats {
   int iterations = 0;
   int base_faces = 0;              // after refinement
   int base_refinement_levels = 0;  // midpoint subdivisions applied to the base
+  int welded_vertices = 0;         // base vertices merged with another at the same position
   int patches_shrunk = 0;
   double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;
