@@ -50,7 +50,9 @@ void accumulate(PatchCounts& a, const PatchCounts& b) {
 void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
                  const ClosestPointQuery& swatch_query, const Vector3d& t,
                  const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
-                 const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times) {
+                 const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
+                 std::vector<int>* rejected) {
+  if (rejected) rejected->clear();
   const double mean_edge = swatch.mean_edge_length;
   // Step 3 (section 2.5): correspondences in the overlapping region.
   Correspondences corr;
@@ -166,7 +168,10 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
   std::vector<char> busy(frame.size(), 0);
   for (size_t i = 0; i < moved.size(); ++i) {
     const Element& in = moved[i];
-    if (!admissible(in)) continue;
+    if (!admissible(in)) {
+      if (rejected) rejected->push_back(static_cast<int>(i));
+      continue;
+    }
     std::vector<int> related;  // local indices
     for (const int k : partners[i])
       if (output.alive(near[k])) related.push_back(k);
@@ -177,6 +182,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
         ++counts.added;
       } else {
         ++counts.rejected_intersecting;
+        if (rejected) rejected->push_back(static_cast<int>(i));
       }
       continue;
     }
@@ -195,6 +201,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
         counts.replaced += static_cast<int>(replaced.size());
       } else {
         ++counts.rejected_intersecting;
+        if (rejected) rejected->push_back(static_cast<int>(i));
       }
       continue;
     }

@@ -51,11 +51,13 @@ struct PatchCounts {
 // Merges the swatch placed at translation t into `output`. `admissible(e)` says whether a swatch
 // element may enter the output at all (e.g. lies at least partly in the domain). Elements are
 // only ever added or changed so that no two of them intersect. Times go to the stages
-// "correspondence", "deformation" and "merging".
+// "correspondence", "deformation" and "merging". `rejected`, when given, receives the indices
+// of the swatch elements that could not enter: not admissible, or intersecting the output.
 void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
                  const ClosestPointQuery& swatch_query, const Vector3d& t,
                  const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
-                 const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times);
+                 const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
+                 std::vector<int>* rejected = nullptr);
 
 // Adds b's counts to a.
 void accumulate(PatchCounts& a, const PatchCounts& b);

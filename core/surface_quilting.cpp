@@ -557,7 +557,9 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       return true;
     };
     PatchCounts counts;
-    quilt_patch(framed, swatch, *swatch_query, t, region, admissible, options.patch, counts, times);
+    std::vector<int> rejected;
+    quilt_patch(framed, swatch, *swatch_query, t, region, admissible, options.patch, counts, times,
+                &rejected);
     accumulate(stats.counts, counts);
     stats.rejected_outside_patch += outside;
 
@@ -596,24 +598,33 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         store.index(id);
       }
     }
-    // Mark the patch faces now covered: their centroid lies inside the swatch footprint and away
-    // from the patch border by the margin (elements there were placed whole), or within
-    // 1.5 shell heights of output geometry (issue 4's coverage criterion), whichever patch placed
-    // it. Without the second rule, faces near the margins of earlier patches became seeds of
-    // patches that could only re-match what was there: ~90% of the patches on the knight added
-    // nothing. (Elements' bounding boxes were too generous a test for long diagonal threads.)
+    // Mark the patch faces now covered: within 1.5 shell heights of output geometry (issue 4's
+    // coverage criterion), whichever patch placed it, or inside the swatch footprint, away from
+    // the patch border by the margin (elements there may have been cut off) and away from the
+    // swatch elements refused here. Those are the places a later patch must try again; a gap of
+    // the swatch itself is a gap of the texture. Elements that would reach into the footprint
+    // from outside are missing from every swatch; a later patch seeded beyond the footprint
+    // adds them, since they lie partly outside the processed region. (Marking only the
+    // footprint's central quarter left ~15 faces of every 16 in a patch to later patches: on
+    // the ivy wall half of the patches added nothing.)
     PointsNear2D geometry(1.5 * H);
     for (const int id : framed.elements_near(frame->uv().colwise().minCoeff().transpose(),
                                              frame->uv().colwise().maxCoeff().transpose())) {
       const Element& e = framed.element(id);
       for (int v = 0; v < e.V.rows(); ++v) geometry.add(Vector2d(e.V(v, 0), e.V(v, 1)));
     }
+    PointsNear2D refused(std::max(1.5 * H, cell));
+    for (const int i : rejected) {
+      const Element& e = swatch.elements[static_cast<size_t>(i)];
+      for (int v = 0; v < e.V.rows(); ++v)
+        refused.add(Vector2d(e.V(v, 0) + t.x(), e.V(v, 1) + t.y()));
+    }
     for (size_t f = 0; f < patch.faces.size(); ++f) {
       const Vector2d q = frame->face_centroid(static_cast<int>(f));
       if (geometry.any_within(q) ||
-          (q.x() >= patch_lo.x() + margin && q.y() >= patch_lo.y() + margin &&
-           q.x() <= patch_hi.x() - margin && q.y() <= patch_hi.y() - margin &&
-           frame->distance_to_border(q) >= margin))
+          (q.x() >= patch_lo.x() && q.y() >= patch_lo.y() && q.x() <= patch_hi.x() &&
+           q.y() <= patch_hi.y() && frame->distance_to_border(q) >= margin &&
+           !refused.any_within(q)))
         mark(patch.faces[f]);
     }
     // A patch that added nothing found a hole no swatch element fits into: give up on the
