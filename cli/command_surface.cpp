@@ -32,7 +32,6 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("threads", threads)
       .value("wall_seconds", wall)
       .value("base_faces", s.base_faces)
-      .value("base_refinement_levels", s.base_refinement_levels)
       .value("welded_vertices", s.welded_vertices)
       .value("swatch_scale", s.swatch_scale)
       .value("shell_height", s.shell_height)

@@ -13,7 +13,6 @@
 #include "core/local_patch.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
-#include "core/midpoint_subdivision.h"
 #include "core/quilt_elements.h"
 #include "core/tangent_field.h"
 #include "core/weld_vertices.h"
@@ -293,20 +292,7 @@ void validate_base(const TriMesh& base) {
 }  // namespace
 
 void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& b) {
-  // Corners of the children of (a, b, c), in the parent's barycentric coordinates; the order
-  // matches midpoint_subdivide.
-  static const double corner[4][3][3] = {{{1, 0, 0}, {.5, .5, 0}, {.5, 0, .5}},
-                                         {{.5, .5, 0}, {0, 1, 0}, {0, .5, .5}},
-                                         {{.5, 0, .5}, {0, .5, .5}, {0, 0, 1}},
-                                         {{.5, .5, 0}, {0, .5, .5}, {.5, 0, .5}}};
-  for (int l = 0; l < quilt.refinement_levels; ++l) {
-    const int k = face % 4;
-    Vector3d parent = Vector3d::Zero();
-    for (int i = 0; i < 3; ++i)
-      parent += b(i) * Vector3d(corner[k][i][0], corner[k][i][1], corner[k][i][2]);
-    b = parent;
-    face /= 4;
-  }
+  if (!quilt.refinement.parent.empty()) to_parent(quilt.refinement, face, b);
 }
 
 Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face, const Vector3d& b,
@@ -359,10 +345,11 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
            "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
            " base faces");
-  // Patches are grown from whole triangles, so triangles must be small next to the swatch:
-  // the base is refined by midpoint subdivision (the surface itself is unchanged) until its
-  // mean edge is at most base_edge_fraction of the swatch's longer side.
+  // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
+  // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
+  // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
   TriMesh cleaned, base;
+  Refinement refinement;
   MatrixX3d input_field;
   {
     ScopedStageTimer timer(times, "prepare");
@@ -370,17 +357,13 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     // patches (and elements) can wrap around its edges.
     cleaned = weld_vertices(base_in, &stats.welded_vertices);
     const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-    int levels = 0;
-    base = refine_to_edge_length(cleaned, options.scale * diagonal * options.base_edge_fraction,
-                                 2'000'000, &levels);
-    stats.base_refinement_levels = levels;
-    // The field is per input face; each subdivision level gives a face four children.
+    base = bisect_longest_edges(cleaned, options.scale * diagonal * options.base_edge_fraction,
+                                2'000'000, &refinement);
+    // The field is per input face.
     if (options.field.rows()) {
       input_field.resize(base.num_faces(), 3);
-      const int children = 1 << (2 * levels);
-      for (int f = 0; f < base.num_faces(); ++f) {
-        input_field.row(f) = options.field.row(f / children);
-      }
+      for (int f = 0; f < base.num_faces(); ++f)
+        input_field.row(f) = options.field.row(refinement.parent[static_cast<size_t>(f)]);
     }
   }
   const int nf = base.num_faces();
@@ -643,7 +626,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   quilt.shell_height = H;
   quilt.base = base;
   quilt.input_base = std::move(cleaned);
-  quilt.refinement_levels = stats.base_refinement_levels;
+  quilt.refinement = std::move(refinement);
   {
     ScopedStageTimer timer(times, "post-processing");
     for (size_t id = 0; id < store.elements.size(); ++id)

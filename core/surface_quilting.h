@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/geometry_matching.h"
+#include "core/longest_edge_bisection.h"
 #include "core/patch_quilting.h"
 #include "core/progress.h"
 #include "core/stage_timer.h"
@@ -27,13 +28,13 @@ struct SurfaceElement {
 struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
-  TriMesh base;               // the (refined) base mesh the local coordinates refer to
-  TriMesh input_base;         // the base as given, coincident vertices welded
-  int refinement_levels = 0;  // midpoint subdivisions from input_base to base
+  TriMesh base;            // the (refined) base mesh the local coordinates refer to
+  TriMesh input_base;      // the base as given, coincident vertices welded
+  Refinement refinement;   // base faces in input_base faces (empty: base is input_base)
 };
 
-// Local coordinates on the refined base expressed on the input base: midpoint subdivision
-// children are affine pieces of their parent (child 4f+k of face f), so this is exact.
+// Local coordinates on the refined base expressed on the input base: refined faces are affine
+// pieces of their parents, so this is exact.
 void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& barycentric);
 
 struct SurfaceQuiltingOptions {
@@ -49,10 +50,8 @@ struct SurfaceQuiltingOptions {
   double patch_area_factor = 0;
   double max_distortion = 4.0;
   double subpatch_fraction = 0.5;  // as for planar quilting
-  // The base is refined until its mean edge is at most this fraction of the swatch's longer
-  // side. A fifth: finer bases (a tenth) cost 5x the parameterisation time on the ivy wall
-  // (1.4M-face base, 73% of the run in LSCM) and covered no more of the knight or the bunny.
-  double base_edge_fraction = 0.2;
+  // The base is refined until no edge is longer than this fraction of the swatch's longer side.
+  double base_edge_fraction = 0.3;
   // Fewer sub-patch points and a coarser sub-cell refinement than on the plane: a conformal
   // patch is only accurate to a fraction of a cell anyway, and surfaces need many patches.
   int match_points = 512;
@@ -68,7 +67,6 @@ struct SurfaceQuiltingOptions {
 struct SurfaceQuiltingStats {
   int iterations = 0;
   int base_faces = 0;              // after refinement
-  int base_refinement_levels = 0;  // midpoint subdivisions applied to the base
   int welded_vertices = 0;         // base vertices merged with another at the same position
   int patches_shrunk = 0;
   double swatch_scale = 0;  // factor applied to the swatch
@@ -81,8 +79,9 @@ struct SurfaceQuiltingStats {
   StageTimes times;
 };
 
-// Runs mesh quilting over `base`. Local coordinates in the result refer to the base refined by
-// refine_to_edge_length(base, scale * diagonal * base_edge_fraction, 2'000'000). Throws
+// Runs mesh quilting over `base`. Local coordinates in the result refer to the base (coincident
+// vertices welded) refined by bisect_longest_edges(base, scale * diagonal * base_edge_fraction,
+// 2'000'000); SurfaceQuilt::refinement maps them back. Throws
 // InvalidInput for an empty or non-finite base or swatch, scale <= 0 or not finite, a field of the
 // wrong size.
 SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,

@@ -5,7 +5,6 @@
 #include "core/geometry_measures.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
-#include "core/midpoint_subdivision.h"
 #include "core/surface_quilting.h"
 #include "core/swatch_generators.h"
 #include "core/translation_cost.h"
@@ -33,28 +32,14 @@ TEST(SurfaceQuilting, InvalidParametersThrow) {
   EXPECT_THROW(quilt_surface(TriMesh(), test::tiny_chainmail(), o, cost), InvalidInput);
 }
 
-TEST(MidpointSubdivision, KeepsTheSurfaceAndTopology) {
-  const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
-  const TriMesh fine = midpoint_subdivide(base);
-  EXPECT_EQ(fine.num_faces(), 4 * base.num_faces());
-  EXPECT_NEAR(surface_area(fine.V, fine.F), surface_area(base.V, base.F), 1e-9);
-  EXPECT_TRUE(topology_report(fine).closed());
-  EXPECT_LE(point_mesh_distance(fine.V, base.V, base.F).maxCoeff(), 1e-12);
-  int levels = -1;
-  const TriMesh r =
-      refine_to_edge_length(base, 0.26 * mean_edge_length(base.V, base.F), 1 << 20, &levels);
-  EXPECT_EQ(levels, 2);
-  EXPECT_EQ(r.num_faces(), 16 * base.num_faces());
-}
-
 TEST(SurfaceQuilting, LocalCoordinatesMapBackToTheInputBase) {
   // A point given on the refined base and converted to the input base is the same 3D point.
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
   SurfaceQuilt quilt;
   quilt.input_base = base;
-  quilt.base = refine_to_edge_length(base, 0.2 * mean_edge_length(base.V, base.F), 1 << 22,
-                                     &quilt.refinement_levels);
-  ASSERT_EQ(quilt.refinement_levels, 3);
+  quilt.base = bisect_longest_edges(base, 0.2 * mean_edge_length(base.V, base.F), 1 << 22,
+                                    &quilt.refinement);
+  ASSERT_GT(quilt.base.num_faces(), 20 * base.num_faces());
   for (int f = 0; f < quilt.base.num_faces(); f += 97) {
     const Vector3d b0(0.2, 0.3, 0.5);
     Vector3d p = Vector3d::Zero();

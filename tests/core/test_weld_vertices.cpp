@@ -4,7 +4,7 @@
 
 #include "core/errors.h"
 #include "core/geometry_measures.h"
-#include "core/midpoint_subdivision.h"
+#include "core/longest_edge_bisection.h"
 #include "core/local_patch.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
@@ -85,10 +85,14 @@ TEST(WeldVertices, PatchesWrapAroundTheBrickWallPillars) {
 
   // Input face 6 is a side of the first pillar (the plane x = 2.54).
   auto widest_turn = [](const TriMesh& base) {
-    int levels = 0;
-    const TriMesh fine = refine_to_edge_length(base, 0.05, 1'000'000, &levels);
-    const int children = 1 << (2 * levels);
-    const int seed = 6 * children + children / 2;
+    Refinement r;
+    const TriMesh fine = bisect_longest_edges(base, 0.05, 1'000'000, &r);
+    // A face of input face 6 near the middle of the pillar's height (y from 0 to 2.7).
+    int seed = -1;
+    for (int f = 0; f < fine.num_faces() && seed < 0; ++f)
+      if (r.parent[static_cast<size_t>(f)] == 6 && std::abs(fine.V(fine.F(f, 0), 1) - 1.35) < 0.1)
+        seed = f;
+    EXPECT_GE(seed, 0);
     LocalPatchBuilder builder(fine);
     LocalPatchOptions o;
     o.max_area = 3.14159 * 0.6 * 0.6;

@@ -5,7 +5,6 @@
 
 #include "core/errors.h"
 #include "core/mesh_io.h"
-#include "core/midpoint_subdivision.h"
 #include "core/tangent_field.h"
 #include "tests/core/planar_checks.h"
 #include "tests/slow/surface_checks.h"
