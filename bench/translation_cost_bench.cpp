@@ -61,19 +61,19 @@ void BM_TranslationCostOpenCL(benchmark::State& state) {
     return;
   }
   const Fixture fx = make_fixture(3, 20);
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
   TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>());
-  benchmark::DoNotOptimize(ocl.evaluate(grid, fx.problem));  // build + upload outside timing
-  for (auto _ : state) benchmark::DoNotOptimize(ocl.evaluate(grid, fx.problem));
+  benchmark::DoNotOptimize(ocl.evaluate(tree, fx.problem));  // build + upload outside timing
+  for (auto _ : state) benchmark::DoNotOptimize(ocl.evaluate(tree, fx.problem));
   set_counters(state, fx.problem, fx.swatch.num_faces());
 }
 BENCHMARK(BM_TranslationCostOpenCL)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_TranslationCostTbb(benchmark::State& state) {
   const Fixture fx = make_fixture(3, 20);
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
-  for (auto _ : state) benchmark::DoNotOptimize(cpu.evaluate(grid, fx.problem));
+  for (auto _ : state) benchmark::DoNotOptimize(cpu.evaluate(tree, fx.problem));
   set_counters(state, fx.problem, fx.swatch.num_faces());
 }
 BENCHMARK(BM_TranslationCostTbb)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -86,15 +86,15 @@ void BM_TranslationCostBruteForceReduced(benchmark::State& state) {
 }
 BENCHMARK(BM_TranslationCostBruteForceReduced)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_SwatchDistanceGridBuild(benchmark::State& state) {
+void BM_SwatchFaceTreeBuild(benchmark::State& state) {
   const Fixture fx = make_fixture(60, 1);
   for (auto _ : state) {
-    SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
-    benchmark::DoNotOptimize(grid.fingerprint());
+    SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
+    benchmark::DoNotOptimize(tree.fingerprint());
   }
   state.counters["faces"] = fx.swatch.num_faces();
 }
-BENCHMARK(BM_SwatchDistanceGridBuild)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SwatchFaceTreeBuild)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mq

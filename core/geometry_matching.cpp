@@ -59,7 +59,7 @@ void strided_subset(const MatrixX3d& P, const MatrixX3d& NP, Eigen::Index n, Mat
 
 }  // namespace
 
-OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
+OffsetChoice choose_offset(const SwatchFaceTree& swatch, TranslationCostEvaluator& evaluator,
                            const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,
                            const Vector2d& t_min, const Vector2d& t_max, double cell_size,
                            const MatchingOptions& options, std::mt19937_64& rng) {

@@ -55,7 +55,7 @@ MatrixX3d whole_cell_offsets(const Vector2d& t_min, const Vector2d& t_max, doubl
 // among `candidates` (#T by 3, whole-cell offsets, at least one). The refinement keeps the xy
 // of t inside [t_min, t_max], the continuous range of offsets for which the swatch still covers
 // the sub-patch. rng is used only when epsilon > 0. Throws InvalidInput for no candidates.
-OffsetChoice choose_offset(const SwatchDistanceGrid& swatch, TranslationCostEvaluator& evaluator,
+OffsetChoice choose_offset(const SwatchFaceTree& swatch, TranslationCostEvaluator& evaluator,
                            const MatrixX3d& P, const MatrixX3d& NP, const MatrixX3d& candidates,
                            const Vector2d& t_min, const Vector2d& t_max, double cell_size,
                            const MatchingOptions& options, std::mt19937_64& rng);

@@ -143,11 +143,11 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
                             swatch_cells_x, swatch_cells_y}));
   const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
 
-  std::unique_ptr<SwatchDistanceGrid> distance_grid;
+  std::unique_ptr<SwatchFaceTree> swatch_tree;
   std::unique_ptr<ClosestPointQuery> swatch_query;
   {
     ScopedStageTimer timer(times, "prepare");
-    distance_grid = std::make_unique<SwatchDistanceGrid>(swatch.mesh.V, swatch.mesh.F);
+    swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
     swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
   }
   OutputStore output(grid);
@@ -206,7 +206,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
       choice =
-          choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+          choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;

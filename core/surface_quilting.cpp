@@ -372,7 +372,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   // The swatch at its size on the surface (section 3.1's relative size s).
   PreparedSwatch swatch;
   MatrixX3d field;
-  std::unique_ptr<SwatchDistanceGrid> distance_grid;
+  std::unique_ptr<SwatchFaceTree> swatch_tree;
   std::unique_ptr<ClosestPointQuery> swatch_query;
   EdgeTopology topo;
   MatrixX3i TT;
@@ -385,7 +385,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     scaled.V *= factor;
     swatch = prepare_swatch(scaled);
     stats.swatch_scale = factor;
-    distance_grid = std::make_unique<SwatchDistanceGrid>(swatch.mesh.V, swatch.mesh.F);
+    swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
     swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
     field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
     topo = edge_topology(base.F, base.num_vertices());
@@ -518,7 +518,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       if (P.rows() == 0)
         T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
       choice =
-          choose_offset(*distance_grid, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+          choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;

@@ -71,232 +71,198 @@ void validate_translation_cost_problem(const TranslationCostProblem& problem) {
            "translation cost: lambda must be finite and >= 0, got ", problem.lambda);
 }
 
-SwatchDistanceGrid::SwatchDistanceGrid(const MatrixX3d& V, const MatrixX3i& F, double cell_size) {
-  MQ_CHECK(F.rows() > 0, InvalidInput, "swatch distance grid: the swatch has no faces");
-  MQ_CHECK(V.allFinite(), InvalidInput,
-           "swatch distance grid: vertices contain NaN or infinite values");
+SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_size) {
+  MQ_CHECK(F.rows() > 0, InvalidInput, "swatch face tree: the swatch has no faces");
+  MQ_CHECK(V.allFinite(), InvalidInput, "swatch face tree: vertices contain NaN or infinite values");
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
-           "swatch distance grid: face index out of range [0, ", V.rows(), ")");
-  MQ_CHECK(std::isfinite(cell_size) && cell_size >= 0.0, InvalidInput,
-           "swatch distance grid: cell size must be finite and >= 0, got ", cell_size);
-  num_faces_ = static_cast<int>(F.rows());
-
-  std::vector<double> triangles(9 * static_cast<std::size_t>(F.rows()));
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < 3; ++a) triangles[9 * f + 3 * k + a] = V(F(f, k), a);
+           "swatch face tree: face index out of range [0, ", V.rows(), ")");
+  MQ_CHECK(leaf_size >= 1, InvalidInput, "swatch face tree: leaf size must be >= 1, got ",
+           leaf_size);
+  const int nf = static_cast<int>(F.rows());
   const MatrixX3d FN = mq::face_normals(V, F);
-
-  const BoundingBox box = bounding_box(V, F);
-  const Vector3d extent = box.extent();
-  const double max_cells_limit = double(1 << 26);
-  auto cells_for = [&](double h) {
-    double n = 1.0;
-    for (int a = 0; a < 3; ++a) n *= std::max(1.0, std::ceil(extent(a) / h));
-    return n;
-  };
-  double h = cell_size;
-  if (h == 0.0) {
-    h = 2.0 * mean_edge_length(V, F);
-    if (!(h > 0.0)) h = std::max(extent.maxCoeff(), 1.0);
-    const double max_cells = 2.0 * double(F.rows()) + 64.0;
-    // Enlarging h by the cube root of the excess converges in a few steps.
-    while (cells_for(h) > max_cells) h *= std::max(1.01, std::cbrt(cells_for(h) / max_cells));
+  MatrixX3d lo(nf, 3), hi(nf, 3), centroid(nf, 3);
+  for (int f = 0; f < nf; ++f) {
+    const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    lo.row(f) = a.cwiseMin(b).cwiseMin(c).transpose();
+    hi.row(f) = a.cwiseMax(b).cwiseMax(c).transpose();
+    centroid.row(f) = ((a + b + c) / 3.0).transpose();
   }
-  MQ_CHECK(cells_for(h) <= max_cells_limit, InvalidInput, "swatch distance grid: cell size ", h,
-           " would need more than 2^26 cells");
-  cell_size_ = h;
-  origin_ = box.min;
-  for (int a = 0; a < 3; ++a) dims_(a) = static_cast<int>(std::max(1.0, std::ceil(extent(a) / h)));
+  const double scale = (hi.colwise().maxCoeff() - lo.colwise().minCoeff()).norm();
+  slack_ = 1e-9 * scale;
 
-  // Bin each face's bounding box into the cells it meets (CSR, two passes).
-  auto face_box = [&](Eigen::Index f, Vector3d& mn, Vector3d& mx) {
-    for (int a = 0; a < 3; ++a) {
-      mn(a) = std::min({triangles[9 * f + a], triangles[9 * f + 3 + a], triangles[9 * f + 6 + a]});
-      mx(a) = std::max({triangles[9 * f + a], triangles[9 * f + 3 + a], triangles[9 * f + 6 + a]});
+  std::vector<int> order(static_cast<std::size_t>(nf));
+  for (int f = 0; f < nf; ++f) order[static_cast<std::size_t>(f)] = f;
+  // Depth-first build: node i's left child is i + 1, its right child is recorded on return.
+  struct Builder {
+    SwatchFaceTree& t;
+    const MatrixX3d &lo, &hi, &centroid, &FN;
+    std::vector<int>& order;
+    int leaf_size;
+    int build(int begin, int end, int depth) {
+      MQ_CHECK(depth <= kMaxDepth, SolverFailure, "swatch face tree deeper than ", kMaxDepth);
+      t.depth_ = std::max(t.depth_, depth);
+      const int node = static_cast<int>(t.node_links_.size() / 2);
+      t.node_links_.insert(t.node_links_.end(), {0, 0});
+      Vector3d bmin = Vector3d::Constant(kInf), bmax = Vector3d::Constant(-kInf);
+      Vector3d cmin = bmin, cmax = bmax, mean = Vector3d::Zero();
+      for (int i = begin; i < end; ++i) {
+        const int f = order[static_cast<std::size_t>(i)];
+        bmin = bmin.cwiseMin(lo.row(f).transpose());
+        bmax = bmax.cwiseMax(hi.row(f).transpose());
+        cmin = cmin.cwiseMin(centroid.row(f).transpose());
+        cmax = cmax.cwiseMax(centroid.row(f).transpose());
+        mean += FN.row(f).transpose();
+      }
+      const double len = mean.norm();
+      const Vector3d dir = len > 1e-12 ? Vector3d(mean / len) : Vector3d::Zero();
+      double r = 0.0;
+      for (int i = begin; i < end; ++i)
+        r = std::max(r, (FN.row(order[static_cast<std::size_t>(i)]).transpose() - dir).norm());
+      for (int a = 0; a < 3; ++a) {
+        t.node_boxes_.push_back(bmin(a));
+      }
+      t.node_boxes_.push_back(0.0);
+      for (int a = 0; a < 3; ++a) t.node_boxes_.push_back(bmax(a));
+      t.node_boxes_.push_back(0.0);
+      // Slightly enlarged so that rounding never makes the bound exceed a face's true factor.
+      t.node_cones_.insert(t.node_cones_.end(), {dir(0), dir(1), dir(2), r * (1 + 1e-12) + 1e-12});
+      if (end - begin <= leaf_size) {
+        t.node_links_[2 * static_cast<std::size_t>(node)] = -1 - begin;
+        t.node_links_[2 * static_cast<std::size_t>(node) + 1] = end - begin;
+        return node;
+      }
+      int axis = 0;
+      (cmax - cmin).maxCoeff(&axis);
+      const int mid = begin + (end - begin) / 2;
+      std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                       [&](int x, int y) {
+                         const double cx = centroid(x, axis), cy = centroid(y, axis);
+                         return cx != cy ? cx < cy : x < y;
+                       });
+      build(begin, mid, depth + 1);
+      const int right = build(mid, end, depth + 1);
+      t.node_links_[2 * static_cast<std::size_t>(node)] = right;
+      return node;
     }
   };
-  auto cell_range = [&](Eigen::Index f, Eigen::Vector3i& lo, Eigen::Vector3i& hi) {
-    Vector3d mn, mx;
-    face_box(f, mn, mx);
-    for (int a = 0; a < 3; ++a) {
-      lo(a) = std::clamp(static_cast<int>(std::floor((mn(a) - origin_(a)) / h)), 0, dims_(a) - 1);
-      hi(a) = std::clamp(static_cast<int>(std::floor((mx(a) - origin_(a)) / h)), 0, dims_(a) - 1);
-    }
-  };
-  const int num_cells = dims_.prod();
-  std::vector<int> count(num_cells + 1, 0);
-  Eigen::Vector3i lo, hi;
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    cell_range(f, lo, hi);
-    for (int z = lo(2); z <= hi(2); ++z)
-      for (int y = lo(1); y <= hi(1); ++y)
-        for (int x = lo(0); x <= hi(0); ++x) ++count[(z * dims_(1) + y) * dims_(0) + x + 1];
-  }
-  for (int c = 0; c < num_cells; ++c) count[c + 1] += count[c];
-  cell_start_ = count;
-  cell_faces_.resize(cell_start_.back());
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    cell_range(f, lo, hi);
-    for (int z = lo(2); z <= hi(2); ++z)
-      for (int y = lo(1); y <= hi(1); ++y)
-        for (int x = lo(0); x <= hi(0); ++x)
-          cell_faces_[count[(z * dims_(1) + y) * dims_(0) + x]++] = static_cast<int>(f);
-  }
+  Builder{*this, lo, hi, centroid, FN, order, leaf_size}.build(0, nf, 0);
 
-  // Per-entry copies of the face data, in cell order.
-  const std::size_t E = cell_faces_.size();
-  entry_triangles_.resize(9 * E);
-  entry_normals_.assign(4 * E, 0.0);
-  entry_spheres_.resize(4 * E);
-  for (std::size_t j = 0; j < E; ++j) {
-    const int f = cell_faces_[j];
-    std::copy_n(&triangles[9 * static_cast<std::size_t>(f)], 9, &entry_triangles_[9 * j]);
-    for (int a = 0; a < 3; ++a) entry_normals_[4 * j + a] = FN(f, a);
-    const double* t = &triangles[9 * static_cast<std::size_t>(f)];
-    const Vector3d pa(t[0], t[1], t[2]), pb(t[3], t[4], t[5]), pc(t[6], t[7], t[8]);
+  // Per-entry copies of the face data, in leaf order.
+  entry_faces_ = order;
+  entry_triangles_.resize(9 * static_cast<std::size_t>(nf));
+  entry_normals_.assign(4 * static_cast<std::size_t>(nf), 0.0);
+  entry_spheres_.resize(4 * static_cast<std::size_t>(nf));
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    const int f = order[j];
+    const Vector3d pa = V.row(F(f, 0)), pb = V.row(F(f, 1)), pc = V.row(F(f, 2));
+    for (int a = 0; a < 3; ++a) {
+      entry_triangles_[9 * j + a] = pa(a);
+      entry_triangles_[9 * j + 3 + a] = pb(a);
+      entry_triangles_[9 * j + 6 + a] = pc(a);
+      entry_normals_[4 * j + a] = FN(f, a);
+    }
     const Vector3d m = (pa + pb + pc) / 3.0;
     const double r = std::max({(pa - m).norm(), (pb - m).norm(), (pc - m).norm()});
     for (int a = 0; a < 3; ++a) entry_spheres_[4 * j + a] = m(a);
     // Enlarged so that rounding never lets the sphere bound exceed a true distance.
-    entry_spheres_[4 * j + 3] = r * (1 + 1e-12) + 1e-12 * h;
-  }
-
-  // Per-cell box of its faces' parts and normal cone.
-  cell_boxes_.assign(8 * std::size_t(num_cells), 0.0);
-  cell_cones_.assign(4 * std::size_t(num_cells), 0.0);
-  for (int c = 0; c < num_cells; ++c) {
-    const int cx = c % dims_(0), cy = (c / dims_(0)) % dims_(1), cz = c / (dims_(0) * dims_(1));
-    const Vector3d cell_lo = origin_ + h * Vector3d(cx, cy, cz);
-    const Vector3d cell_hi = cell_lo + Vector3d::Constant(h);
-    Vector3d bmin = Vector3d::Constant(kInf), bmax = Vector3d::Constant(-kInf);
-    Vector3d mean = Vector3d::Zero();
-    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j) {
-      Vector3d mn, mx;
-      face_box(cell_faces_[j], mn, mx);
-      // The face's box clipped to the cell (cells on the grid border keep what lies beyond,
-      // since faces there are clamped in).
-      for (int a = 0; a < 3; ++a) {
-        const int i = a == 0 ? cx : (a == 1 ? cy : cz);
-        const double clo = i == 0 ? -kInf : cell_lo(a), chi = i == dims_(a) - 1 ? kInf : cell_hi(a);
-        bmin(a) = std::min(bmin(a), std::max(mn(a), clo));
-        bmax(a) = std::max(bmax(a), std::min(mx(a), chi));
-      }
-      mean += Vector3d(&entry_normals_[4 * j]);
-    }
-    for (int a = 0; a < 3; ++a) {
-      cell_boxes_[8 * c + a] = bmin(a);
-      cell_boxes_[8 * c + 4 + a] = bmax(a);
-    }
-    const double len = mean.norm();
-    const Vector3d dir = len > 1e-12 ? Vector3d(mean / len) : Vector3d::Zero();
-    double r = 0.0;
-    for (int j = cell_start_[c]; j < cell_start_[c + 1]; ++j)
-      r = std::max(r, (Vector3d(&entry_normals_[4 * j]) - dir).norm());
-    // Slightly enlarged so that rounding never makes the bound exceed a face's true factor.
-    cell_cones_[4 * c + 0] = dir(0);
-    cell_cones_[4 * c + 1] = dir(1);
-    cell_cones_[4 * c + 2] = dir(2);
-    cell_cones_[4 * c + 3] = r * (1 + 1e-12) + 1e-12;
+    entry_spheres_[4 * j + 3] = r * (1 + 1e-12) + 1e-12 * scale;
   }
 
   std::uint64_t fp = 14695981039346656037ull;
-  fnv1a(fp, origin_.data(), sizeof(double) * 3);
-  fnv1a(fp, &cell_size_, sizeof(double));
-  fnv1a(fp, dims_.data(), sizeof(int) * 3);
-  fnv1a(fp, cell_start_.data(), sizeof(int) * cell_start_.size());
-  fnv1a(fp, cell_faces_.data(), sizeof(int) * cell_faces_.size());
+  fnv1a(fp, &slack_, sizeof(double));
+  fnv1a(fp, node_links_.data(), sizeof(int) * node_links_.size());
+  fnv1a(fp, node_boxes_.data(), sizeof(double) * node_boxes_.size());
+  fnv1a(fp, node_cones_.data(), sizeof(double) * node_cones_.size());
+  fnv1a(fp, entry_faces_.data(), sizeof(int) * entry_faces_.size());
   fnv1a(fp, entry_triangles_.data(), sizeof(double) * entry_triangles_.size());
   fnv1a(fp, entry_normals_.data(), sizeof(double) * entry_normals_.size());
   fnv1a(fp, entry_spheres_.data(), sizeof(double) * entry_spheres_.size());
-  fnv1a(fp, cell_boxes_.data(), sizeof(double) * cell_boxes_.size());
-  fnv1a(fp, cell_cones_.data(), sizeof(double) * cell_cones_.size());
   fingerprint_ = fp;
 }
 
-double SwatchDistanceGrid::min_face_cost(const Vector3d& q, const Vector3d& n,
-                                         double lambda) const {
-  const double h = cell_size_;
-  // Continuous cell coordinates of q and the (clamped) cell the rings grow from.
-  double g[3];
-  int c[3];
-  for (int a = 0; a < 3; ++a) {
-    g[a] = (q(a) - origin_(a)) / h;
-    c[a] = static_cast<int>(std::clamp(std::floor(g[a]), 0.0, double(dims_(a) - 1)));
-  }
-  // Distance (in cells) from q to the slab of cell i along axis a.
-  auto gap = [&](int a, int i) { return std::max(0.0, std::max(i - g[a], g[a] - (i + 1))); };
-  // A tiny slack keeps the bounds below the true distances despite rounding.
-  const double slack = 1e-9 * h;
-  double best = kInf;
-  for (int k = 0;; ++k) {
-    if (k > 0) {
-      double lb = kInf;
-      for (int a = 0; a < 3; ++a)
-        for (int s = -1; s <= 1; s += 2) {
-          const int i = c[a] + s * k;
-          if (i >= 0 && i < dims_(a)) lb = std::min(lb, gap(a, i));
-        }
-      if (lb == kInf) break;  // the ring lies outside the grid: every cell was visited
-      if (1.0 + lambda * (lb * h - slack) >= best) break;
+double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda) const {
+  const double slack = slack_;
+  // Squared distance from q to node i's box.
+  auto box_distance2 = [&](int i) {
+    const double* bx = &node_boxes_[8 * static_cast<std::size_t>(i)];
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double e = std::max(0.0, std::max(bx[a] - q(a), q(a) - bx[4 + a]));
+      d2 += e * e;
     }
-    const int x0 = std::max(0, c[0] - k), x1 = std::min(dims_(0) - 1, c[0] + k);
-    const int y0 = std::max(0, c[1] - k), y1 = std::min(dims_(1) - 1, c[1] + k);
-    for (int x = x0; x <= x1; ++x) {
-      for (int y = y0; y <= y1; ++y) {
-        const bool shell = std::abs(x - c[0]) == k || std::abs(y - c[1]) == k;
-        // Inside the ring's x/y shell every z is on the ring; otherwise only the two z caps.
-        const int zs[2] = {c[2] - k, c[2] + k};
-        const int z0 = shell ? std::max(0, c[2] - k) : 0;
-        const int z1 = shell ? std::min(dims_(2) - 1, c[2] + k) : (k > 0 ? 1 : 0);
-        for (int zi = z0; zi <= z1; ++zi) {
-          const int z = shell ? zi : zs[zi];
-          if (z < 0 || z >= dims_(2)) continue;
-          const int cell = (z * dims_(1) + y) * dims_(0) + x;
-          const int j0 = cell_start_[cell], j1 = cell_start_[cell + 1];
-          if (j0 == j1) continue;
-          const double* bx = &cell_boxes_[8 * cell];
-          double d2 = 0.0;
-          for (int a = 0; a < 3; ++a) {
-            const double e = std::max(0.0, std::max(bx[a] - q(a), q(a) - bx[4 + a]));
-            d2 += e * e;
-          }
-          const double dist_factor = 1.0 + lambda * (std::sqrt(d2) - slack);
-          if (dist_factor >= best) continue;
-          const double* cone = &cell_cones_[4 * cell];
-          const double cx = n(0) - cone[0], cy = n(1) - cone[1], cz = n(2) - cone[2];
-          const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
-          if (dist_factor * (1.0 + std::max(0.0, cone_lb)) >= best) continue;
-          // Normal factor bound without a square root: skip an entry when
-          // |n - n_f| >= best / df - 1 (updated whenever best improves).
-          double r = best / dist_factor - 1.0;
-          double r2 = r * r * (1.0 + 1e-12);
-          for (int j = j0; j < j1; ++j) {
-            const double* fn = &entry_normals_[4 * j];
-            const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
-            const double dn2 = nx * nx + ny * ny + nz * nz;
-            if (dn2 >= r2) continue;
-            const double nf = 1.0 + std::sqrt(dn2);
-            const double* sp = &entry_spheres_[4 * j];
-            const double sx = q(0) - sp[0], sy = q(1) - sp[1], sz = q(2) - sp[2];
-            const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp[3];
-            if ((1.0 + lambda * (sphere_lb - slack)) * nf >= best) continue;
-            const double dist2 = triangle_dist2(q, &entry_triangles_[9 * j]);
-            const double cost = (1.0 + lambda * std::sqrt(dist2)) * nf;  // face_cost
-            if (cost < best) {
-              best = cost;
-              r = best / dist_factor - 1.0;
-              r2 = r * r * (1.0 + 1e-12);
-            }
-          }
+    return d2;
+  };
+  // A node can hold a better face only if 1 + lambda * (distance - slack) < best, i.e. its box
+  // lies nearer than reach = (best - 1) / lambda + slack (no bound without a distance weight):
+  // compared squared, so inner nodes cost no square root.
+  double best = kInf, reach2 = kInf;
+  auto update_reach = [&] {
+    if (lambda > 0) {
+      const double reach = (best - 1.0) / lambda + slack;
+      reach2 = reach * reach * (1.0 + 1e-12);
+    }
+  };
+  int stack[kMaxDepth + 2];
+  double stack_d2[kMaxDepth + 2];
+  int sp = 0;
+  stack[sp] = 0;
+  stack_d2[sp++] = 0.0;
+  while (sp > 0) {
+    --sp;
+    const int i = stack[sp];
+    if (stack_d2[sp] >= reach2) continue;
+    const int a = node_links_[2 * static_cast<std::size_t>(i)];
+    if (a < 0) {
+      const double df = 1.0 + lambda * (std::sqrt(stack_d2[sp]) - slack);
+      const double* cone = &node_cones_[4 * static_cast<std::size_t>(i)];
+      const double cx = n(0) - cone[0], cy = n(1) - cone[1], cz = n(2) - cone[2];
+      const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
+      if (df * (1.0 + std::max(0.0, cone_lb)) >= best) continue;
+      const int j0 = -1 - a, j1 = j0 + node_links_[2 * static_cast<std::size_t>(i) + 1];
+      // Normal factor bound without a square root: skip an entry when
+      // |n - n_f| >= best / df - 1 (updated whenever best improves).
+      double r = best / df - 1.0;
+      double r2 = r * r * (1.0 + 1e-12);
+      for (int j = j0; j < j1; ++j) {
+        const double* fn = &entry_normals_[4 * static_cast<std::size_t>(j)];
+        const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
+        const double dn2 = nx * nx + ny * ny + nz * nz;
+        if (dn2 >= r2) continue;
+        const double nfac = 1.0 + std::sqrt(dn2);
+        const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
+        const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
+        const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp4[3];
+        if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best) continue;
+        const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
+        const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
+        if (cost < best) {
+          best = cost;
+          update_reach();
+          r = best / df - 1.0;
+          r2 = r * r * (1.0 + 1e-12);
         }
       }
+      continue;
+    }
+    // Inner node: push the farther child first so the nearer one is searched first.
+    const int left = i + 1, right = a;
+    const double dl = box_distance2(left), dr = box_distance2(right);
+    const bool left_first = dl <= dr;
+    const int first = left_first ? left : right, second = left_first ? right : left;
+    const double d1 = left_first ? dl : dr, d2 = left_first ? dr : dl;
+    if (d2 < reach2) {
+      stack[sp] = second;
+      stack_d2[sp++] = d2;
+    }
+    if (d1 < reach2) {
+      stack[sp] = first;
+      stack_d2[sp++] = d1;
     }
   }
   return best;
 }
 
-Eigen::VectorXd TranslationCostCpu::evaluate(const SwatchDistanceGrid& grid,
+Eigen::VectorXd TranslationCostCpu::evaluate(const SwatchFaceTree& tree,
                                              const TranslationCostProblem& problem) {
   validate_translation_cost_problem(problem);
   const Eigen::Index P = problem.points.rows(), T = problem.offsets.rows();
@@ -306,7 +272,7 @@ Eigen::VectorXd TranslationCostCpu::evaluate(const SwatchDistanceGrid& grid,
         for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
           const Eigen::Index t = i / P, p = i % P;
           const Vector3d q = problem.points.row(p) - problem.offsets.row(t);
-          minima[i] = grid.min_face_cost(q, problem.point_normals.row(p), problem.lambda);
+          minima[i] = tree.min_face_cost(q, problem.point_normals.row(p), problem.lambda);
         }
       });
   return sum_per_offset(minima, P, T);

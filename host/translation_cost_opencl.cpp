@@ -11,8 +11,8 @@ namespace mq {
 
 namespace {
 
-// Grids kept on the device at once; beyond this the cache is flushed.
-constexpr std::size_t kMaxCachedGrids = 4;
+// Trees kept on the device at once; beyond this the cache is flushed.
+constexpr std::size_t kMaxCachedTrees = 4;
 // Bound on #P * (offsets per launch), i.e. on the minima buffer (8 bytes each).
 constexpr std::size_t kMaxMinimaPerLaunch = std::size_t(1) << 23;
 
@@ -36,25 +36,24 @@ TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtim
   group_ = cl::work_group_size(kernel_.get(), runtime_->device());
 }
 
-const TranslationCostOpenCL::DeviceGrid& TranslationCostOpenCL::upload(
-    const SwatchDistanceGrid& grid) {
-  auto it = grids_.find(grid.fingerprint());
-  if (it != grids_.end()) return it->second;
-  if (grids_.size() >= kMaxCachedGrids) grids_.clear();
+const TranslationCostOpenCL::DeviceTree& TranslationCostOpenCL::upload(
+    const SwatchFaceTree& tree) {
+  auto it = trees_.find(tree.fingerprint());
+  if (it != trees_.end()) return it->second;
+  if (trees_.size() >= kMaxCachedTrees) trees_.clear();
   const cl_context ctx = runtime_->context();
-  DeviceGrid d;
+  DeviceTree d;
   d.entry_triangles =
-      upload_array(ctx, grid.entry_triangles().data(), grid.entry_triangles().size());
-  d.entry_normals = upload_array(ctx, grid.entry_normals().data(), grid.entry_normals().size());
-  d.entry_spheres = upload_array(ctx, grid.entry_spheres().data(), grid.entry_spheres().size());
-  d.cell_start = upload_array(ctx, grid.cell_start().data(), grid.cell_start().size());
-  d.cell_boxes = upload_array(ctx, grid.cell_boxes().data(), grid.cell_boxes().size());
-  d.cell_cones =
-      upload_array(ctx, grid.cell_normal_cones().data(), grid.cell_normal_cones().size());
-  return grids_.emplace(grid.fingerprint(), std::move(d)).first->second;
+      upload_array(ctx, tree.entry_triangles().data(), tree.entry_triangles().size());
+  d.entry_normals = upload_array(ctx, tree.entry_normals().data(), tree.entry_normals().size());
+  d.entry_spheres = upload_array(ctx, tree.entry_spheres().data(), tree.entry_spheres().size());
+  d.node_links = upload_array(ctx, tree.node_links().data(), tree.node_links().size());
+  d.node_boxes = upload_array(ctx, tree.node_boxes().data(), tree.node_boxes().size());
+  d.node_cones = upload_array(ctx, tree.node_cones().data(), tree.node_cones().size());
+  return trees_.emplace(tree.fingerprint(), std::move(d)).first->second;
 }
 
-Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
+Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchFaceTree& tree,
                                                 const TranslationCostProblem& problem) {
   validate_translation_cost_problem(problem);
   const std::size_t P = static_cast<std::size_t>(problem.points.rows());
@@ -63,7 +62,7 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
   if (P == 0 || T == 0) return E;
   MQ_CHECK(P <= kMaxMinimaPerLaunch, InvalidInput, "translation cost: too many points (", P, ")");
 
-  const DeviceGrid& dg = upload(grid);
+  const DeviceTree& dt = upload(tree);
   const cl_context ctx = runtime_->context();
   const cl_command_queue queue = runtime_->queue();
   const cl::Buffer points = upload_array(ctx, problem.points.data(), problem.points.size());
@@ -76,22 +75,16 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchDistanceGrid& grid,
   const cl_kernel k = kernel_.get();
   cl::set_arg(k, 0, points.get());
   cl::set_arg(k, 1, normals.get());
-  cl::set_arg(k, 3, dg.entry_triangles.get());
-  cl::set_arg(k, 4, dg.entry_normals.get());
-  cl::set_arg(k, 5, dg.entry_spheres.get());
-  cl::set_arg(k, 6, dg.cell_start.get());
-  cl::set_arg(k, 7, dg.cell_boxes.get());
-  cl::set_arg(k, 8, dg.cell_cones.get());
-  cl::set_arg(k, 9, grid.origin()(0));
-  cl::set_arg(k, 10, grid.origin()(1));
-  cl::set_arg(k, 11, grid.origin()(2));
-  cl::set_arg(k, 12, grid.cell_size());
-  cl::set_arg(k, 13, cl_int(grid.dims()(0)));
-  cl::set_arg(k, 14, cl_int(grid.dims()(1)));
-  cl::set_arg(k, 15, cl_int(grid.dims()(2)));
-  cl::set_arg(k, 16, problem.lambda);
-  cl::set_arg(k, 17, cl_int(P));
-  cl::set_arg(k, 18, out.get());
+  cl::set_arg(k, 3, dt.entry_triangles.get());
+  cl::set_arg(k, 4, dt.entry_normals.get());
+  cl::set_arg(k, 5, dt.entry_spheres.get());
+  cl::set_arg(k, 6, dt.node_links.get());
+  cl::set_arg(k, 7, dt.node_boxes.get());
+  cl::set_arg(k, 8, dt.node_cones.get());
+  cl::set_arg(k, 9, tree.query_slack());
+  cl::set_arg(k, 10, problem.lambda);
+  cl::set_arg(k, 11, cl_int(P));
+  cl::set_arg(k, 12, out.get());
 
   std::vector<double> minima(P * chunk);
   for (std::size_t t0 = 0; t0 < T; t0 += chunk) {

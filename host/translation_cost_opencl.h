@@ -18,31 +18,31 @@ namespace mq {
 // deterministic and use the same summation order as the CPU path. Runs in double precision;
 // per-offset costs agree with the CPU path to rounding (FP_CONTRACT is off in the kernel; on
 // PoCL's CPU device they came out bitwise identical).
-// Swatch grids are uploaded once and cached by their fingerprint (a few grids at a time).
+// Swatch trees are uploaded once and cached by their fingerprint (a few trees at a time).
 class TranslationCostOpenCL final : public TranslationCostEvaluator {
  public:
   // Builds the kernel through the runtime's program cache. Throws DeviceError when the device
   // lacks cl_khr_fp64 or the build fails; InvalidInput when runtime is null.
   explicit TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime);
 
-  Eigen::VectorXd evaluate(const SwatchDistanceGrid& grid,
+  Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                            const TranslationCostProblem& problem) override;
   std::string name() const override { return "opencl"; }
 
   const cl::Runtime& runtime() const { return *runtime_; }
-  // Number of swatch grids currently held on the device.
-  std::size_t num_cached_grids() const { return grids_.size(); }
+  // Number of swatch trees currently held on the device.
+  std::size_t num_cached_trees() const { return trees_.size(); }
 
  private:
-  struct DeviceGrid {
-    cl::Buffer entry_triangles, entry_normals, entry_spheres, cell_start, cell_boxes, cell_cones;
+  struct DeviceTree {
+    cl::Buffer entry_triangles, entry_normals, entry_spheres, node_links, node_boxes, node_cones;
   };
-  const DeviceGrid& upload(const SwatchDistanceGrid& grid);
+  const DeviceTree& upload(const SwatchFaceTree& tree);
 
   std::shared_ptr<cl::Runtime> runtime_;
   cl::Kernel kernel_;
   std::size_t group_ = 1;  // work-group size along the points
-  std::map<std::uint64_t, DeviceGrid> grids_;
+  std::map<std::uint64_t, DeviceTree> trees_;
 };
 
 }  // namespace mq

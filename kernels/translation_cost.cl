@@ -2,7 +2,7 @@
 // one work-item per (point p, offset t) writes min over faces f of
 //   (1 + lambda * Dist(v_p - t, f)) * (1 + |n_p - n_f|)
 // to out[t_local * num_points + p]; the host sums each offset's row in point order (Eq. 3).
-// The grid traversal and the point-triangle region tests mirror core/translation_cost.cpp and
+// The tree traversal and the point-triangle region tests mirror core/translation_cost.cpp and
 // core/point_triangle.h (Ericson, Real-Time Collision Detection 5.1.5).
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
@@ -57,87 +57,88 @@ static real triangle_dist2(real3 p, real3 a, real3 b, real3 c) {
   return d.x * d.x + d.y * d.y + d.z * d.z;
 }
 
-// Distance, in cells, from continuous cell coordinate g to the slab of cell i.
-static real cell_gap(real g, int i) { return fmax((real)0, fmax(i - g, g - (i + 1))); }
+// Squared distance from q to a node's box.
+static real box_distance2(real3 q, __global const real* box) {
+  const real3 e = fmax((real3)(0), fmax(vload3(0, box) - q, q - vload3(0, box + 4)));
+  return e.x * e.x + e.y * e.y + e.z * e.z;
+}
+
+#define MAX_STACK 50  // SwatchFaceTree::kMaxDepth + 2
 
 __kernel void translation_cost_minima(
     __global const real* points,          // #P * 3
     __global const real* point_normals,   // #P * 3
     __global const real* offsets,         // #T * 3, starting at this launch's first offset
-    __global const real* entry_triangles, // #entries * 9, in cell order
-    __global const real* entry_normals,   // #entries * 4: unit face normal, 0
-    __global const real* entry_spheres,   // #entries * 4: centre, radius
-    __global const int* cell_start,       // #cells + 1
-    __global const real* cell_boxes,      // #cells * 8: box of the cell's face parts
-    __global const real* cell_cones,      // #cells * 4: normal cone (direction, radius)
-    const real origin_x, const real origin_y, const real origin_z, const real h,
-    const int nx, const int ny, const int nz, const real lambda, const int num_points,
+    __global const real* entry_triangles, // #F * 9, in leaf order
+    __global const real* entry_normals,   // #F * 4: unit face normal, 0
+    __global const real* entry_spheres,   // #F * 4: centre, radius
+    __global const int* node_links,       // #nodes * 2: (right child, 0) or (-1 - first, count)
+    __global const real* node_boxes,      // #nodes * 8: box of the node's faces
+    __global const real* node_cones,      // #nodes * 4: normal cone (direction, radius)
+    const real slack, const real lambda, const int num_points,
     __global real* out) {                  // #T * #P
   const int p = get_global_id(0);
   const int t = get_global_id(1);
   if (p >= num_points) return;
   const real3 q = vload3(p, points) - vload3(t, offsets);
   const real3 n = vload3(p, point_normals);
-  const int dims[3] = {nx, ny, nz};
-  const real g[3] = {(q.x - origin_x) / h, (q.y - origin_y) / h, (q.z - origin_z) / h};
-  int c[3];
-  for (int a = 0; a < 3; ++a) c[a] = (int)clamp(floor(g[a]), (real)0, (real)(dims[a] - 1));
-  const real slack = 1e-9 * h;
-  real best = INFINITY;
-  for (int k = 0;; ++k) {
-    if (k > 0) {
-      real lb = INFINITY;
-      for (int a = 0; a < 3; ++a)
-        for (int s = -1; s <= 1; s += 2) {
-          const int i = c[a] + s * k;
-          if (i >= 0 && i < dims[a]) lb = fmin(lb, cell_gap(g[a], i));
-        }
-      if (lb == INFINITY) break;
-      if (1 + lambda * (lb * h - slack) >= best) break;
-    }
-    const int x0 = max(0, c[0] - k), x1 = min(nx - 1, c[0] + k);
-    const int y0 = max(0, c[1] - k), y1 = min(ny - 1, c[1] + k);
-    for (int x = x0; x <= x1; ++x) {
-      for (int y = y0; y <= y1; ++y) {
-        const bool shell = abs(x - c[0]) == k || abs(y - c[1]) == k;
-        const int z0 = shell ? max(0, c[2] - k) : 0;
-        const int z1 = shell ? min(nz - 1, c[2] + k) : (k > 0 ? 1 : 0);
-        for (int zi = z0; zi <= z1; ++zi) {
-          const int z = shell ? zi : (zi == 0 ? c[2] - k : c[2] + k);
-          if (z < 0 || z >= nz) continue;
-          const int cell = (z * ny + y) * nx + x;
-          const int j0 = cell_start[cell], j1 = cell_start[cell + 1];
-          if (j0 == j1) continue;
-          const real3 blo = vload3(0, cell_boxes + 8 * cell);
-          const real3 bhi = vload3(0, cell_boxes + 8 * cell + 4);
-          const real3 e = fmax((real3)(0), fmax(blo - q, q - bhi));
-          const real dist_factor = 1 + lambda * (sqrt(e.x * e.x + e.y * e.y + e.z * e.z) - slack);
-          if (dist_factor >= best) continue;
-          const real3 dc = n - vload3(0, cell_cones + 4 * cell);
-          const real cone_lb = sqrt(dc.x * dc.x + dc.y * dc.y + dc.z * dc.z) - cell_cones[4 * cell + 3];
-          if (dist_factor * (1 + fmax((real)0, cone_lb)) >= best) continue;
-          real r = best / dist_factor - 1;
-          real r2 = r * r * (1 + 1e-12);
-          for (int j = j0; j < j1; ++j) {
-            const real3 dn = n - vload3(0, entry_normals + 4 * j);
-            const real dn2 = dn.x * dn.x + dn.y * dn.y + dn.z * dn.z;
-            if (dn2 >= r2) continue;
-            const real nf = 1 + sqrt(dn2);
-            const real3 ds = q - vload3(0, entry_spheres + 4 * j);
-            const real sphere_lb = sqrt(ds.x * ds.x + ds.y * ds.y + ds.z * ds.z) - entry_spheres[4 * j + 3];
-            if ((1 + lambda * (sphere_lb - slack)) * nf >= best) continue;
-            const real d2 = triangle_dist2(q, vload3(3 * j, entry_triangles),
-                                           vload3(3 * j + 1, entry_triangles),
-                                           vload3(3 * j + 2, entry_triangles));
-            const real cost = (1 + lambda * sqrt(d2)) * nf;
-            if (cost < best) {
-              best = cost;
-              r = best / dist_factor - 1;
-              r2 = r * r * (1 + 1e-12);
-            }
+  real best = INFINITY, reach2 = INFINITY;
+  int stack[MAX_STACK];
+  real stack_d2[MAX_STACK];
+  int sp = 0;
+  stack[sp] = 0;
+  stack_d2[sp++] = 0;
+  while (sp > 0) {
+    --sp;
+    const int i = stack[sp];
+    if (stack_d2[sp] >= reach2) continue;
+    const int a = node_links[2 * i];
+    if (a < 0) {
+      const real df = 1 + lambda * (sqrt(stack_d2[sp]) - slack);
+      const real3 dc = n - vload3(0, node_cones + 4 * i);
+      const real cone_lb = sqrt(dc.x * dc.x + dc.y * dc.y + dc.z * dc.z) - node_cones[4 * i + 3];
+      if (df * (1 + fmax((real)0, cone_lb)) >= best) continue;
+      const int j0 = -1 - a, j1 = j0 + node_links[2 * i + 1];
+      real r = best / df - 1;
+      real r2 = r * r * (1 + 1e-12);
+      for (int j = j0; j < j1; ++j) {
+        const real3 dn = n - vload3(0, entry_normals + 4 * j);
+        const real dn2 = dn.x * dn.x + dn.y * dn.y + dn.z * dn.z;
+        if (dn2 >= r2) continue;
+        const real nf = 1 + sqrt(dn2);
+        const real3 ds = q - vload3(0, entry_spheres + 4 * j);
+        const real sphere_lb = sqrt(ds.x * ds.x + ds.y * ds.y + ds.z * ds.z) - entry_spheres[4 * j + 3];
+        if ((1 + lambda * (sphere_lb - slack)) * nf >= best) continue;
+        const real d2 = triangle_dist2(q, vload3(3 * j, entry_triangles),
+                                       vload3(3 * j + 1, entry_triangles),
+                                       vload3(3 * j + 2, entry_triangles));
+        const real cost = (1 + lambda * sqrt(d2)) * nf;
+        if (cost < best) {
+          best = cost;
+          if (lambda > 0) {
+            const real reach = (best - 1) / lambda + slack;
+            reach2 = reach * reach * (1 + 1e-12);
           }
+          r = best / df - 1;
+          r2 = r * r * (1 + 1e-12);
         }
       }
+      continue;
+    }
+    // Inner node: push the farther child first so the nearer one is searched first.
+    const int left = i + 1, right = a;
+    const real dl = box_distance2(q, node_boxes + 8 * left);
+    const real dr = box_distance2(q, node_boxes + 8 * right);
+    const bool left_first = dl <= dr;
+    const int first = left_first ? left : right, second = left_first ? right : left;
+    const real d1 = left_first ? dl : dr, d2 = left_first ? dr : dl;
+    if (d2 < reach2) {
+      stack[sp] = second;
+      stack_d2[sp++] = d2;
+    }
+    if (d1 < reach2) {
+      stack[sp] = first;
+      stack_d2[sp++] = d1;
     }
   }
   out[t * num_points + p] = best;

@@ -71,7 +71,7 @@ double periodic_distance(const Vector3d& a, const Vector3d& b, double px, double
 
 TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   MatrixX3d P, NP;
   const Vector3d shift(fx.px(), fx.py(), 0);  // 4 and 2 cells
@@ -108,7 +108,7 @@ TEST(GeometryMatching, PeriodicSwatchFindsAnExactPeriodOffset) {
 
 TEST(GeometryMatching, ScreeningKeepsTheExhaustiveChoiceAtAFractionOfTheWork) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   MatrixX3d P, NP;
   const Vector3d shift(fx.px(), fx.py(), 0);
@@ -134,7 +134,7 @@ TEST(GeometryMatching, ScreeningKeepsTheExhaustiveChoiceAtAFractionOfTheWork) {
 
 TEST(GeometryMatching, RefinementRecoversASubCellShift) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   MatrixX3d P, NP;
   const Vector3d shift(fx.px() + 0.2, fx.py() - 0.15, 0);  // +0.32 and -0.24 of a cell
@@ -160,7 +160,7 @@ TEST(GeometryMatching, RefinementRecoversASubCellShift) {
 
 TEST(GeometryMatching, RefinementStaysInTheAdmissibleRange) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   MatrixX3d P, NP;
   fx.subpatch(2.0, 4.0, 1.5, 3.0, Vector3d(fx.px() + 0.2, fx.py() - 0.15, 0), P, NP);
@@ -179,7 +179,7 @@ TEST(GeometryMatching, RefinementStaysInTheAdmissibleRange) {
 
 TEST(GeometryMatching, VarietyIsSeededAndStaysNearTheMinimum) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   MatrixX3d P, NP;
   fx.subpatch(2.0, 4.0, 1.5, 3.0, Vector3d(fx.px(), fx.py(), 0), P, NP);
@@ -211,7 +211,7 @@ TEST(GeometryMatching, VarietyIsSeededAndStaysNearTheMinimum) {
 
 TEST(GeometryMatching, EdgeCases) {
   const PeriodicFixture fx;
-  const SwatchDistanceGrid grid(fx.swatch.V, fx.swatch.F);
+  const SwatchFaceTree grid(fx.swatch.V, fx.swatch.F);
   TranslationCostCpu cpu;
   std::mt19937_64 rng(1);
   MatchingOptions options;

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include <functional>
 #include <tbb/task_arena.h>
 
 #include <cmath>
@@ -56,40 +58,70 @@ TEST(TranslationCost, BruteForceMatchesHandComputedValues) {
   EXPECT_NEAR(E(1), (1 + 0.5 * d0) * 1 + (1 + 0.5 * 2) * 3, 1e-12);
 }
 
-TEST(TranslationCost, GridQueryIsExactEverywhere) {
-  // Points inside, near and far outside the grid, several lambdas and cell sizes.
+TEST(TranslationCost, TreeQueryIsExactEverywhere) {
+  // Points inside, near and far outside the swatch, several lambdas and leaf sizes.
   const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
   std::mt19937_64 rng(7);
-  for (double cell : {0.0, 0.13, 1.7}) {
-    const SwatchDistanceGrid grid(torus.V, torus.F, cell);
-    if (cell > 0) {
-      EXPECT_DOUBLE_EQ(grid.cell_size(), cell);
-    }
+  for (int leaf : {1, 4, 64, 10000}) {
+    const SwatchFaceTree tree(torus.V, torus.F, leaf);
     for (double lambda : {0.0, 1.0, 4.0}) {
       for (int i = 0; i < 40; ++i) {
         const double r = i < 20 ? 3.0 : 30.0;
         const Vector3d q(uniform(rng, -r, r), uniform(rng, -r, r), uniform(rng, -r, r));
         const Vector3d n = Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), 0.3).normalized();
         const double expected = min_face_cost_reference(torus.V, torus.F, q, n, lambda);
-        EXPECT_NEAR(grid.min_face_cost(q, n, lambda), expected, 1e-12 * expected)
-            << "cell " << cell << " lambda " << lambda << " q " << q.transpose();
+        EXPECT_NEAR(tree.min_face_cost(q, n, lambda), expected, 1e-12 * expected)
+            << "leaf " << leaf << " lambda " << lambda << " q " << q.transpose();
       }
     }
   }
 }
 
-TEST(TranslationCost, GridBinsEveryFace) {
+TEST(TranslationCost, TreeHoldsEveryFaceOnceInBoundedLeaves) {
   const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
-  const SwatchDistanceGrid grid(torus.V, torus.F);
-  EXPECT_EQ(grid.num_faces(), torus.num_faces());
-  EXPECT_LE(grid.num_cells(), 2 * torus.num_faces() + 64);
-  EXPECT_EQ(grid.cell_start().size(), std::size_t(grid.num_cells()) + 1);
+  const int leaf = 8;
+  const SwatchFaceTree tree(torus.V, torus.F, leaf);
+  EXPECT_EQ(tree.num_faces(), torus.num_faces());
   std::vector<int> seen(torus.num_faces(), 0);
-  for (int f : grid.cell_faces()) ++seen[f];
-  for (int f = 0; f < torus.num_faces(); ++f) EXPECT_GT(seen[f], 0) << "face " << f;
+  for (int f : tree.entry_faces()) ++seen[f];
+  for (int f = 0; f < torus.num_faces(); ++f) EXPECT_EQ(seen[f], 1) << "face " << f;
+  // Leaves partition the entries in order, hold at most `leaf` faces, and every node's box and
+  // normal cone hold all faces below it; median splits keep the tree balanced.
+  const std::vector<int>& links = tree.node_links();
+  int next_entry = 0;
+  for (int i = 0; i < tree.num_nodes(); ++i) {
+    if (links[2 * i] >= 0) continue;
+    EXPECT_EQ(-1 - links[2 * i], next_entry);
+    EXPECT_LE(links[2 * i + 1], leaf);
+    EXPECT_GE(links[2 * i + 1], 1);
+    next_entry += links[2 * i + 1];
+  }
+  EXPECT_EQ(next_entry, torus.num_faces());
+  std::function<void(int, std::vector<int>&)> faces_below = [&](int i, std::vector<int>& out) {
+    if (links[2 * i] < 0) {
+      for (int j = -1 - links[2 * i]; j < -1 - links[2 * i] + links[2 * i + 1]; ++j) out.push_back(j);
+      return;
+    }
+    faces_below(i + 1, out);
+    faces_below(links[2 * i], out);
+  };
+  for (int i = 0; i < tree.num_nodes(); i += 7) {
+    std::vector<int> entries;
+    faces_below(i, entries);
+    const double* box = &tree.node_boxes()[8 * i];
+    const double* cone = &tree.node_cones()[4 * i];
+    for (const int j : entries) {
+      for (int k = 0; k < 9; ++k)
+        EXPECT_TRUE(tree.entry_triangles()[9 * j + k] >= box[k % 3] &&
+                    tree.entry_triangles()[9 * j + k] <= box[4 + k % 3]);
+      const Vector3d nf(&tree.entry_normals()[4 * j]);
+      EXPECT_LE((nf - Vector3d(cone)).norm(), cone[3]);
+    }
+  }
+  EXPECT_LE(tree.depth(), static_cast<int>(std::ceil(std::log2(torus.num_faces() / 4.0))) + 1);
   // The fingerprint follows the content.
-  EXPECT_EQ(grid.fingerprint(), SwatchDistanceGrid(torus.V, torus.F).fingerprint());
-  EXPECT_NE(grid.fingerprint(), SwatchDistanceGrid(torus.V, torus.F, 0.3).fingerprint());
+  EXPECT_EQ(tree.fingerprint(), SwatchFaceTree(torus.V, torus.F, leaf).fingerprint());
+  EXPECT_NE(tree.fingerprint(), SwatchFaceTree(torus.V, torus.F, 16).fingerprint());
 }
 
 TEST(TranslationCost, BestOffsetTieRule) {
@@ -105,17 +137,16 @@ TEST(TranslationCost, BestOffsetTieRule) {
   EXPECT_THROW(best_offset(c), InvalidInput);
 }
 
-TEST(TranslationCost, InvalidGridInputThrows) {
+TEST(TranslationCost, InvalidTreeInputThrows) {
   const TriMesh cube = test::unit_cube();
-  EXPECT_THROW(SwatchDistanceGrid(cube.V, MatrixX3i(0, 3)), InvalidInput);
+  EXPECT_THROW(SwatchFaceTree(cube.V, MatrixX3i(0, 3)), InvalidInput);
   MatrixX3i badF = cube.F;
   badF(3, 1) = 8;
-  EXPECT_THROW(SwatchDistanceGrid(cube.V, badF), InvalidInput);
+  EXPECT_THROW(SwatchFaceTree(cube.V, badF), InvalidInput);
   MatrixX3d badV = cube.V;
   badV(2, 0) = std::nan("");
-  EXPECT_THROW(SwatchDistanceGrid(badV, cube.F), InvalidInput);
-  EXPECT_THROW(SwatchDistanceGrid(cube.V, cube.F, -1.0), InvalidInput);
-  EXPECT_THROW(SwatchDistanceGrid(cube.V, cube.F, 1e-6), InvalidInput);  // 10^18 cells
+  EXPECT_THROW(SwatchFaceTree(badV, cube.F), InvalidInput);
+  EXPECT_THROW(SwatchFaceTree(cube.V, cube.F, 0), InvalidInput);
 }
 
 TEST(TranslationCost, CpuIsIndependentOfThreadCount) {
@@ -126,14 +157,14 @@ TEST(TranslationCost, CpuIsIndependentOfThreadCount) {
   pb.point_normals = N.topRows(100);
   pb.offsets.resize(9, 3);
   for (int i = 0; i < 9; ++i) pb.offsets.row(i) << 0.1 * (i % 3), 0.1 * (i / 3), 0.0;
-  const SwatchDistanceGrid grid(torus.V, torus.F);
+  const SwatchFaceTree tree(torus.V, torus.F);
   TranslationCostCpu cpu;
   Eigen::VectorXd one, two;
-  tbb::task_arena(1).execute([&] { one = cpu.evaluate(grid, pb); });
-  tbb::task_arena(2).execute([&] { two = cpu.evaluate(grid, pb); });
+  tbb::task_arena(1).execute([&] { one = cpu.evaluate(tree, pb); });
+  tbb::task_arena(2).execute([&] { two = cpu.evaluate(tree, pb); });
   ASSERT_EQ(one.size(), 9);
   for (int i = 0; i < 9; ++i) EXPECT_EQ(one(i), two(i)) << "offset " << i;
-  // The grid's pruning is exact and sums in the same order: bitwise equal to brute force.
+  // The tree's pruning is exact and sums in the same order: bitwise equal to brute force.
   const Eigen::VectorXd brute = translation_cost_brute_force(torus.V, torus.F, pb);
   for (int i = 0; i < 9; ++i) EXPECT_EQ(one(i), brute(i)) << "offset " << i;
   // Zero offset puts every point on the swatch: the smallest cost.

@@ -69,8 +69,8 @@ class TranslationCostPaths : public ::testing::TestWithParam<Device> {
   // also checks that the costs differ enough across offsets for the test to mean something.
   void expect_agreement(const TriMesh& m, const TranslationCostProblem& pb,
                         double min_spread = 1.05) {
-    const SwatchDistanceGrid grid(m.V, m.F);
-    const Eigen::VectorXd fast = evaluator_->evaluate(grid, pb);
+    const SwatchFaceTree tree(m.V, m.F);
+    const Eigen::VectorXd fast = evaluator_->evaluate(tree, pb);
     const Eigen::VectorXd brute = translation_cost_brute_force(m.V, m.F, pb);
     ASSERT_EQ(fast.size(), brute.size());
     for (Eigen::Index t = 0; t < brute.size(); ++t) {
@@ -95,8 +95,8 @@ TEST_P(TranslationCostPaths, ExactShiftOfTorusSwatchWins) {
   const TranslationCostProblem pb =
       self_subpatch(m, 2, Vector3d(3.1 * h, -1.7 * h, 0), 0.6 * h, 0.0, 1.0, 1);
   expect_agreement(m, pb);
-  const SwatchDistanceGrid grid(m.V, m.F);
-  EXPECT_EQ(best_offset(evaluator_->evaluate(grid, pb)), 12);
+  const SwatchFaceTree tree(m.V, m.F);
+  EXPECT_EQ(best_offset(evaluator_->evaluate(tree, pb)), 12);
 }
 
 TEST_P(TranslationCostPaths, PerturbedTorusSubpatchLambdaNotOne) {
@@ -130,52 +130,52 @@ TEST_P(TranslationCostPaths, PointsFarOutsideTheSwatch) {
 TEST_P(TranslationCostPaths, RepeatedEvaluationIsIdentical) {
   const TriMesh m = test::torus(2.0, 0.5, 32, 16);
   const TranslationCostProblem pb = self_subpatch(m, 3, Vector3d(0.3, 0.1, 0), 0.2, 0.02, 1, 5);
-  const SwatchDistanceGrid grid(m.V, m.F);
-  const Eigen::VectorXd a = evaluator_->evaluate(grid, pb);
-  const Eigen::VectorXd b = evaluator_->evaluate(grid, pb);
+  const SwatchFaceTree tree(m.V, m.F);
+  const Eigen::VectorXd a = evaluator_->evaluate(tree, pb);
+  const Eigen::VectorXd b = evaluator_->evaluate(tree, pb);
   for (Eigen::Index t = 0; t < a.size(); ++t) EXPECT_EQ(a(t), b(t)) << "offset " << t;
 }
 
 TEST_P(TranslationCostPaths, EmptyProblem) {
   const TriMesh m = test::unit_cube();
-  const SwatchDistanceGrid grid(m.V, m.F);
+  const SwatchFaceTree tree(m.V, m.F);
   TranslationCostProblem pb;  // no points, no offsets
-  EXPECT_EQ(evaluator_->evaluate(grid, pb).size(), 0);
+  EXPECT_EQ(evaluator_->evaluate(tree, pb).size(), 0);
   pb.offsets = MatrixX3d::Zero(3, 3);  // offsets but no points: E(t) = 0
-  const Eigen::VectorXd E = evaluator_->evaluate(grid, pb);
+  const Eigen::VectorXd E = evaluator_->evaluate(tree, pb);
   ASSERT_EQ(E.size(), 3);
   EXPECT_EQ(E.cwiseAbs().maxCoeff(), 0.0);
   pb.points = MatrixX3d::Constant(2, 3, 0.5);  // points but no offsets
   pb.point_normals = MatrixX3d::Zero(2, 3);
   pb.offsets.resize(0, 3);
-  EXPECT_EQ(evaluator_->evaluate(grid, pb).size(), 0);
+  EXPECT_EQ(evaluator_->evaluate(tree, pb).size(), 0);
 }
 
 TEST_P(TranslationCostPaths, InvalidInputThrows) {
   const TriMesh m = test::unit_cube();
-  const SwatchDistanceGrid grid(m.V, m.F);
+  const SwatchFaceTree tree(m.V, m.F);
   TranslationCostProblem good;
   good.points = MatrixX3d::Constant(2, 3, 0.5);
   good.point_normals = MatrixX3d::Zero(2, 3);
   good.offsets = MatrixX3d::Zero(1, 3);
-  EXPECT_NO_THROW(evaluator_->evaluate(grid, good));
+  EXPECT_NO_THROW(evaluator_->evaluate(tree, good));
   TranslationCostProblem pb = good;
   pb.point_normals = MatrixX3d::Zero(3, 3);
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
   pb = good;
   pb.points(1, 2) = std::nan("");
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
   pb = good;
   pb.point_normals(0, 0) = std::nan("");
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
   pb = good;
   pb.offsets(0, 1) = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
   pb = good;
   pb.lambda = -1.0;
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
   pb.lambda = std::nan("");
-  EXPECT_THROW(evaluator_->evaluate(grid, pb), InvalidInput);
+  EXPECT_THROW(evaluator_->evaluate(tree, pb), InvalidInput);
 }
 
 INSTANTIATE_TEST_SUITE_P(Paths, TranslationCostPaths,
@@ -188,18 +188,18 @@ TEST(TranslationCostOpenCL, SwatchGridIsUploadedOncePerGrid) {
   if (!cl::Runtime::available()) GTEST_SKIP() << "no OpenCL platform";
   TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>());
   const TriMesh a = test::torus(2.0, 0.5, 16, 8), b = test::unit_cube();
-  const SwatchDistanceGrid ga(a.V, a.F), gb(b.V, b.F);
+  const SwatchFaceTree ga(a.V, a.F), gb(b.V, b.F);
   TranslationCostProblem pb;
   pb.points = MatrixX3d::Constant(4, 3, 0.25);
   pb.point_normals = MatrixX3d::Zero(4, 3);
   pb.offsets = MatrixX3d::Zero(2, 3);
   const Eigen::VectorXd first = ocl.evaluate(ga, pb);
-  EXPECT_EQ(ocl.num_cached_grids(), 1u);
+  EXPECT_EQ(ocl.num_cached_trees(), 1u);
   ocl.evaluate(ga, pb);
-  EXPECT_EQ(ocl.num_cached_grids(), 1u);
+  EXPECT_EQ(ocl.num_cached_trees(), 1u);
   const Eigen::VectorXd cube = ocl.evaluate(gb, pb);
-  EXPECT_EQ(ocl.num_cached_grids(), 2u);
-  // The cached buffers belong to the right grid.
+  EXPECT_EQ(ocl.num_cached_trees(), 2u);
+  // The cached buffers belong to the right tree.
   EXPECT_EQ(ocl.evaluate(ga, pb)(0), first(0));
   EXPECT_NE(cube(0), first(0));
 }
