@@ -23,7 +23,7 @@ struct MatchingOptions {
   // (0 disables). The paper notes finer offsets help; periodic swatches then align exactly.
   double refine_to = 1e-3;
   // Sub-patch points used by the refinement (an evenly strided subset when there are more).
-  Eigen::Index refine_points = 256;
+  Eigen::Index refine_points = 128;
   // Screening: when there are more than screen_keep candidates and more than screen_points
   // sub-patch points, every candidate is first scored on an evenly strided subset of
   // screen_points points and only the screen_keep best are scored on all points (0 disables).
