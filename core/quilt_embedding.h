@@ -29,7 +29,8 @@ struct QuiltEmbeddingStats {
   int faces = 0, vertices = 0, elements = 0;
   // Spread of element surface areas (how even the texture is over the surface).
   double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
-  // Fraction of the input base's area with output geometry within 1.5 shell heights.
+  // Fraction of the base's area with output geometry within 1.5 shell heights, sampled at the
+  // centroids of the refined base's faces.
   double coverage = 0;
   StageTimes times;
 };
