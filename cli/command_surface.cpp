@@ -54,6 +54,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
   write_element_counts(j, s.counts);
   j.value("rejected_outside_patch", s.rejected_outside_patch)
       .value("removed_post", em.removed_intersecting)
+      .value("unoptimized_map", em.unoptimized_elements)
       .end_object()
       .begin_object("element_area")
       .value("mean", em.element_area_mean)

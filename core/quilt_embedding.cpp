@@ -62,6 +62,16 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     }
   }
   if (map) {
+    // The unoptimised map creates no intersections where the base is concave (the shell is
+    // valid and elements lie in it apart); the optimised one bends its tetrahedra a little, and
+    // an element whose triangles span a bent tetrahedron boundary can then touch a neighbour
+    // (chain mail over the knight: 8 face pairs of 2 rings, none without optimisation). Those
+    // elements keep the unoptimised map.
+    MatrixX3d unoptimized;
+    if (options.optimize_stretch) {
+      ScopedStageTimer timer(stats.times, "embedding");
+      unoptimized = ShellEmbedding(*map).embed(points);
+    }
     {
       ScopedStageTimer timer(stats.times, "stretch optimization");
       stats.stretch_before = stats.stretch_after = map->stretch(stretch);
@@ -75,6 +85,20 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     }
     ScopedStageTimer timer(stats.times, "embedding");
     all.V = ShellEmbedding(*map).embed(points);
+    if (options.optimize_stretch) {
+      std::vector<char> revert(quilt.elements.size(), 0);
+      for (const auto& [f, g] : intersecting_face_pairs(all.V, all.F))
+        revert[static_cast<size_t>(element_of[f])] = revert[static_cast<size_t>(element_of[g])] = 1;
+      Eigen::Index v0 = 0;
+      for (size_t k = 0; k < quilt.elements.size(); ++k) {
+        const Eigen::Index ev = static_cast<Eigen::Index>(quilt.elements[k].face.size());
+        if (revert[k]) {
+          all.V.middleRows(v0, ev) = unoptimized.middleRows(v0, ev);
+          ++stats.unoptimized_elements;
+        }
+        v0 += ev;
+      }
+    }
   } else {
     ScopedStageTimer timer(stats.times, "embedding");
     all.V = normal_displacement(quilt.input_base.V, quilt.input_base.F, points);

@@ -24,6 +24,9 @@ struct QuiltEmbeddingStats {
   int atlas_charts = 0;
   int fold_repaired_vertices = 0;
   int removed_intersecting = 0;
+  // Elements mapped through the shell map as it was before stretch optimisation, because the
+  // optimised map made them intersect another element.
+  int unoptimized_elements = 0;
   // Non-empty when the shell map could not be built and normal displacement was used instead.
   std::string shell_map_failure;
   int faces = 0, vertices = 0, elements = 0;
@@ -37,8 +40,10 @@ struct QuiltEmbeddingStats {
 
 // Embeds the quilt. `stretch` evaluates per-tetrahedron stretch for the shell map (CPU or
 // OpenCL); it is unused for normal displacement. When no valid shell exists over the base, falls
-// back to normal displacement and says why in stats->shell_map_failure. Throws DeviceError from
-// the evaluator.
+// back to normal displacement and says why in stats->shell_map_failure. With stretch
+// optimisation, elements that the optimised map makes intersect another element are mapped
+// through the map as it was before optimisation (stats->unoptimized_elements). Throws
+// DeviceError from the evaluator.
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
                     TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats = nullptr);
 
