@@ -12,7 +12,7 @@
 namespace mq {
 
 struct LocalPatchOptions {
-  double max_area = 0;        // stop growing once the patch area reaches this (0: unlimited)
+  double max_area = 0;  // stop growing once the patch area reaches this (0: unlimited)
   // stop at faces whose centroid lies farther than this from the seed's, measured along the
   // surface as in LocalPatchBuilder::grow (0: unlimited)
   double max_radius = 0;
@@ -26,7 +26,7 @@ struct LocalPatch {
   std::vector<int> vertex_map;  // patch vertex -> base vertex
   MatrixX2d uv;                 // LSCM of the patch, #patch V by 2, area-matched to 3D
   double max_distortion = 1;    // worst face area distortion of uv
-  double distortion = 1;  // 95th percentile of the face area distortions (what is bounded)
+  double distortion = 1;        // 95th percentile of the face area distortions (what is bounded)
   int shrink_steps = 0;         // how many times the patch was halved
   double area = 0;              // 3D area of the patch
 };
@@ -49,10 +49,10 @@ class LocalPatchBuilder {
   // options.max_area or the next face lies beyond options.max_radius. A face is added only when
   // the patch stays a topological disk: it shares one edge with the patch and brings a new
   // vertex, or it shares two edges and closes a notch; faces with zero area or a repeated vertex
-  // are never added. A refused face is retried whenever a neighbour of it joins the patch. The patch is then
-  // flattened with lscm; while the 95th percentile face area distortion exceeds max_distortion or
-  // a UV triangle is flipped, the patch is cut to the longest prefix of its growth order with at
-  // most half its area (every prefix is a disk) and flattened again.
+  // are never added. A refused face is retried whenever a neighbour of it joins the patch. The
+  // patch is then flattened with lscm; while the 95th percentile face area distortion exceeds
+  // max_distortion or a UV triangle is flipped, the patch is cut to the longest prefix of its
+  // growth order with at most half its area (every prefix is a disk) and flattened again.
   // Guarantees: one boundary loop, Euler characteristic 1, the seed is faces[0], area <
   // max_area + area of one face (when max_area > 0). The result may still exceed max_distortion
   // only when it is down to the seed alone.

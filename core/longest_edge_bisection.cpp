@@ -109,7 +109,7 @@ TriMesh bisect_longest_edges(const TriMesh& mesh, double max_edge, int max_faces
     refinement->corners.resize(static_cast<Eigen::Index>(F.size()), 9);
     for (size_t f = 0; f < F.size(); ++f)
       for (int k = 0; k < 3; ++k)
-        refinement->corners.block<1, 3>(static_cast<Eigen::Index>(f), 3 * k) =
+        refinement->corners.block<1, 3>(static_cast<Eigen::Index>(f), 3 * Eigen::Index{k}) =
             corners[f][static_cast<size_t>(k)].transpose();
   }
   return out;
@@ -118,7 +118,7 @@ TriMesh bisect_longest_edges(const TriMesh& mesh, double max_edge, int max_faces
 void to_parent(const Refinement& refinement, int& face, Vector3d& b) {
   Vector3d p = Vector3d::Zero();
   for (int k = 0; k < 3; ++k)
-    p += b(k) * refinement.corners.block<1, 3>(face, 3 * k).transpose();
+    p += b(k) * refinement.corners.block<1, 3>(face, 3 * Eigen::Index{k}).transpose();
   b = p;
   face = refinement.parent[static_cast<size_t>(face)];
 }

@@ -205,8 +205,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       const MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
       MatchingOptions matching = options.matching;
       matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
-      choice =
-          choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+      choice = choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;

@@ -517,8 +517,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
       // The first patch has nothing to match: the swatch is centred on the seed.
       if (P.rows() == 0)
         T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
-      choice =
-          choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+      choice = choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
       stats.matched_point_offsets += choice.point_offsets;
     }
     const Vector3d t = choice.offset;

@@ -28,9 +28,9 @@ struct SurfaceElement {
 struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
-  TriMesh base;            // the (refined) base mesh the local coordinates refer to
-  TriMesh input_base;      // the base as given, coincident vertices welded
-  Refinement refinement;   // base faces in input_base faces (empty: base is input_base)
+  TriMesh base;           // the (refined) base mesh the local coordinates refer to
+  TriMesh input_base;     // the base as given, coincident vertices welded
+  Refinement refinement;  // base faces in input_base faces (empty: base is input_base)
 };
 
 // Local coordinates on the refined base expressed on the input base: refined faces are affine
@@ -66,8 +66,8 @@ struct SurfaceQuiltingOptions {
 
 struct SurfaceQuiltingStats {
   int iterations = 0;
-  int base_faces = 0;              // after refinement
-  int welded_vertices = 0;         // base vertices merged with another at the same position
+  int base_faces = 0;       // after refinement
+  int welded_vertices = 0;  // base vertices merged with another at the same position
   int patches_shrunk = 0;
   double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;

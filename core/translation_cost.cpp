@@ -73,7 +73,8 @@ void validate_translation_cost_problem(const TranslationCostProblem& problem) {
 
 SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_size) {
   MQ_CHECK(F.rows() > 0, InvalidInput, "swatch face tree: the swatch has no faces");
-  MQ_CHECK(V.allFinite(), InvalidInput, "swatch face tree: vertices contain NaN or infinite values");
+  MQ_CHECK(V.allFinite(), InvalidInput,
+           "swatch face tree: vertices contain NaN or infinite values");
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "swatch face tree: face index out of range [0, ", V.rows(), ")");
   MQ_CHECK(leaf_size >= 1, InvalidInput, "swatch face tree: leaf size must be >= 1, got ",

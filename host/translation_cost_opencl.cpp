@@ -36,8 +36,7 @@ TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtim
   group_ = cl::work_group_size(kernel_.get(), runtime_->device());
 }
 
-const TranslationCostOpenCL::DeviceTree& TranslationCostOpenCL::upload(
-    const SwatchFaceTree& tree) {
+const TranslationCostOpenCL::DeviceTree& TranslationCostOpenCL::upload(const SwatchFaceTree& tree) {
   auto it = trees_.find(tree.fingerprint());
   if (it != trees_.end()) return it->second;
   if (trees_.size() >= kMaxCachedTrees) trees_.clear();

@@ -125,8 +125,8 @@ TEST(LocalPatch, RadiusLimits) {
   // Every face of a larger radius patch lies within it along the surface (here: in the plane).
   o.max_radius = 0.3;
   const LocalPatch q = builder.grow(57, o);
-  const Eigen::RowVector3d c0 = (grid.V.row(grid.F(57, 0)) + grid.V.row(grid.F(57, 1)) +
-                                 grid.V.row(grid.F(57, 2))) / 3.0;
+  const Eigen::RowVector3d c0 =
+      (grid.V.row(grid.F(57, 0)) + grid.V.row(grid.F(57, 1)) + grid.V.row(grid.F(57, 2))) / 3.0;
   for (const int f : q.faces) {
     const Eigen::RowVector3d c =
         (grid.V.row(grid.F(f, 0)) + grid.V.row(grid.F(f, 1)) + grid.V.row(grid.F(f, 2))) / 3.0;

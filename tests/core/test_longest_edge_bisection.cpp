@@ -71,7 +71,8 @@ TEST(LongestEdgeBisection, RefinesOnlyWhereEdgesAreLong) {
   long long uniform_faces = wall.num_faces();
   for (double e = longest_edge(wall); e > bound; e *= 0.5) uniform_faces *= 4;
   EXPECT_LT(4LL * fine.num_faces(), uniform_faces);
-  EXPECT_EQ(topology_report(fine).num_boundary_edges > 0, topology_report(wall).num_boundary_edges > 0);
+  EXPECT_EQ(topology_report(fine).num_boundary_edges > 0,
+            topology_report(wall).num_boundary_edges > 0);
   // Same input, same output.
   const TriMesh again = bisect_longest_edges(wall, bound, 1 << 24);
   EXPECT_EQ(again.V, fine.V);

@@ -1,9 +1,8 @@
 #include <gtest/gtest.h>
-
-#include <functional>
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "core/errors.h"
@@ -99,7 +98,8 @@ TEST(TranslationCost, TreeHoldsEveryFaceOnceInBoundedLeaves) {
   EXPECT_EQ(next_entry, torus.num_faces());
   std::function<void(int, std::vector<int>&)> faces_below = [&](int i, std::vector<int>& out) {
     if (links[2 * i] < 0) {
-      for (int j = -1 - links[2 * i]; j < -1 - links[2 * i] + links[2 * i + 1]; ++j) out.push_back(j);
+      for (int j = -1 - links[2 * i]; j < -1 - links[2 * i] + links[2 * i + 1]; ++j)
+        out.push_back(j);
       return;
     }
     faces_below(i + 1, out);

@@ -4,8 +4,8 @@
 
 #include "core/errors.h"
 #include "core/geometry_measures.h"
-#include "core/longest_edge_bisection.h"
 #include "core/local_patch.h"
+#include "core/longest_edge_bisection.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 #include "core/weld_vertices.h"
@@ -38,8 +38,7 @@ TEST(WeldVertices, ASplitCubeBecomesClosedAgain) {
   ASSERT_EQ(welded.num_faces(), split.num_faces());
   // Same triangles in the same order.
   for (int f = 0; f < split.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k)
-      EXPECT_EQ(welded.V.row(welded.F(f, k)), split.V.row(split.F(f, k)));
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(welded.V.row(welded.F(f, k)), split.V.row(split.F(f, k)));
   EXPECT_TRUE(topology_report(welded).closed());
   EXPECT_EQ(topology_report(welded).num_components, 1);
 }
@@ -102,7 +101,7 @@ TEST(WeldVertices, PatchesWrapAroundTheBrickWallPillars) {
     for (const int f : p.faces) turn = std::min(turn, N.row(f).dot(N.row(seed)));
     return turn;
   };
-  EXPECT_GT(widest_turn(wall), 0.99);     // split: stays on the seed's side
+  EXPECT_GT(widest_turn(wall), 0.99);    // split: stays on the seed's side
   EXPECT_LT(widest_turn(welded), 0.01);  // welded: reaches a side at 90 degrees
 }
 
