@@ -23,7 +23,10 @@ struct Fixture {
 
 // Output points: every stride-th swatch vertex, jittered and moved; offsets: a 20 x 20 grid of
 // whole-cell translations around the true shift (t_z = 0).
-Fixture make_fixture(int stride, int offsets_per_axis) {
+// lambda_cells > 0 sets lambda to 1 / (lambda_cells mean edges), as geometry matching does with
+// its grid cell (several edges); else lambda stays 1 in swatch units, where the normal factor
+// dominates Eq. (1).
+Fixture make_fixture(int stride, int offsets_per_axis, double lambda_cells = 0) {
   Fixture fx;
   fx.swatch = read_mesh(std::string(MESHQUILT_SHARED_DATA) + "/swatch/chainlink_half_12k.obj");
   const MatrixX3d N = vertex_normals(fx.swatch.V, fx.swatch.F);
@@ -44,6 +47,7 @@ Fixture make_fixture(int stride, int offsets_per_axis) {
   pb.offsets.resize(n * n, 3);
   for (int i = 0; i < n * n; ++i)
     pb.offsets.row(i) = shift + Vector3d(h * (i % n - n / 2), h * (i / n - n / 2), 0);
+  if (lambda_cells > 0) pb.lambda = 1.0 / (lambda_cells * h);
   return fx;
 }
 
@@ -77,6 +81,30 @@ void BM_TranslationCostTbb(benchmark::State& state) {
   set_counters(state, fx.problem, fx.swatch.num_faces());
 }
 BENCHMARK(BM_TranslationCostTbb)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same with matching's distance weight (lambda = 1 / cell, the cell about 8 mean edges).
+void BM_TranslationCostOpenCLMatchingWeight(benchmark::State& state) {
+  if (!cl::Runtime::available()) {
+    state.SkipWithError("no OpenCL platform");
+    return;
+  }
+  const Fixture fx = make_fixture(3, 20, 8.0);
+  const SwatchFaceTree index(fx.swatch.V, fx.swatch.F);
+  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>());
+  benchmark::DoNotOptimize(ocl.evaluate(index, fx.problem));
+  for (auto _ : state) benchmark::DoNotOptimize(ocl.evaluate(index, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostOpenCLMatchingWeight)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TranslationCostTbbMatchingWeight(benchmark::State& state) {
+  const Fixture fx = make_fixture(3, 20, 8.0);
+  const SwatchFaceTree index(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  for (auto _ : state) benchmark::DoNotOptimize(cpu.evaluate(index, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostTbbMatchingWeight)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_TranslationCostBruteForceReduced(benchmark::State& state) {
   const Fixture fx = make_fixture(30, 4);  // ~200 points x 16 offsets
