@@ -68,10 +68,9 @@ uint32_t LocalPatchBuilder::next_tick() {
 // edge and its distance from it, and moves to the side opposite g's third vertex.
 Vector3d LocalPatchBuilder::unfold_across(int f, int k, int g, const Vector3d& p) const {
   const MatrixX3i& F = base_->F;
-  const Vector3d a = base_->V.row(F(f, k)).transpose();
-  const Vector3d b = base_->V.row(F(f, (k + 1) % 3)).transpose();
-  const Vector3d e = (b - a).normalized();
   const int fa = F(f, k), fb = F(f, (k + 1) % 3);
+  const Vector3d a = base_->V.row(fa).transpose();
+  const Vector3d e = (base_->V.row(fb).transpose() - a).normalized();
   int gc = F(g, 0);
   for (int j = 0; j < 3; ++j)
     if (F(g, j) != fa && F(g, j) != fb) gc = F(g, j);

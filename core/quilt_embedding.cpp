@@ -61,6 +61,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       stats.shell_map_failure = e.what();
     }
   }
+  bool known_disjoint = false;  // no two elements of all.V intersect (already checked)
   if (map) {
     // The unoptimised map creates no intersections where the base is concave (the shell is
     // valid and elements lie in it apart); the optimised one bends its tetrahedra a little, and
@@ -86,8 +87,11 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     ScopedStageTimer timer(stats.times, "embedding");
     all.V = ShellEmbedding(*map).embed(points);
     if (options.optimize_stretch) {
+      const auto pairs = intersecting_face_pairs(all.V, all.F);
+      // Nothing to revert: post-processing would find the same nothing.
+      known_disjoint = pairs.empty();
       std::vector<char> revert(quilt.elements.size(), 0);
-      for (const auto& [f, g] : intersecting_face_pairs(all.V, all.F))
+      for (const auto& [f, g] : pairs)
         revert[static_cast<size_t>(element_of[f])] = revert[static_cast<size_t>(element_of[g])] = 1;
       Eigen::Index v0 = 0;
       for (size_t k = 0; k < quilt.elements.size(); ++k) {
@@ -106,7 +110,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
 
   // Post-processing: of two intersecting elements the later one goes.
   std::vector<char> drop(quilt.elements.size(), 0);
-  if (options.remove_intersecting) {
+  if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "post-processing");
     for (const auto& [f, g] : intersecting_face_pairs(all.V, all.F)) {
       const int a = element_of[f], b = element_of[g];

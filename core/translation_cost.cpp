@@ -119,12 +119,8 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
       double r = 0.0;
       for (int i = begin; i < end; ++i)
         r = std::max(r, (FN.row(order[static_cast<std::size_t>(i)]).transpose() - dir).norm());
-      for (int a = 0; a < 3; ++a) {
-        t.node_boxes_.push_back(bmin(a));
-      }
-      t.node_boxes_.push_back(0.0);
-      for (int a = 0; a < 3; ++a) t.node_boxes_.push_back(bmax(a));
-      t.node_boxes_.push_back(0.0);
+      t.node_boxes_.insert(t.node_boxes_.end(),
+                           {bmin(0), bmin(1), bmin(2), 0.0, bmax(0), bmax(1), bmax(2), 0.0});
       // Slightly enlarged so that rounding never makes the bound exceed a face's true factor.
       t.node_cones_.insert(t.node_cones_.end(), {dir(0), dir(1), dir(2), r * (1 + 1e-12) + 1e-12});
       if (end - begin <= leaf_size) {

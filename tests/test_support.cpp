@@ -70,4 +70,21 @@ TriMesh plane_grid(double w, double h, int nx, int ny) {
   return g;
 }
 
+void expect_same_points_on_coarse(const TriMesh& fine, const TriMesh& coarse, int stride,
+                                  const std::function<void(int&, Vector3d&)>& to_coarse) {
+  for (int f = 0; f < fine.num_faces(); f += stride) {
+    const Vector3d b0(0.2, 0.3, 0.5);
+    Vector3d p = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += b0(k) * fine.V.row(fine.F(f, k)).transpose();
+    int face = f;
+    Vector3d b = b0;
+    to_coarse(face, b);
+    Vector3d q = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) q += b(k) * coarse.V.row(coarse.F(face, k)).transpose();
+    EXPECT_LT((p - q).norm(), 1e-12) << f;
+    EXPECT_NEAR(b.sum(), 1.0, 1e-12);
+    EXPECT_GE(b.minCoeff(), -1e-12);
+  }
+}
+
 }  // namespace mq::test

@@ -1,6 +1,7 @@
 // Shared helpers for the test programs: data paths and small procedural fixtures.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "core/mesh.h"
@@ -21,5 +22,11 @@ TriMesh torus(double R, double r, int n, int m);
 
 // Open regular grid in the z = 0 plane over [0,w]x[0,h], nx by ny quads split in two.
 TriMesh plane_grid(double w, double h, int nx, int ny);
+
+// Expects every stride-th face of `fine`, a refinement of `coarse`, to map through
+// to_coarse(face, barycentric) onto the same 3D point of `coarse` (within 1e-12), with
+// barycentric coordinates that sum to 1 and are not negative.
+void expect_same_points_on_coarse(const TriMesh& fine, const TriMesh& coarse, int stride,
+                                  const std::function<void(int&, Vector3d&)>& to_coarse);
 
 }  // namespace mq::test

@@ -44,19 +44,8 @@ TEST(LongestEdgeBisection, BoundsEdgesAndKeepsTheSurface) {
   for (int f = 0; f < fine.num_faces(); ++f)
     EXPECT_GT(N.row(f).dot(N0.row(r.parent[static_cast<size_t>(f)])), 1 - 1e-9) << f;
   // Points map back exactly.
-  for (int f = 0; f < fine.num_faces(); f += 101) {
-    const Vector3d b0(0.2, 0.3, 0.5);
-    Vector3d p = Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) p += b0(k) * fine.V.row(fine.F(f, k)).transpose();
-    int face = f;
-    Vector3d b = b0;
-    to_parent(r, face, b);
-    Vector3d q = Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) q += b(k) * base.V.row(base.F(face, k)).transpose();
-    EXPECT_LT((p - q).norm(), 1e-12) << f;
-    EXPECT_NEAR(b.sum(), 1.0, 1e-12);
-    EXPECT_GE(b.minCoeff(), -1e-12);
-  }
+  test::expect_same_points_on_coarse(fine, base, 101,
+                                     [&r](int& face, Vector3d& b) { to_parent(r, face, b); });
 }
 
 // The reason for bisection over uniform subdivision: small faces next to large ones are left

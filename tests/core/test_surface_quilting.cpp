@@ -40,19 +40,8 @@ TEST(SurfaceQuilting, LocalCoordinatesMapBackToTheInputBase) {
   quilt.base = bisect_longest_edges(base, 0.2 * mean_edge_length(base.V, base.F), 1 << 22,
                                     &quilt.refinement);
   ASSERT_GT(quilt.base.num_faces(), 20 * base.num_faces());
-  for (int f = 0; f < quilt.base.num_faces(); f += 97) {
-    const Vector3d b0(0.2, 0.3, 0.5);
-    Vector3d p = Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) p += b0(k) * quilt.base.V.row(quilt.base.F(f, k)).transpose();
-    int face = f;
-    Vector3d b = b0;
-    to_input_base(quilt, face, b);
-    Vector3d q = Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) q += b(k) * base.V.row(base.F(face, k)).transpose();
-    EXPECT_LT((p - q).norm(), 1e-12) << f;
-    EXPECT_NEAR(b.sum(), 1.0, 1e-12);
-    EXPECT_GE(b.minCoeff(), -1e-12);
-  }
+  test::expect_same_points_on_coarse(
+      quilt.base, base, 97, [&quilt](int& face, Vector3d& b) { to_input_base(quilt, face, b); });
 }
 
 }  // namespace
