@@ -132,7 +132,10 @@ ClosestPointQuery::ClosestPointQuery(const EmbreeDevice& device, const MatrixX3d
   }
   // From here on the destructor will not run if we throw: release the scene ourselves.
   try {
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    // Most queries are built for one merge step on a few thousand faces: the high-quality
+    // (spatial split) build took 20 ms for 16k faces, the medium one 3 ms, and answers are
+    // the same (the callback keeps the exact minimum whatever the visiting order).
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
     RTCGeometry geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     device_.check("closest point query: rtcNewGeometry");
     // Embree-allocated buffers carry the padding Embree's SIMD loads need.

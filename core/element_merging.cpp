@@ -1,5 +1,7 @@
 #include "core/element_merging.h"
 
+#include <cmath>
+
 #include "core/boundary_loops.h"
 #include "core/closest_point_query.h"
 #include "core/element_cut.h"
@@ -160,9 +162,18 @@ const char* stitch_failure_name(StitchFailure f) {
 }
 
 bool elements_coincide(const Element& a, const Element& b, double tolerance) {
-  const ClosestPointQuery qa(a.V, a.F), qb(b.V, b.F);
+  // Each bounding box lies within the other's enlarged by the tolerance when the elements
+  // coincide, so boxes further apart than that rule it out without building a BVH. The
+  // margin keeps the shortcut conservative under rounding; the exact test decides the rest.
+  const double margin = tolerance * (1 + 1e-9) + 1e-12 * (a.hi - a.lo).norm();
+  const auto apart = [&](double x, double y) { return std::abs(x - y) > margin; };
+  for (int k = 0; k < 2; ++k)
+    if (apart(a.lo[k], b.lo[k]) || apart(a.hi[k], b.hi[k])) return false;
+  if (apart(a.z_lo, b.z_lo) || apart(a.z_hi, b.z_hi)) return false;
+  const ClosestPointQuery qb(b.V, b.F);
   for (int v = 0; v < a.V.rows(); ++v)
     if (qb.closest(Vector3d(a.V.row(v).transpose()), tolerance).face < 0) return false;
+  const ClosestPointQuery qa(a.V, a.F);
   for (int v = 0; v < b.V.rows(); ++v)
     if (qa.closest(Vector3d(b.V.row(v).transpose()), tolerance).face < 0) return false;
   return true;
@@ -209,12 +220,18 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   std::vector<int> fc;
   if (connected_components(stitched->mesh.F, stitched->mesh.num_vertices(), fc) != 1)
     return fail(StitchFailure::NotOneComponent);
-  const int boundary = count_boundary_edges(stitched->mesh.F, stitched->mesh.num_vertices());
-  const int allowed = count_boundary_edges(out.F, static_cast<int>(out.V.rows())) +
-                      count_boundary_edges(in.F, static_cast<int>(in.V.rows()));
-  if (boundary > allowed) return fail(StitchFailure::OpenSeam);
-  if (topology_report(stitched->mesh).num_non_manifold_edges > 0)
-    return fail(StitchFailure::BadSeam);
+  // One edge topology answers both seam checks; the parents' open edges are counted only when
+  // the stitched element has any (closed elements, the common case, never need them).
+  const EdgeTopology topo = edge_topology(stitched->mesh.F, stitched->mesh.num_vertices());
+  int boundary = 0, non_manifold = 0;
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    boundary += topo.is_boundary(e);
+    non_manifold += topo.is_non_manifold(e);
+  }
+  if (boundary > 0 && boundary > count_boundary_edges(out.F, static_cast<int>(out.V.rows())) +
+                                     count_boundary_edges(in.F, static_cast<int>(in.V.rows())))
+    return fail(StitchFailure::OpenSeam);
+  if (non_manifold > 0) return fail(StitchFailure::BadSeam);
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;

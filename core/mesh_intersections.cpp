@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.h"
 #include "core/mesh_topology.h"
@@ -271,12 +272,51 @@ std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, con
 }
 
 bool meshes_intersect(const TriMesh& A, const TriMesh& B) {
-  TriMesh both;
-  both.V = A.V;
-  both.F = A.F;
-  append_mesh(both, B);
+  MQ_CHECK(A.F.rows() == 0 || (A.F.minCoeff() >= 0 && A.F.maxCoeff() < A.V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", A.V.rows(), ")");
+  MQ_CHECK(B.F.rows() == 0 || (B.F.minCoeff() >= 0 && B.F.maxCoeff() < B.V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", B.V.rows(), ")");
+  MQ_CHECK(A.V.allFinite() && B.V.allFinite(), InvalidInput,
+           "intersection test: vertex positions are not finite");
+  if (A.F.rows() == 0 || B.F.rows() == 0) return false;
+  // Only faces whose boxes meet the other mesh's box can take part in an intersection; for two
+  // long elements crossing once that is a small part of each.
+  const auto face_box = [](const TriMesh& M, int f, Vector3d& lo, Vector3d& hi) {
+    lo = M.V.row(M.F(f, 0)).cwiseMin(M.V.row(M.F(f, 1))).cwiseMin(M.V.row(M.F(f, 2))).transpose();
+    hi = M.V.row(M.F(f, 0)).cwiseMax(M.V.row(M.F(f, 1))).cwiseMax(M.V.row(M.F(f, 2))).transpose();
+  };
+  const auto mesh_box = [&](const TriMesh& M, Vector3d& lo, Vector3d& hi) {
+    lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    for (int f = 0; f < M.F.rows(); ++f) {
+      Vector3d flo, fhi;
+      face_box(M, f, flo, fhi);
+      lo = lo.cwiseMin(flo);
+      hi = hi.cwiseMax(fhi);
+    }
+  };
+  const auto faces_meeting = [&](const TriMesh& M, const Vector3d& lo, const Vector3d& hi) {
+    std::vector<int> faces;
+    for (int f = 0; f < M.F.rows(); ++f) {
+      Vector3d flo, fhi;
+      face_box(M, f, flo, fhi);
+      if ((flo.array() <= hi.array()).all() && (lo.array() <= fhi.array()).all())
+        faces.push_back(f);
+    }
+    return faces;
+  };
+  Vector3d a_lo, a_hi, b_lo, b_hi;
+  mesh_box(A, a_lo, a_hi);
+  mesh_box(B, b_lo, b_hi);
+  const std::vector<int> fa = faces_meeting(A, b_lo, b_hi);
+  if (fa.empty()) return false;
+  const std::vector<int> fb = faces_meeting(B, a_lo, a_hi);
+  if (fb.empty()) return false;
+  TriMesh both = extract_faces(A, fa);
+  const int num_a = static_cast<int>(both.F.rows());
+  append_mesh(both, extract_faces(B, fb));
   std::vector<int> label(both.F.rows(), 1);
-  std::fill(label.begin(), label.begin() + A.F.rows(), 0);
+  std::fill(label.begin(), label.begin() + num_a, 0);
   return !find_pairs(both.V, both.F, &label, true).empty();
 }
 

@@ -28,6 +28,11 @@ TEST(ElementMerging, ElementsCoincide) {
   Element near = a;
   near.translate(Vector3d(0, 0, 0.5 * tol));
   EXPECT_TRUE(elements_coincide(a, near, tol));
+  // Bounding boxes shifted by nearly the tolerance sideways: still within it.
+  Element beside = a;
+  beside.translate(Vector3d(0.9 * tol, 0, 0));
+  EXPECT_TRUE(elements_coincide(a, beside, tol));
+  EXPECT_TRUE(elements_coincide(beside, a, tol));
   Element far = a;
   far.translate(Vector3d(0, 0, 2 * tol));
   EXPECT_FALSE(elements_coincide(a, far, tol));

@@ -35,6 +35,29 @@ TEST(TriangleIntersection, BasicConfigurations) {
   EXPECT_TRUE(triangles_intersect({0.1, 0.1, 0}, {0.2, 0.1, 0}, {0.1, 0.2, 0}, a0, a1, a2));
 }
 
+// meshes_intersect only looks at faces meeting the other mesh's box; it must agree with the
+// full pairwise test on the two meshes put together, whatever the placement.
+TEST(MeshIntersections, MeshesIntersectAgreesWithTheFullPairTest) {
+  const TriMesh a = test::torus(2.0, 0.4, 32, 10);
+  int hits = 0, misses = 0;
+  for (int i = 0; i < 24; ++i) {
+    const double angle = 0.37 * i, shift = 0.25 * i;
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(angle, Vector3d(1, 0.3, 0.1).normalized()).toRotationMatrix();
+    const TriMesh b = transformed(a, R, Vector3d(shift, 0.1 * i, 0.05 * i));
+    TriMesh both = a;
+    append_mesh(both, b);
+    IntersectionOptions between;
+    between.between_components_only = true;
+    const bool expected = !intersecting_face_pairs(both.V, both.F, between).empty();
+    EXPECT_EQ(meshes_intersect(a, b), expected) << "placement " << i;
+    EXPECT_EQ(meshes_intersect(b, a), expected) << "placement " << i;
+    (expected ? hits : misses) += 1;
+  }
+  EXPECT_GT(hits, 0);
+  EXPECT_GT(misses, 0);  // the placements reach beyond the torus: both answers are exercised
+}
+
 TEST(MeshIntersections, LinkedToriDoNotIntersectOverlappingDo) {
   const TriMesh a = test::torus(2.0, 0.4, 48, 12);
   // A chain link: rotated into the xz plane and shifted by R along x, through a's hole.
