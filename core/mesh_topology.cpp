@@ -10,17 +10,31 @@ namespace mq {
 
 namespace {
 
-Adjacency build_adjacency(int n, std::vector<std::pair<int, int>>& pairs, bool unique) {
-  std::sort(pairs.begin(), pairs.end());
-  if (unique) pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+// Adjacency lists from (from, to) pairs with from in [0, n): each list ascending, duplicates
+// removed when unique. A counting sort on `from` then a sort of each (short) list: the same
+// result as sorting the pairs, in about linear time.
+Adjacency build_adjacency(int n, const std::vector<std::pair<int, int>>& pairs, bool unique) {
   Adjacency adj;
-  adj.offsets.assign(n + 1, 0);
-  adj.indices.reserve(pairs.size());
-  for (const auto& [a, b] : pairs) {
-    ++adj.offsets[a + 1];
-    adj.indices.push_back(b);
-  }
+  adj.offsets.assign(static_cast<size_t>(n) + 1, 0);
+  for (const auto& [a, b] : pairs) ++adj.offsets[static_cast<size_t>(a) + 1];
   for (int i = 0; i < n; ++i) adj.offsets[i + 1] += adj.offsets[i];
+  adj.indices.resize(pairs.size());
+  {
+    std::vector<int> cursor(adj.offsets.begin(), adj.offsets.end() - 1);
+    for (const auto& [a, b] : pairs) adj.indices[cursor[a]++] = b;
+  }
+  int write = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto first = adj.indices.begin() + adj.offsets[i];
+    auto last = adj.indices.begin() + adj.offsets[i + 1];
+    std::sort(first, last);
+    if (unique) last = std::unique(first, last);
+    adj.offsets[i] = write;
+    write =
+        static_cast<int>(std::copy(first, last, adj.indices.begin() + write) - adj.indices.begin());
+  }
+  adj.offsets[n] = write;
+  adj.indices.resize(static_cast<size_t>(write));
   return adj;
 }
 
@@ -50,14 +64,29 @@ struct UnionFind {
 EdgeTopology edge_topology(const MatrixX3i& F, int num_vertices) {
   check_indices(F, num_vertices);
   const int nf = static_cast<int>(F.rows());
-  // (min vertex, max vertex, half-edge id) sorted groups identical edges together.
-  std::vector<std::array<int, 3>> half(3 * static_cast<size_t>(nf));
+  // Half-edges grouped by their smaller vertex (counting sort, ids ascending within a group),
+  // then each short group ordered by the larger vertex: the (min vertex, max vertex, id) order
+  // that puts copies of an edge next to each other, without a global sort.
+  std::vector<int> start(static_cast<size_t>(num_vertices) + 1, 0);
   for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      half[3 * f + k] = {std::min(a, b), std::max(a, b), 3 * f + k};
+    for (int k = 0; k < 3; ++k) ++start[std::min(F(f, k), F(f, (k + 1) % 3)) + 1];
+  for (int v = 0; v < num_vertices; ++v) start[v + 1] += start[v];
+  std::vector<std::array<int, 3>> half(3 * static_cast<size_t>(nf));
+  {
+    std::vector<int> cursor(start.begin(), start.end() - 1);
+    for (int f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = F(f, k), b = F(f, (k + 1) % 3);
+        half[cursor[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), 3 * f + k};
+      }
+  }
+  for (int v = 0; v < num_vertices; ++v)  // stable insertion sort: groups hold a few entries
+    for (int i = start[v] + 1; i < start[v + 1]; ++i) {
+      const std::array<int, 3> h = half[i];
+      int j = i;
+      for (; j > start[v] && half[j - 1][1] > h[1]; --j) half[j] = half[j - 1];
+      half[j] = h;
     }
-  std::sort(half.begin(), half.end());
   EdgeTopology topo;
   topo.FE.resize(nf, 3);
   std::vector<std::pair<int, int>> edge_face;
@@ -167,8 +196,8 @@ TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces,
 }
 
 void append_mesh(TriMesh& a, const TriMesh& b) {
-  const bool normals = a.N.rows() == a.V.rows() && b.N.rows() == b.V.rows() &&
-                       (a.V.rows() > 0 || b.V.rows() > 0);
+  const bool normals =
+      a.N.rows() == a.V.rows() && b.N.rows() == b.V.rows() && (a.V.rows() > 0 || b.V.rows() > 0);
   const Eigen::Index nv = a.V.rows(), nf = a.F.rows();
   a.V.conservativeResize(nv + b.V.rows(), 3);
   a.V.bottomRows(b.V.rows()) = b.V;

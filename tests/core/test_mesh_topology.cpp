@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <set>
+#include <vector>
+
 #include "core/errors.h"
 #include "core/geometry_measures.h"
+#include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 #include "tests/test_support.h"
 
@@ -94,6 +100,64 @@ TEST(MeshTopology, RemoveUnreferencedKeepsOrder) {
   remove_unreferenced_vertices(m);
   EXPECT_EQ(m.num_vertices(), 8);
   EXPECT_TRUE(topology_report(m).closed());
+}
+
+}  // namespace
+}  // namespace mq
+
+namespace mq {
+namespace {
+
+// The linear-time groupings must give exactly what sorting all pairs gives: on a real mesh,
+// plus a duplicated face and a non-manifold fin, with an isolated vertex index at the end.
+TEST(MeshTopology, EdgeTopologyAndAdjacencyMatchSortedReference) {
+  TriMesh m = read_mesh(test::shared_data("base/bunny_igl_7k.off"));
+  const int nv = m.num_vertices() + 1;
+  MatrixX3i F(m.F.rows() + 2, 3);
+  F.topRows(m.F.rows()) = m.F;
+  F.row(m.F.rows()) = m.F.row(0);                              // duplicate
+  F.row(m.F.rows() + 1) << m.F(5, 1), m.F(5, 0), m.F(100, 2);  // fin on edge of face 5
+  const EdgeTopology topo = edge_topology(F, nv);
+
+  std::vector<std::array<int, 3>> half;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      half.push_back({std::min(a, b), std::max(a, b), 3 * f + k});
+    }
+  std::sort(half.begin(), half.end());
+  int e = -1;
+  std::vector<std::vector<int>> edge_faces;
+  for (size_t i = 0; i < half.size(); ++i) {
+    if (i == 0 || half[i][0] != half[i - 1][0] || half[i][1] != half[i - 1][1]) {
+      ++e;
+      ASSERT_LT(e, topo.num_edges());
+      EXPECT_EQ(topo.E(e, 0), half[i][0]);
+      EXPECT_EQ(topo.E(e, 1), half[i][1]);
+      edge_faces.emplace_back();
+    }
+    EXPECT_EQ(topo.FE(half[i][2] / 3, half[i][2] % 3), e);
+    edge_faces.back().push_back(half[i][2] / 3);
+  }
+  ASSERT_EQ(e + 1, topo.num_edges());
+  int non_manifold = 0;
+  for (int k = 0; k < topo.num_edges(); ++k) {
+    EXPECT_EQ(std::vector<int>(topo.edge_faces.begin(k), topo.edge_faces.end(k)), edge_faces[k]);
+    non_manifold += topo.is_non_manifold(k);
+  }
+  EXPECT_GE(non_manifold, 3);  // the duplicate's edges and the fin's shared edge
+
+  std::vector<std::set<int>> ring(nv);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      ring[F(f, k)].insert(F(f, (k + 1) % 3));
+      ring[F(f, (k + 1) % 3)].insert(F(f, k));
+    }
+  const Adjacency adj = vertex_adjacency(F, nv);
+  for (int v = 0; v < nv; ++v)
+    EXPECT_EQ(std::vector<int>(adj.begin(v), adj.end(v)),
+              std::vector<int>(ring[v].begin(), ring[v].end()));
+  EXPECT_EQ(adj.degree(nv - 1), 0);
 }
 
 }  // namespace
