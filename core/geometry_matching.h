@@ -1,6 +1,7 @@
 // Geometry matching, paper section 2.4: the placement of the swatch that best continues the
 // output around a seed, minimising E(t) of Eqs. (1)-(3) over whole-cell offsets, then refined
-// below the cell size by a compass search on the same cost.
+// below the cell size on the same cost (majorize-minimize: compass searches with each point's
+// best face frozen, then exact reassignment; see refine_offset in the .cpp).
 #pragma once
 
 #include <cstdint>
@@ -19,8 +20,9 @@ struct MatchingOptions {
   // Choose at random among offsets within (1 + epsilon) of the minimum (variety); 0 = the
   // minimum, ties to the lowest candidate index.
   double epsilon = 0.0;
-  // Refine the chosen whole-cell offset by compass search down to this fraction of a cell
-  // (0 disables). The paper notes finer offsets help; periodic swatches then align exactly.
+  // Refine the chosen whole-cell offset down to this fraction of a cell (0 disables); the
+  // result's exact cost is never above the whole-cell one's. The paper notes finer offsets help;
+  // periodic swatches then align exactly.
   double refine_to = 1e-3;
   // Sub-patch points used by the refinement (an evenly strided subset when there are more).
   Eigen::Index refine_points = 128;
@@ -37,7 +39,7 @@ struct OffsetChoice {
   Vector3d offset = Vector3d::Zero();
   double cost = 0;              // E(t) at the chosen offset
   int candidates = 0;           // whole-cell offsets evaluated
-  int evaluations = 0;          // all offsets evaluated, refinement included
+  int evaluations = 0;          // exact evaluations of E over a point set, refinement included
   long long point_offsets = 0;  // (point, offset) pairs evaluated
 };
 

@@ -177,7 +177,20 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
   fingerprint_ = fp;
 }
 
-double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda) const {
+double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& n,
+                                  double lambda) const {
+  MQ_ASSERT(entry >= 0 && entry < num_faces());
+  const std::size_t j = static_cast<std::size_t>(entry);
+  const double* fn = &entry_normals_[4 * j];
+  const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
+  const double nfac = 1.0 + std::sqrt(nx * nx + ny * ny + nz * nz);
+  const double dist2 = triangle_dist2(q, &entry_triangles_[9 * j]);
+  return (1.0 + lambda * std::sqrt(dist2)) * nfac;  // as in min_face_cost's leaf loop
+}
+
+double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
+                                     int* entry) const {
+  if (entry) *entry = -1;
   const double slack = slack_;
   // Squared distance from q to node i's box.
   auto box_distance2 = [&](int i) {
@@ -234,6 +247,7 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
         const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
         if (cost < best) {
           best = cost;
+          if (entry) *entry = j;
           update_reach();
           r = best / df - 1.0;
           r2 = r * r * (1.0 + 1e-12);

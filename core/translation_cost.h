@@ -58,7 +58,13 @@ class SwatchFaceTree {
   // normal factor (tested without a square root) times the leaf's distance bound cannot, or when
   // its bounding sphere's distance cannot; only then is the exact point-triangle distance
   // computed.
-  double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda) const;
+  // entry (optional): receives the entry (leaf-order face slot, see entry_faces()) attaining
+  // the minimum, -1 when there is none.
+  double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
+                       int* entry = nullptr) const;
+  // The Eq. (1) cost of one entry's face for query point q, bitwise the value min_face_cost
+  // computes for it (so a sum of entry costs bounds a sum of minima exactly).
+  double entry_cost(int entry, const Vector3d& q, const Vector3d& n, double lambda) const;
 
   int num_faces() const { return static_cast<int>(entry_faces_.size()); }
   int num_nodes() const { return static_cast<int>(node_links_.size() / 2); }

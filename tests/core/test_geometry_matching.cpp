@@ -229,3 +229,72 @@ TEST(GeometryMatching, EdgeCases) {
 
 }  // namespace
 }  // namespace mq
+
+namespace mq {
+namespace {
+
+// The sub-cell refinement reports the exact Eq. (3) cost of the offset it returns, and that
+// cost is never above the cost of the whole-cell offset it started from (each accepted
+// majorize-minimize round lowers the exact cost), on a swatch with no exact match.
+TEST(GeometryMatching, RefinementLowersTheExactCost) {
+  AppleOptions apples;
+  apples.count = 9;
+  const TriMesh swatch = apple_layer(apples);
+  const SwatchFaceTree tree(swatch.V, swatch.F);
+  TranslationCostCpu cpu;
+  // A sub-patch from the swatch itself, mirrored and shifted: close to it, never on it.
+  const BoundingBox box = bounding_box(swatch.V, swatch.F);
+  const Vector3d mid = 0.5 * (box.min + box.max);
+  const MatrixX3d FN = face_normals(swatch.V, swatch.F);
+  std::vector<Vector3d> points, normals;
+  for (int f = 0; f < swatch.num_faces(); f += 3) {
+    Vector3d c =
+        (swatch.V.row(swatch.F(f, 0)) + swatch.V.row(swatch.F(f, 1)) + swatch.V.row(swatch.F(f, 2)))
+            .transpose() /
+        3.0;
+    if ((c - mid).head<2>().norm() > 0.3 * (box.max - box.min).head<2>().norm()) continue;
+    c.x() = 2 * mid.x() - c.x();
+    points.push_back(c + Vector3d(0.13, -0.07, 0));
+    normals.push_back(Vector3d(-FN(f, 0), FN(f, 1), FN(f, 2)));
+  }
+  ASSERT_GT(points.size(), 20u);
+  MatrixX3d P(static_cast<Eigen::Index>(points.size()), 3), NP(P.rows(), 3);
+  for (size_t i = 0; i < points.size(); ++i) {
+    P.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+    NP.row(static_cast<Eigen::Index>(i)) = normals[i].transpose();
+  }
+  const double cell = 0.25 * (box.max - box.min).head<2>().minCoeff();
+  MatrixX3d T(25, 3);
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 5; ++i) T.row(j * 5 + i) << (i - 2) * cell, (j - 2) * cell, 0.0;
+  MatchingOptions options;
+  options.lambda = 1.0 / cell;
+  options.refine_points = P.rows();  // refine on every point, so the costs are comparable
+  options.screen_keep = 0;
+  std::mt19937_64 rng(1);
+  const Vector2d lo(-2 * cell, -2 * cell), hi(2 * cell, 2 * cell);
+  const OffsetChoice refined = choose_offset(tree, cpu, P, NP, T, lo, hi, cell, options, rng);
+  options.refine_to = 0;
+  const OffsetChoice whole = choose_offset(tree, cpu, P, NP, T, lo, hi, cell, options, rng);
+  EXPECT_NE(refined.offset, whole.offset);
+  EXPECT_GT(refined.evaluations, whole.evaluations);
+
+  TranslationCostProblem problem;
+  problem.points = P;
+  problem.point_normals = NP;
+  problem.lambda = options.lambda;
+  problem.offsets.resize(2, 3);
+  problem.offsets.row(0) = refined.offset.transpose();
+  problem.offsets.row(1) = whole.offset.transpose();
+  const Eigen::VectorXd E = translation_cost_brute_force(swatch.V, swatch.F, problem);
+  EXPECT_NEAR(refined.cost, E(0), 1e-9 * E(0));
+  EXPECT_NEAR(whole.cost, E(1), 1e-9 * E(1));
+  EXPECT_LT(E(0), E(1));
+  for (int k = 0; k < 2; ++k) {  // inside the admissible range
+    EXPECT_GE(refined.offset(k), lo(k));
+    EXPECT_LE(refined.offset(k), hi(k));
+  }
+}
+
+}  // namespace
+}  // namespace mq
