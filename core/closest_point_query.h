@@ -82,6 +82,8 @@ class ClosestPointQuery {
   int num_faces() const { return static_cast<int>(F_.rows()); }
   const MatrixX3d& vertices() const { return V_; }
   const MatrixX3i& faces() const { return F_; }
+  // The device the BVH lives on, for building more queries without a new device each.
+  const EmbreeDevice& device() const { return device_; }
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();

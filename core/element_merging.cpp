@@ -161,7 +161,8 @@ const char* stitch_failure_name(StitchFailure f) {
   return "unknown";
 }
 
-bool elements_coincide(const Element& a, const Element& b, double tolerance) {
+bool elements_coincide(const Element& a, const Element& b, double tolerance,
+                       const EmbreeDevice* device) {
   // Each bounding box lies within the other's enlarged by the tolerance when the elements
   // coincide, so boxes further apart than that rule it out without building a BVH. The
   // margin keeps the shortcut conservative under rounding; the exact test decides the rest.
@@ -170,30 +171,35 @@ bool elements_coincide(const Element& a, const Element& b, double tolerance) {
   for (int k = 0; k < 2; ++k)
     if (apart(a.lo[k], b.lo[k]) || apart(a.hi[k], b.hi[k])) return false;
   if (apart(a.z_lo, b.z_lo) || apart(a.z_hi, b.z_hi)) return false;
-  const ClosestPointQuery qb(b.V, b.F);
-  for (int v = 0; v < a.V.rows(); ++v)
-    if (qb.closest(Vector3d(a.V.row(v).transpose()), tolerance).face < 0) return false;
-  const ClosestPointQuery qa(a.V, a.F);
-  for (int v = 0; v < b.V.rows(); ++v)
-    if (qa.closest(Vector3d(b.V.row(v).transpose()), tolerance).face < 0) return false;
-  return true;
+  const EmbreeDevice shared = device ? *device : EmbreeDevice();
+  const auto all_within = [&](const Element& from, const Element& to) {
+    const ClosestPointQuery query(shared, to.V, to.F);
+    for (const ClosestPointHit& hit : query.closest(from.V, tolerance))
+      if (hit.face < 0) return false;
+    return true;
+  };
+  return all_within(a, b) && all_within(b, a);
 }
 
 std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
                                       const OverlapRegion& region, double mean_edge_length,
-                                      const MergeOptions& options, StitchFailure* failure) {
+                                      const MergeOptions& options, StitchFailure* failure,
+                                      const EmbreeDevice* device) {
   auto fail = [&](StitchFailure why) -> std::optional<Element> {
     if (failure) *failure = why;
     return std::nullopt;
   };
   if (failure) *failure = StitchFailure::None;
   const double cover = options.cover_distance * mean_edge_length;
-  const ClosestPointQuery query_out(out.V, out.F), query_in(in.V, in.F);
+  const EmbreeDevice shared = device ? *device : EmbreeDevice();
+  const ClosestPointQuery query_out(shared, out.V, out.F), query_in(shared, in.V, in.F);
   Eigen::VectorXd dist_out(out.V.rows()), dist_in(in.V.rows());
-  for (int v = 0; v < out.V.rows(); ++v)
-    dist_out(v) = query_in.closest(Vector3d(out.V.row(v).transpose())).distance;
-  for (int v = 0; v < in.V.rows(); ++v)
-    dist_in(v) = query_out.closest(Vector3d(in.V.row(v).transpose())).distance;
+  {
+    const std::vector<ClosestPointHit> to_in = query_in.closest(out.V);
+    for (int v = 0; v < out.V.rows(); ++v) dist_out(v) = to_in[v].distance;
+    const std::vector<ClosestPointHit> to_out = query_out.closest(in.V);
+    for (int v = 0; v < in.V.rows(); ++v) dist_in(v) = to_out[v].distance;
+  }
   // Eq. (7) weights are in absolute units; scale distances by the edge length so the cut
   // behaves the same whatever the swatch's units.
   const double unit = mean_edge_length > 0 ? mean_edge_length : 1.0;

@@ -4,6 +4,7 @@
 
 #include <optional>
 
+#include "core/embree_device.h"
 #include "core/overlap_region.h"
 #include "core/quilt_elements.h"
 
@@ -29,7 +30,10 @@ struct MergeOptions {
 };
 
 // Every vertex of a lies within tolerance of b and every vertex of b within tolerance of a.
-bool elements_coincide(const Element& a, const Element& b, double tolerance);
+// device: where the temporary BVHs are built (a new device when null; creating one costs about
+// as much as building a BVH over a small element).
+bool elements_coincide(const Element& a, const Element& b, double tolerance,
+                       const EmbreeDevice* device = nullptr);
 
 // Why a cut-and-stitch was refused (for stats and messages).
 enum class StitchFailure {
@@ -52,9 +56,11 @@ const char* stitch_failure_name(StitchFailure f);
 // links where a vertex's partner lies outside it or at the rim of the matched area), bridges the
 // seam loops, and deforms the union with the averaged seam points as Eq. (5) constraints.
 // Returns the stitched element (one connected component, no boundary edges beyond those the two
-// inputs already had), or nullopt with the reason in `failure`.
+// inputs already had), or nullopt with the reason in `failure`. device: as for
+// elements_coincide.
 std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
                                       const OverlapRegion& region, double mean_edge_length,
-                                      const MergeOptions& options, StitchFailure* failure = nullptr);
+                                      const MergeOptions& options, StitchFailure* failure = nullptr,
+                                      const EmbreeDevice* device = nullptr);
 
 }  // namespace mq

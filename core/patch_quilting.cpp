@@ -213,7 +213,8 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     const Element& base = current(k);
     // The same element placed twice (nearly identical, or mostly the same footprint, as for two
     // apples slightly apart): keep the output one rather than stitching two halves.
-    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge) ||
+    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge,
+                          &swatch_query.device()) ||
         footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
       ++counts.matched;
       busy[k] = 1;
@@ -221,7 +222,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     }
     StitchFailure why = StitchFailure::None;
     std::optional<Element> joined =
-        cut_and_stitch(base, in, region, mean_edge, options.merging, &why);
+        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &swatch_query.device());
     std::vector<int> ignore = replaced_ids;
     ignore.push_back(near[k]);
     if (joined && fits(output, *joined, ignore)) {

@@ -48,8 +48,10 @@ Vector3d triangle_barycentric_2d(const Vector2d& p, const Vector2d& a, const Vec
 // field points along +x at the seed and translated so the seed's centroid is the origin.
 class PatchFrame {
  public:
-  PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction)
-      : base_(base), patch_(std::move(patch)) {
+  // device: where the BVH for points beyond the patch is built when first needed.
+  PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction,
+             const EmbreeDevice& device)
+      : base_(base), patch_(std::move(patch)), device_(device) {
     const MatrixX3i& F = patch_.mesh.F;
     for (int f = 0; f < F.rows(); ++f) local_of_[patch_.faces[f]] = f;
     // The seed face's affine map takes the 3D field direction into the UV plane.
@@ -87,7 +89,8 @@ class PatchFrame {
                          bary(1) * base_.V.row(base_.F(base_face, 1)).transpose() +
                          bary(2) * base_.V.row(base_.F(base_face, 2)).transpose();
       // Built on first use: most patches never need it, and a BVH per patch is not free.
-      if (!query_) query_ = std::make_unique<ClosestPointQuery>(patch_.mesh.V, patch_.mesh.F);
+      if (!query_)
+        query_ = std::make_unique<ClosestPointQuery>(device_, patch_.mesh.V, patch_.mesh.F);
       f = query_->closest(p).face;
       const MatrixX3i& F = patch_.mesh.F;
       w = plane_barycentric(p, patch_.mesh.V.row(F(f, 0)), patch_.mesh.V.row(F(f, 1)),
@@ -190,6 +193,7 @@ class PatchFrame {
   int nx_ = 1, ny_ = 1;
   std::vector<std::vector<int>> cells_;
   std::vector<std::pair<int, int>> border_;
+  const EmbreeDevice& device_;
   mutable std::unique_ptr<ClosestPointQuery> query_;
 };
 
@@ -460,7 +464,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         continue;
       }
       if (patch.shrink_steps > 0) ++stats.patches_shrunk;
-      frame = std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose());
+      frame = std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose(),
+                                           base_query.device());
     }
     const LocalPatch& patch = frame->patch();
 
