@@ -29,10 +29,12 @@ struct MatchingOptions {
   // Screening: when there are more than screen_keep candidates and more than screen_points
   // sub-patch points, every candidate is first scored on an evenly strided subset of
   // screen_points points and only the screen_keep best are scored on all points (0 disables).
-  // A few hundred points rank whole-cell offsets almost as the full set does, at a fraction of
-  // the cost; the final choice is still made with the exact cost over all points.
+  // A hundred points rank whole-cell offsets almost as the full set does, at a fraction of
+  // the cost; the final choice is still made with the exact cost over all points. Measured on
+  // 1,180 screened patches (ivy wall at scale 0.03, plane + apple, bunny + weave), the winner
+  // over all points was the screening's first in 808, its second in 43, third in 2, fifth in 1.
   Eigen::Index screen_points = 128;
-  int screen_keep = 8;
+  int screen_keep = 3;
 };
 
 struct OffsetChoice {
