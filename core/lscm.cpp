@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/errors.h"
@@ -98,6 +99,55 @@ std::vector<int> disk_boundary(const MatrixX3i& F, int n) {
   return loop;
 }
 
+// UV scaled about the origin (pin0) so that its total signed area equals area3d.
+MatrixX2d rescaled_to_3d_area(MatrixX2d UV, const MatrixX3i& F, double area3d) {
+  double area_uv = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Vector2d a = UV.row(F(f, 0)).transpose(), b = UV.row(F(f, 1)).transpose(),
+                   c = UV.row(F(f, 2)).transpose();
+    const Vector2d ab = b - a, ac = c - a;
+    area_uv += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
+  }
+  MQ_CHECK(area_uv > 0 && std::isfinite(area_uv), SolverFailure,
+           "lscm: the conformal map has non-positive total area");
+  UV *= std::sqrt(area3d / area_uv);
+  return UV;
+}
+
+double patch_area(const MatrixX3d& V, const MatrixX3i& F) {
+  double area = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    area += 0.5 *
+            (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0))).norm();
+  return area;
+}
+
+// When every face normal equals the first within 1e-9 (coplanar and consistently oriented), the
+// vertices in the plane's frame with pin0 at the origin and pin1 on the +u axis; else nullopt.
+std::optional<MatrixX2d> planar_map(const MatrixX3d& V, const MatrixX3i& F, int pin0, int pin1,
+                                    double pin_distance) {
+  constexpr double kTolerance = 1e-9;
+  Vector3d normal = Vector3d::Zero();
+  for (int f = 0; f < F.rows(); ++f) {
+    const Vector3d n = (row3(V, F(f, 1)) - row3(V, F(f, 0)))
+                           .cross(row3(V, F(f, 2)) - row3(V, F(f, 0)))
+                           .normalized();
+    if (!n.allFinite()) return std::nullopt;
+    if (f == 0) normal = n;
+    if ((n - normal).norm() > kTolerance) return std::nullopt;
+  }
+  const Vector3d u = (row3(V, pin1) - row3(V, pin0)) / pin_distance;
+  if (std::abs(u.dot(normal)) > kTolerance) return std::nullopt;
+  const Vector3d v = normal.cross(u).normalized();
+  MatrixX2d UV(V.rows(), 2);
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Vector3d d = row3(V, static_cast<int>(i)) - row3(V, pin0);
+    UV.row(i) << d.dot(u), d.dot(v);
+  }
+  UV.row(pin0).setZero();
+  UV.row(pin1) << pin_distance, 0.0;
+  return UV;
+}
 }  // namespace
 
 MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
@@ -131,6 +181,11 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   const double pin_distance = (row3(V, pin1) - row3(V, pin0)).norm();
   MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
 
+  // A planar patch (the panels of a wall, a table top) has a zero-energy conformal map: its
+  // projection into the plane, placed so the pins land where they are pinned. It is the
+  // solution of the system below (unique for a connected disk with two pins), without a solve.
+  if (const std::optional<MatrixX2d> flat = planar_map(V, F, pin0, pin1, pin_distance))
+    return rescaled_to_3d_area(*flat, F, patch_area(V, F));
   // Unknowns: u and v of every free vertex; pinned values go to the right-hand side.
   std::vector<int> unknown(n, -1);
   int nu = 0;
@@ -193,18 +248,7 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
       if (unknown[v] >= 0) UV.row(v) << x(unknown[v]), x(nu + unknown[v]);
   }
 
-  // Rescale about pin0 so that total UV area equals total 3D area.
-  double area_uv = 0;
-  for (int f = 0; f < nf; ++f) {
-    const Vector2d a = UV.row(F(f, 0)).transpose(), b = UV.row(F(f, 1)).transpose(),
-                   c = UV.row(F(f, 2)).transpose();
-    const Vector2d ab = b - a, ac = c - a;
-    area_uv += 0.5 * (ab.x() * ac.y() - ab.y() * ac.x());
-  }
-  MQ_CHECK(area_uv > 0 && std::isfinite(area_uv), SolverFailure,
-           "lscm: the conformal map has non-positive total area");
-  UV *= std::sqrt(area3d / area_uv);
-  return UV;
+  return rescaled_to_3d_area(UV, F, area3d);
 }
 
 Eigen::VectorXd face_area_distortion(const MatrixX3d& V, const MatrixX3i& F, const MatrixX2d& UV) {
