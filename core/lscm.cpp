@@ -23,8 +23,7 @@ void check_indices(const MatrixX3i& F, Eigen::Index n) {
 }
 
 // Checks that F is a connected, manifold disk; returns its boundary loop.
-std::vector<int> disk_boundary(const MatrixX3i& F, int n) {
-  const EdgeTopology topo = edge_topology(F, n);
+std::vector<int> disk_boundary(const MatrixX3i& F, int n, const EdgeTopology& topo) {
   // Boundary edges traversed as in their face; each vertex needs in- and out-degree <= 1.
   std::vector<int> next(n, -1), in_count(n, 0);
   for (int e = 0; e < topo.num_edges(); ++e)
@@ -122,31 +121,77 @@ double patch_area(const MatrixX3d& V, const MatrixX3i& F) {
   return area;
 }
 
-// When every face normal equals the first within 1e-9 (coplanar and consistently oriented), the
-// vertices in the plane's frame with pin0 at the origin and pin1 on the +u axis; else nullopt.
-std::optional<MatrixX2d> planar_map(const MatrixX3d& V, const MatrixX3i& F, int pin0, int pin1,
-                                    double pin_distance) {
-  constexpr double kTolerance = 1e-9;
-  Vector3d normal = Vector3d::Zero();
-  for (int f = 0; f < F.rows(); ++f) {
-    const Vector3d n = (row3(V, F(f, 1)) - row3(V, F(f, 0)))
-                           .cross(row3(V, F(f, 2)) - row3(V, F(f, 0)))
-                           .normalized();
-    if (!n.allFinite()) return std::nullopt;
-    if (f == 0) normal = n;
-    if ((n - normal).norm() > kTolerance) return std::nullopt;
+// Isometric unfolding of a developable patch (a plane, or planes folded along edges like the
+// sides of a box): faces are laid out breadth first across shared edges from face 0, each
+// congruent to its 3D triangle. nullopt when a vertex reached through two faces lands in two
+// places (some interior vertex's angles do not sum to 2 pi: the patch is curved) or a face is
+// degenerate. Returned with pin0 at the origin and pin1 on the +u axis.
+std::optional<MatrixX2d> developable_unfolding(const MatrixX3d& V, const MatrixX3i& F,
+                                               const EdgeTopology& topo, int pin0, int pin1) {
+  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
+  const double extent = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  const double tolerance = 1e-9 * extent;
+  MatrixX2d UV = MatrixX2d::Zero(n, 2);
+  std::vector<char> placed(n, 0), reached(nf, 0);
+  const auto length = [&](int a, int b) { return (row3(V, a) - row3(V, b)).norm(); };
+  // c to the left of a -> b at its 3D distances from a and b; false if the face is degenerate.
+  const auto place = [&](int a, int b, int c, Vector2d& out) {
+    const Vector2d pa = UV.row(a).transpose(), pb = UV.row(b).transpose();
+    const double ab = (pb - pa).norm(), ac = length(a, c), bc = length(b, c);
+    if (!(ab > 0)) return false;
+    const Vector2d e = (pb - pa) / ab, perp(-e.y(), e.x());
+    const double x = (ac * ac - bc * bc + ab * ab) / (2 * ab), y2 = ac * ac - x * x;
+    if (!(y2 > 0) || !std::isfinite(y2)) return false;
+    out = pa + x * e + std::sqrt(y2) * perp;
+    return true;
+  };
+  UV.row(F(0, 1)) << length(F(0, 0), F(0, 1)), 0.0;
+  placed[F(0, 0)] = placed[F(0, 1)] = 1;
+  Vector2d c2;
+  if (!place(F(0, 0), F(0, 1), F(0, 2), c2)) return std::nullopt;
+  UV.row(F(0, 2)) = c2.transpose();
+  placed[F(0, 2)] = 1;
+  std::vector<int> queue{0};
+  reached[0] = 1;
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int f = queue[head];
+    for (int k = 0; k < 3; ++k) {
+      const int e = topo.FE(f, k);
+      if (topo.edge_faces.degree(e) != 2) continue;
+      const int* fs = topo.edge_faces.begin(e);
+      const int g = fs[0] == f ? fs[1] : fs[0];
+      if (reached[g]) continue;
+      reached[g] = 1;
+      int j = 0;
+      while (topo.FE(g, j) != e) ++j;
+      const int a = F(g, j), b = F(g, (j + 1) % 3), c = F(g, (j + 2) % 3);
+      if (!place(a, b, c, c2)) return std::nullopt;
+      if (placed[c]) {
+        if ((UV.row(c).transpose() - c2).norm() > tolerance) return std::nullopt;
+      } else {
+        UV.row(c) = c2.transpose();
+        placed[c] = 1;
+      }
+      queue.push_back(g);
+    }
   }
-  const Vector3d u = (row3(V, pin1) - row3(V, pin0)) / pin_distance;
-  if (std::abs(u.dot(normal)) > kTolerance) return std::nullopt;
-  const Vector3d v = normal.cross(u).normalized();
-  MatrixX2d UV(V.rows(), 2);
-  for (Eigen::Index i = 0; i < V.rows(); ++i) {
-    const Vector3d d = row3(V, static_cast<int>(i)) - row3(V, pin0);
-    UV.row(i) << d.dot(u), d.dot(v);
+  if (static_cast<int>(queue.size()) != nf) return std::nullopt;
+  // Every face's corners must also agree with where its neighbours put them.
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      const double l2 = (UV.row(a) - UV.row(b)).norm();
+      if (std::abs(l2 - length(a, b)) > tolerance) return std::nullopt;
+    }
+  const Vector2d origin = UV.row(pin0).transpose();
+  const Vector2d axis = (UV.row(pin1).transpose() - origin).normalized();
+  if (!axis.allFinite()) return std::nullopt;
+  MatrixX2d out(n, 2);
+  for (int i = 0; i < n; ++i) {
+    const Vector2d d = UV.row(i).transpose() - origin;
+    out.row(i) << d.dot(axis), axis.x() * d.y() - axis.y() * d.x();
   }
-  UV.row(pin0).setZero();
-  UV.row(pin1) << pin_distance, 0.0;
-  return UV;
+  return out;
 }
 }  // namespace
 
@@ -164,7 +209,8 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   }
   for (int v = 0; v < n; ++v)
     MQ_CHECK(used[v], InvalidInput, "lscm: vertex ", v, " is used by no face");
-  const std::vector<int> boundary = disk_boundary(F, n);
+  const EdgeTopology topo = edge_topology(F, n);
+  const std::vector<int> boundary = disk_boundary(F, n, topo);
 
   // Pins: double sweep over the boundary for a far-apart pair (first farthest point wins ties).
   auto farthest = [&](int from) {
@@ -181,10 +227,10 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   const double pin_distance = (row3(V, pin1) - row3(V, pin0)).norm();
   MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
 
-  // A planar patch (the panels of a wall, a table top) has a zero-energy conformal map: its
-  // projection into the plane, placed so the pins land where they are pinned. It is the
+  // A developable patch (a wall's panel, the folded sides of a pillar) has a zero-energy
+  // conformal map, its isometric unfolding: up to the similarity the pins and the area fix, the
   // solution of the system below (unique for a connected disk with two pins), without a solve.
-  if (const std::optional<MatrixX2d> flat = planar_map(V, F, pin0, pin1, pin_distance))
+  if (const std::optional<MatrixX2d> flat = developable_unfolding(V, F, topo, pin0, pin1))
     return rescaled_to_3d_area(*flat, F, patch_area(V, F));
   // Unknowns: u and v of every free vertex; pinned values go to the right-hand side.
   std::vector<int> unknown(n, -1);

@@ -105,19 +105,45 @@ TEST(Lscm, PlanarPatchIsReproducedUpToASimilarity) {
     }
 }
 
-// Planar patches skip the solve; a patch bent out of its plane by 1e-7 goes through it. Both
-// must place the patch the same way (same pins, same scale), so the maps agree closely.
-TEST(Lscm, PlanarShortcutAgreesWithTheSolve) {
+// The grid of tilted_jittered_grid, not jittered, folded by 90 degrees along its vertex column
+// x = 1 (the part beyond rises along the plane's normal), like a patch wrapping round the edge
+// of a box.
+TriMesh folded(const Eigen::Matrix3d& R) {
+  TriMesh m = test::plane_grid(2.0, 1.0, 12, 7);
+  for (int v = 0; v < m.num_vertices(); ++v)
+    m.V.row(v) = (R * m.V.row(v).transpose() + Vector3d(0.3, -1, 2)).transpose();
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const Vector3d local = R.transpose() * (m.V.row(v).transpose() - Vector3d(0.3, -1, 2));
+    if (local.x() > 1.0) {
+      const Vector3d bent(1.0, local.y(), local.x() - 1.0);
+      m.V.row(v) = (R * bent + Vector3d(0.3, -1, 2)).transpose();
+    }
+  }
+  return m;
+}
+
+// Developable patches (flat or folded) skip the solve and are unfolded isometrically; a patch
+// bent 1e-7 out of developable goes through the solve. Both must place the patch the same way
+// (same pins, same scale), so their maps agree closely.
+TEST(Lscm, DevelopableShortcutAgreesWithTheSolve) {
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.4, Vector3d(-1, 2, 0.5).normalized()).toRotationMatrix();
   const TriMesh flat = tilted_jittered_grid(R, 9);
-  TriMesh bent = flat;
-  const Vector3d normal = R.col(2);
-  for (int v = 0; v < bent.num_vertices(); ++v)
-    bent.V.row(v) += 1e-7 * std::sin(3.0 * v) * normal.transpose();
-  const MatrixX2d A = lscm(flat.V, flat.F), B = lscm(bent.V, bent.F);
-  EXPECT_LT((A - B).cwiseAbs().maxCoeff(), 1e-5);
-  EXPECT_GT((A - B).cwiseAbs().maxCoeff(), 0.0);  // the bent patch really took the other path
+  for (const TriMesh& m : {flat, folded(R)}) {
+    TriMesh bent = m;
+    for (int v = 0; v < bent.num_vertices(); ++v)
+      bent.V.row(v) += 1e-7 * std::sin(3.0 * v) * R.col(2).transpose();
+    const MatrixX2d A = lscm(m.V, m.F), B = lscm(bent.V, bent.F);
+    EXPECT_LT((A - B).cwiseAbs().maxCoeff(), 1e-5);
+    EXPECT_GT((A - B).cwiseAbs().maxCoeff(), 0.0);  // the bent patch really took the other path
+    // The unfolding is an isometry: every edge keeps its length.
+    for (int f = 0; f < m.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.F(f, k), b = m.F(f, (k + 1) % 3);
+        ASSERT_NEAR((A.row(a) - A.row(b)).norm(), (m.V.row(a) - m.V.row(b)).norm(), 1e-9);
+      }
+    EXPECT_EQ(count_flipped(m.F, A), 0);
+  }
 }
 
 TEST(Lscm, HemisphereHasNoFlipsAndBoundedDistortion) {
