@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 // GCC 12 reports a false -Wmaybe-uninitialized inside Boost's edge iterator (boost::optional).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+#include <boost/range/iterator_range.hpp>
 #pragma GCC diagnostic pop
 
 #include "core/errors.h"
@@ -55,23 +59,45 @@ std::vector<DualEdge> dual_edges(const MatrixX3d& V, const MatrixX3i& F,
   return edges;
 }
 
+// The flow network in compressed sparse row form: arcs and their properties in flat arrays
+// (an adjacency_list allocated every arc's properties separately, which cost as much as the
+// max-flow itself on elements of a few hundred faces).
+using ArcDescriptor = boost::detail::csr_edge_descriptor<std::size_t, std::size_t>;
 struct ArcProperties {
   double capacity = 0;
   double residual = 0;
-  boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>::edge_descriptor reverse;
+  ArcDescriptor reverse;
+  std::size_t input = 0;  // position in the arc list given to the constructor
 };
-using FlowGraph = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS,
-                                        boost::no_property, ArcProperties>;
+using FlowGraph =
+    boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, ArcProperties>;
 using Arc = boost::graph_traits<FlowGraph>::edge_descriptor;
 
-// Adds u->v with capacity cap_uv and v->u with capacity cap_vu, each the other's reverse.
-void add_arc_pair(FlowGraph& g, int u, int v, double cap_uv, double cap_vu) {
-  const Arc a = boost::add_edge(u, v, g).first;
-  const Arc b = boost::add_edge(v, u, g).first;
-  g[a].capacity = cap_uv;
-  g[b].capacity = cap_vu;
-  g[a].reverse = b;
-  g[b].reverse = a;
+// Arc list under construction: arcs 2k and 2k + 1 are each other's reverse.
+struct ArcList {
+  std::vector<std::pair<std::size_t, std::size_t>> ends;
+  std::vector<ArcProperties> properties;
+  // Adds u->v with capacity cap_uv and v->u with capacity cap_vu.
+  void add_pair(int u, int v, double cap_uv, double cap_vu) {
+    for (const auto& [a, b, cap] : {std::tuple{u, v, cap_uv}, std::tuple{v, u, cap_vu}}) {
+      ArcProperties p;
+      p.capacity = cap;
+      p.input = ends.size();
+      ends.emplace_back(a, b);
+      properties.push_back(p);
+    }
+  }
+};
+
+// The graph, with every arc's reverse set.
+FlowGraph build_flow_graph(const ArcList& arcs, std::size_t num_vertices) {
+  FlowGraph g(boost::edges_are_unsorted_multi_pass, arcs.ends.begin(), arcs.ends.end(),
+              arcs.properties.begin(), num_vertices);
+  std::vector<Arc> by_input(arcs.ends.size());
+  for (const Arc& a : boost::make_iterator_range(boost::edges(g))) by_input[g[a].input] = a;
+  for (const Arc& a : boost::make_iterator_range(boost::edges(g)))
+    g[a].reverse = by_input[g[a].input ^ 1];
+  return g;
 }
 
 }  // namespace
@@ -93,12 +119,15 @@ ElementCut element_graph_cut(const MatrixX3d& V, const MatrixX3i& F,
   const double infinite = 2.0 * total;
 
   const int source = nf, sink = nf + 1;
-  FlowGraph g(nf + 2);
-  for (const DualEdge& e : edges) add_arc_pair(g, e.f, e.g, e.weight, e.weight);
+  ArcList arcs;
+  arcs.ends.reserve(2 * edges.size() + 2 * static_cast<std::size_t>(nf));
+  arcs.properties.reserve(arcs.ends.capacity());
+  for (const DualEdge& e : edges) arcs.add_pair(e.f, e.g, e.weight, e.weight);
   for (int f = 0; f < nf; ++f) {
-    if (hard[f] == CutLabel::Keep) add_arc_pair(g, source, f, infinite, 0.0);
-    if (hard[f] == CutLabel::Remove) add_arc_pair(g, f, sink, infinite, 0.0);
+    if (hard[f] == CutLabel::Keep) arcs.add_pair(source, f, infinite, 0.0);
+    if (hard[f] == CutLabel::Remove) arcs.add_pair(f, sink, infinite, 0.0);
   }
+  FlowGraph g = build_flow_graph(arcs, static_cast<std::size_t>(nf) + 2);
   result.flow = boost::boykov_kolmogorov_max_flow(
       g, boost::get(&ArcProperties::capacity, g), boost::get(&ArcProperties::residual, g),
       boost::get(&ArcProperties::reverse, g), boost::get(boost::vertex_index, g), source, sink);
@@ -113,7 +142,8 @@ ElementCut element_graph_cut(const MatrixX3d& V, const MatrixX3i& F,
   while (!queue.empty()) {
     const int u = queue.front();
     queue.pop();
-    for (const Arc& a : boost::make_iterator_range(boost::out_edges(u, g))) {
+    for (const Arc& a :
+         boost::make_iterator_range(boost::out_edges(static_cast<std::size_t>(u), g))) {
       const int v = static_cast<int>(boost::target(a, g));
       if (!reached[v] && g[a].residual > tol) {
         reached[v] = 1;
