@@ -115,10 +115,13 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
   std::vector<int> entry, next_entry;
   double cost = assigned_cost(swatch, P, NP, t, options.lambda, entry);
   result.evaluations = 1;
+  // Later rounds start with a step of twice the previous round's largest move: the faces
+  // reassigned after a short move only shift the optimum by about that much.
+  double first_step = 0.5 * cell_size;
   for (int round = 0; round < kMaxRounds; ++round) {
     Vector3d u = t;
     double frozen = cost;
-    for (double step = 0.5 * cell_size; step >= options.refine_to * cell_size;) {
+    for (double step = first_step; step >= options.refine_to * cell_size;) {
       const Vector3d moves[4] = {{step, 0, 0}, {-step, 0, 0}, {0, step, 0}, {0, -step, 0}};
       int best = -1;
       double best_cost = frozen;
@@ -143,6 +146,8 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
       }
     }
     if (u == t) break;
+    const double moved_by = (u - t).cwiseAbs().maxCoeff();
+    first_step = std::min(0.5 * cell_size, std::max(2.0 * moved_by, options.refine_to * cell_size));
     const double moved = assigned_cost(swatch, P, NP, u, options.lambda, next_entry);
     ++result.evaluations;
     if (!(moved < cost * (1 - 1e-9))) break;
