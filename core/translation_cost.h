@@ -64,6 +64,7 @@ class SwatchFaceTree {
                        int* entry = nullptr) const;
   // The Eq. (1) cost of one entry's face for query point q, bitwise the value min_face_cost
   // computes for it (so a sum of entry costs bounds a sum of minima exactly).
+  // Precondition: 0 <= entry < num_faces() (InternalError otherwise).
   double entry_cost(int entry, const Vector3d& q, const Vector3d& n, double lambda) const;
 
   int num_faces() const { return static_cast<int>(entry_faces_.size()); }

@@ -76,6 +76,37 @@ TEST(TranslationCost, TreeQueryIsExactEverywhere) {
   }
 }
 
+// The reported entry attains the minimum: its own cost (entry_cost) is bitwise the minimum,
+// and its face's reference cost matches within rounding. The majorize-minimize refinement
+// relies on both.
+TEST(TranslationCost, TreeQueryReportsTheEntryAttainingTheMinimum) {
+  const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
+  const MatrixX3d FN = face_normals(torus.V, torus.F);
+  std::mt19937_64 rng(11);
+  for (int leaf : {1, 64}) {
+    const SwatchFaceTree tree(torus.V, torus.F, leaf);
+    for (double lambda : {0.0, 2.0}) {
+      for (int i = 0; i < 40; ++i) {
+        const double r = i < 20 ? 3.0 : 30.0;
+        const Vector3d q(uniform(rng, -r, r), uniform(rng, -r, r), uniform(rng, -r, r));
+        const Vector3d n = Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), 0.3).normalized();
+        int entry = -2;
+        const double best = tree.min_face_cost(q, n, lambda, &entry);
+        ASSERT_GE(entry, 0);
+        ASSERT_LT(entry, tree.num_faces());
+        EXPECT_EQ(tree.entry_cost(entry, q, n, lambda), best);
+        const int f = tree.entry_faces()[static_cast<size_t>(entry)];
+        const Vector3d a = torus.V.row(torus.F(f, 0)), b = torus.V.row(torus.F(f, 1)),
+                       c = torus.V.row(torus.F(f, 2));
+        const double d = std::sqrt(point_triangle_squared_distance<double>(q, a, b, c));
+        const double reference = (1 + lambda * d) * (1 + (n - Vector3d(FN.row(f))).norm());
+        EXPECT_NEAR(reference, best, 1e-12 * best);
+        EXPECT_NEAR(min_face_cost_reference(torus.V, torus.F, q, n, lambda), best, 1e-12 * best);
+      }
+    }
+  }
+}
+
 TEST(TranslationCost, TreeHoldsEveryFaceOnceInBoundedLeaves) {
   const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
   const int leaf = 8;
