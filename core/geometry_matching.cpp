@@ -123,7 +123,6 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
     double frozen = cost;
     for (double step = first_step; step >= options.refine_to * cell_size;) {
       const Vector3d moves[4] = {{step, 0, 0}, {-step, 0, 0}, {0, step, 0}, {0, -step, 0}};
-      int best = -1;
       double best_cost = frozen;
       Vector3d best_c = u;
       for (int k = 0; k < 4; ++k) {
@@ -132,13 +131,12 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
         c.y() = std::clamp(c.y(), lo.y(), hi.y());
         const double e = surrogate_cost(swatch, P, NP, entry, c, options.lambda);
         if (e < best_cost) {
-          best = k;
           best_cost = e;
           best_c = c;
         }
       }
       // Require a real improvement so float noise cannot make the search wander.
-      if (best >= 0 && best_cost < frozen * (1 - 1e-9)) {
+      if (best_cost < frozen * (1 - 1e-9)) {
         u = best_c;
         frozen = best_cost;
       } else {

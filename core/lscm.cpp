@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
 
 namespace mq {
@@ -113,14 +114,6 @@ MatrixX2d rescaled_to_3d_area(MatrixX2d UV, const MatrixX3i& F, double area3d) {
   return UV;
 }
 
-double patch_area(const MatrixX3d& V, const MatrixX3i& F) {
-  double area = 0;
-  for (int f = 0; f < F.rows(); ++f)
-    area += 0.5 *
-            (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0))).norm();
-  return area;
-}
-
 // Isometric unfolding of a developable patch (a plane, or planes folded along edges like the
 // sides of a box): faces are laid out breadth first across shared edges from face 0, each
 // congruent to its 3D triangle. nullopt when a vertex reached through two faces lands in two
@@ -175,14 +168,9 @@ std::optional<MatrixX2d> developable_unfolding(const MatrixX3d& V, const MatrixX
       queue.push_back(g);
     }
   }
+  // Each face reached is congruent to its triangle: two corners came from its neighbour and the
+  // third was placed, or checked, at its 3D distances from them.
   if (static_cast<int>(queue.size()) != nf) return std::nullopt;
-  // Every face's corners must also agree with where its neighbours put them.
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      const double l2 = (UV.row(a) - UV.row(b)).norm();
-      if (std::abs(l2 - length(a, b)) > tolerance) return std::nullopt;
-    }
   const Vector2d origin = UV.row(pin0).transpose();
   const Vector2d axis = (UV.row(pin1).transpose() - origin).normalized();
   if (!axis.allFinite()) return std::nullopt;
@@ -227,11 +215,17 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   const double pin_distance = (row3(V, pin1) - row3(V, pin0)).norm();
   MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
 
+  // Total 3D area, summed in face order (the scale both paths below are normalised to).
+  double area3d = 0;
+  {
+    const Eigen::VectorXd A = face_areas(V, F);
+    for (Eigen::Index f = 0; f < A.size(); ++f) area3d += A(f);
+  }
   // A developable patch (a wall's panel, the folded sides of a pillar) has a zero-energy
   // conformal map, its isometric unfolding: up to the similarity the pins and the area fix, the
   // solution of the system below (unique for a connected disk with two pins), without a solve.
   if (const std::optional<MatrixX2d> flat = developable_unfolding(V, F, topo, pin0, pin1))
-    return rescaled_to_3d_area(*flat, F, patch_area(V, F));
+    return rescaled_to_3d_area(*flat, F, area3d);
   // Unknowns: u and v of every free vertex; pinned values go to the right-hand side.
   std::vector<int> unknown(n, -1);
   int nu = 0;
@@ -245,7 +239,6 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<size_t>(nf) * 12);
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
-  double area3d = 0;
   for (int f = 0; f < nf; ++f) {
     const Vector3d P0 = row3(V, F(f, 0)), P1 = row3(V, F(f, 1)), P2 = row3(V, F(f, 2));
     const Vector3d normal = (P1 - P0).cross(P2 - P0);
@@ -253,7 +246,6 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
     const double l01 = (P1 - P0).norm();
     MQ_CHECK(twice_area > 0 && l01 > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
              " has zero area");
-    area3d += 0.5 * twice_area;
     const Vector3d x = (P1 - P0) / l01;
     const Vector3d y = normal.cross(x).normalized();
     const Vector2d p[3] = {Vector2d::Zero(), Vector2d(l01, 0),

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 
 #include "core/errors.h"
+#include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
 
 namespace mq {
@@ -285,16 +285,6 @@ bool meshes_intersect(const TriMesh& A, const TriMesh& B) {
     lo = M.V.row(M.F(f, 0)).cwiseMin(M.V.row(M.F(f, 1))).cwiseMin(M.V.row(M.F(f, 2))).transpose();
     hi = M.V.row(M.F(f, 0)).cwiseMax(M.V.row(M.F(f, 1))).cwiseMax(M.V.row(M.F(f, 2))).transpose();
   };
-  const auto mesh_box = [&](const TriMesh& M, Vector3d& lo, Vector3d& hi) {
-    lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
-    hi = -lo;
-    for (int f = 0; f < M.F.rows(); ++f) {
-      Vector3d flo, fhi;
-      face_box(M, f, flo, fhi);
-      lo = lo.cwiseMin(flo);
-      hi = hi.cwiseMax(fhi);
-    }
-  };
   const auto faces_meeting = [&](const TriMesh& M, const Vector3d& lo, const Vector3d& hi) {
     std::vector<int> faces;
     for (int f = 0; f < M.F.rows(); ++f) {
@@ -305,12 +295,10 @@ bool meshes_intersect(const TriMesh& A, const TriMesh& B) {
     }
     return faces;
   };
-  Vector3d a_lo, a_hi, b_lo, b_hi;
-  mesh_box(A, a_lo, a_hi);
-  mesh_box(B, b_lo, b_hi);
-  const std::vector<int> fa = faces_meeting(A, b_lo, b_hi);
+  const BoundingBox box_a = bounding_box(A.V, A.F), box_b = bounding_box(B.V, B.F);
+  const std::vector<int> fa = faces_meeting(A, box_b.min, box_b.max);
   if (fa.empty()) return false;
-  const std::vector<int> fb = faces_meeting(B, a_lo, a_hi);
+  const std::vector<int> fb = faces_meeting(B, box_a.min, box_a.max);
   if (fb.empty()) return false;
   TriMesh both = extract_faces(A, fa);
   const int num_a = static_cast<int>(both.F.rows());

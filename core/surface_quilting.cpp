@@ -378,6 +378,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   MatrixX3d field;
   std::unique_ptr<SwatchFaceTree> swatch_tree;
   std::unique_ptr<ClosestPointQuery> swatch_query;
+  const EmbreeDevice embree;  // one device for every BVH of the run
   EdgeTopology topo;
   MatrixX3i TT;
   {
@@ -390,7 +391,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     swatch = prepare_swatch(scaled);
     stats.swatch_scale = factor;
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
-    swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
+    swatch_query = std::make_unique<ClosestPointQuery>(embree, swatch.mesh.V, swatch.mesh.F);
     field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
     topo = edge_topology(base.F, base.num_vertices());
     TT = face_adjacency(topo);
@@ -448,7 +449,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   }
   patch_options.max_distortion = options.max_distortion;
   const MatrixX3d base_normals = vertex_normals(base.V, base.F);
-  const ClosestPointQuery base_query(base.V, base.F);
+  const ClosestPointQuery base_query(embree, base.V, base.F);
 
   while (!queue.empty()) {
     const int seed = queue.begin()->second;
@@ -464,8 +465,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         continue;
       }
       if (patch.shrink_steps > 0) ++stats.patches_shrunk;
-      frame = std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose(),
-                                           base_query.device());
+      frame =
+          std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose(), embree);
     }
     const LocalPatch& patch = frame->patch();
 
