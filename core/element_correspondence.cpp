@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/point_triangle.h"
+
 namespace mq {
 
 namespace {
@@ -59,7 +61,7 @@ bool projections_overlap(const Element& a, const Element& b, double resolution) 
 Correspondences find_correspondences(const std::vector<Element>& output,
                                      const std::vector<int>& candidates,
                                      const OverlapRegion& region, const PreparedSwatch& swatch,
-                                     const ClosestPointQuery& swatch_query, const Vector3d& t,
+                                     const SwatchFaceTree& swatch_faces, const Vector3d& t,
                                      const CorrespondenceOptions& options) {
   const double max_distance = options.prune_distance * swatch.mean_edge_length;
   // Per candidate element, its pairs; filled in parallel, concatenated in candidate order.
@@ -75,18 +77,29 @@ Correspondences find_correspondences(const std::vector<Element>& output,
       // A vertex whose faces all lost their area (squeezed by a deformation, or seen through a
       // degenerate patch map) has no normal: it cannot be matched by Eq. (1) and is skipped.
       if (!n.allFinite() || !(n.squaredNorm() > 0)) continue;
-      const ClosestPointHit hit = swatch_query.match(p - t, n, options.lambda, max_distance);
-      if (hit.face < 0 || hit.distance > max_distance) continue;
-      if (n.dot(swatch_query.face_normals().row(hit.face).transpose()) < options.min_normal_dot)
-        continue;
+      // The Eq. (1)-closest swatch face among those within max_distance (the same search as
+      // geometry matching, so pairs rank faces exactly as the matched cost did).
+      const Vector3d q = p - t;
+      int entry = -1;
+      swatch_faces.min_face_cost(q, n, options.lambda, &entry, max_distance);
+      if (entry < 0) continue;
+      const size_t j = static_cast<size_t>(entry);
+      const double* fn = &swatch_faces.entry_normals()[4 * j];
+      if (n.dot(Vector3d(fn[0], fn[1], fn[2])) < options.min_normal_dot) continue;
+      const double* tri = &swatch_faces.entry_triangles()[9 * j];
+      const Vector3d a(tri[0], tri[1], tri[2]), b(tri[3], tri[4], tri[5]),
+          c(tri[6], tri[7], tri[8]);
+      const Vector3d w = closest_point_barycentric<double>(q, a, b, c);
+      const Vector3d closest = w(0) * a + w(1) * b + w(2) * c;
+      const int face = swatch_faces.entry_faces()[j];
       VertexFacePair pair;
       pair.out_element = o;
       pair.out_vertex = v;
-      pair.in_element = swatch.face_element[hit.face];
-      pair.in_face = hit.face - swatch.element_first_face[pair.in_element];
-      pair.barycentric = hit.barycentric;
-      pair.closest = hit.point + t;
-      pair.distance = hit.distance;
+      pair.in_element = swatch.face_element[face];
+      pair.in_face = face - swatch.element_first_face[pair.in_element];
+      pair.barycentric = w;
+      pair.closest = closest + t;
+      pair.distance = (q - closest).norm();
       pairs.push_back(pair);
     }
   });

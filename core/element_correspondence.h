@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/closest_point_query.h"
 #include "core/overlap_region.h"
 #include "core/quilt_elements.h"
+#include "core/translation_cost.h"
 
 namespace mq {
 
@@ -23,28 +23,28 @@ struct CorrespondenceOptions {
 // One surviving vertex-face pair. Positions are in the output frame (swatch translated by t).
 struct VertexFacePair {
   int out_element = -1;
-  int out_vertex = -1;     // local to the output element
+  int out_vertex = -1;  // local to the output element
   int in_element = -1;
-  int in_face = -1;        // local to the swatch element
+  int in_face = -1;  // local to the swatch element
   Vector3d barycentric = Vector3d::Zero();
   Vector3d closest = Vector3d::Zero();  // h_i of section 2.6
   double distance = 0;
 };
 
 struct Correspondences {
-  std::vector<VertexFacePair> pairs;               // grouped by output element, then vertex
-  std::vector<std::pair<int, int>> relations;      // (output element, swatch element), sorted
+  std::vector<VertexFacePair> pairs;           // grouped by output element, then vertex
+  std::vector<std::pair<int, int>> relations;  // (output element, swatch element), sorted
 };
 
 // Pairs every output vertex in `region` (of the listed output elements) with its Eq. (1)-closest
 // face of the swatch translated by t, prunes opposite normals and far pairs, and drops the
 // relations whose 2D projections do not overlap (with their pairs).
 //   output          all output elements; only those listed in `candidates` are visited
-//   swatch_query    query over swatch.mesh in the swatch frame (untranslated)
+//   swatch_faces    face tree over swatch.mesh in the swatch frame (untranslated)
 Correspondences find_correspondences(const std::vector<Element>& output,
                                      const std::vector<int>& candidates,
                                      const OverlapRegion& region, const PreparedSwatch& swatch,
-                                     const ClosestPointQuery& swatch_query, const Vector3d& t,
+                                     const SwatchFaceTree& swatch_faces, const Vector3d& t,
                                      const CorrespondenceOptions& options);
 
 // Whether the xy projections of two elements' triangles overlap, tested on a raster of the

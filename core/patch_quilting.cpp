@@ -48,7 +48,7 @@ void accumulate(PatchCounts& a, const PatchCounts& b) {
 }
 
 void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
-                 const ClosestPointQuery& swatch_query, const Vector3d& t,
+                 const SwatchFaceTree& swatch_faces, const EmbreeDevice& embree, const Vector3d& t,
                  const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
                  const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
                  std::vector<int>* rejected) {
@@ -73,7 +73,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
       local[k] = static_cast<int>(k);
     }
     corr =
-        find_correspondences(frame, local, region, swatch, swatch_query, t, options.correspondence);
+        find_correspondences(frame, local, region, swatch, swatch_faces, t, options.correspondence);
     counts.pairs += static_cast<long long>(corr.pairs.size());
     counts.relations += static_cast<long long>(corr.relations.size());
   }
@@ -213,8 +213,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     const Element& base = current(k);
     // The same element placed twice (nearly identical, or mostly the same footprint, as for two
     // apples slightly apart): keep the output one rather than stitching two halves.
-    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge,
-                          &swatch_query.device()) ||
+    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge, &embree) ||
         footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
       ++counts.matched;
       busy[k] = 1;
@@ -222,7 +221,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     }
     StitchFailure why = StitchFailure::None;
     std::optional<Element> joined =
-        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &swatch_query.device());
+        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &embree);
     std::vector<int> ignore = replaced_ids;
     ignore.push_back(near[k]);
     if (joined && fits(output, *joined, ignore)) {

@@ -8,9 +8,9 @@
 #include <functional>
 #include <vector>
 
-#include "core/closest_point_query.h"
 #include "core/element_correspondence.h"
 #include "core/element_merging.h"
+#include "core/embree_device.h"
 #include "core/stage_timer.h"
 
 namespace mq {
@@ -53,8 +53,10 @@ struct PatchCounts {
 // only ever added or changed so that no two of them intersect. Times go to the stages
 // "correspondence", "deformation" and "merging". `rejected`, when given, receives the indices
 // of the swatch elements that could not enter: not admissible, or intersecting the output.
+//   swatch_faces   face tree over swatch.mesh in the swatch frame (the matching's)
+//   embree         the device the merging's temporary BVHs are built on
 void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
-                 const ClosestPointQuery& swatch_query, const Vector3d& t,
+                 const SwatchFaceTree& swatch_faces, const EmbreeDevice& embree, const Vector3d& t,
                  const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
                  const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
                  std::vector<int>* rejected = nullptr);

@@ -6,7 +6,7 @@
 #include <map>
 #include <memory>
 
-#include "core/closest_point_query.h"
+#include "core/embree_device.h"
 #include "core/errors.h"
 #include "core/mesh_topology.h"
 #include "core/patch_quilting.h"
@@ -144,11 +144,10 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
 
   std::unique_ptr<SwatchFaceTree> swatch_tree;
-  std::unique_ptr<ClosestPointQuery> swatch_query;
+  const EmbreeDevice embree;  // for the merging's temporary BVHs
   {
     ScopedStageTimer timer(times, "prepare");
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
-    swatch_query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
   }
   OutputStore output(grid);
   std::mt19937_64 rng(options.seed);
@@ -213,8 +212,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
 
     // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
-    quilt_patch(output, swatch, *swatch_query, t, region, in_domain, patch_options, stats.counts,
-                times);
+    quilt_patch(output, swatch, *swatch_tree, embree, t, region, in_domain, patch_options,
+                stats.counts, times);
     mark_patch(patch_lo, patch_hi);
     grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
     report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());

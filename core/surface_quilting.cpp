@@ -377,7 +377,6 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   PreparedSwatch swatch;
   MatrixX3d field;
   std::unique_ptr<SwatchFaceTree> swatch_tree;
-  std::unique_ptr<ClosestPointQuery> swatch_query;
   const EmbreeDevice embree;  // one device for every BVH of the run
   EdgeTopology topo;
   MatrixX3i TT;
@@ -391,7 +390,6 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     swatch = prepare_swatch(scaled);
     stats.swatch_scale = factor;
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
-    swatch_query = std::make_unique<ClosestPointQuery>(embree, swatch.mesh.V, swatch.mesh.F);
     field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
     topo = edge_topology(base.F, base.num_vertices());
     TT = face_adjacency(topo);
@@ -546,8 +544,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     };
     PatchCounts counts;
     std::vector<int> rejected;
-    quilt_patch(framed, swatch, *swatch_query, t, region, admissible, options.patch, counts, times,
-                &rejected);
+    quilt_patch(framed, swatch, *swatch_tree, embree, t, region, admissible, options.patch, counts,
+                times, &rejected);
     accumulate(stats.counts, counts);
     stats.rejected_outside_patch += outside;
 

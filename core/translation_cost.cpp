@@ -189,8 +189,9 @@ double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& 
 }
 
 double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
-                                     int* entry) const {
+                                     int* entry, double max_distance) const {
   if (entry) *entry = -1;
+  MQ_ASSERT(max_distance >= 0);
   const double slack = slack_;
   // Squared distance from q to node i's box.
   auto box_distance2 = [&](int i) {
@@ -205,11 +206,14 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
   // A node can hold a better face only if 1 + lambda * (distance - slack) < best, i.e. its box
   // lies nearer than reach = (best - 1) / lambda + slack (no bound without a distance weight):
   // compared squared, so inner nodes cost no square root.
-  double best = kInf, reach2 = kInf;
+  // max_distance caps the reach the same way: faces farther away do not compete at all.
+  const double cap = max_distance + slack, cap2 = cap * cap * (1.0 + 1e-12);
+  const double max_dist2 = max_distance * max_distance;
+  double best = kInf, reach2 = cap2;
   auto update_reach = [&] {
     if (lambda > 0) {
       const double reach = (best - 1.0) / lambda + slack;
-      reach2 = reach * reach * (1.0 + 1e-12);
+      reach2 = std::min(cap2, reach * reach * (1.0 + 1e-12));
     }
   };
   int stack[kMaxDepth + 2];
@@ -242,10 +246,11 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
         const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
         const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
         const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp4[3];
-        if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best) continue;
+        if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best || sphere_lb - slack > cap)
+          continue;
         const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
         const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
-        if (cost < best) {
+        if (cost < best && dist2 <= max_dist2) {
           best = cost;
           if (entry) *entry = j;
           update_reach();

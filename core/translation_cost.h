@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -60,8 +61,10 @@ class SwatchFaceTree {
   // computed.
   // entry (optional): receives the entry (leaf-order face slot, see entry_faces()) attaining
   // the minimum, -1 when there is none.
-  double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
-                       int* entry = nullptr) const;
+  // max_distance (>= 0): only faces within this distance of q compete (infinity, and -1 in
+  // entry, when there is none); the cap also bounds the search, so a small one makes it cheap.
+  double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda, int* entry = nullptr,
+                       double max_distance = std::numeric_limits<double>::infinity()) const;
   // The Eq. (1) cost of one entry's face for query point q, bitwise the value min_face_cost
   // computes for it (so a sum of entry costs bounds a sum of minima exactly).
   // Precondition: 0 <= entry < num_faces() (InternalError otherwise).

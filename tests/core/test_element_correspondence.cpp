@@ -17,7 +17,7 @@ namespace {
 
 struct TwoTori {
   PreparedSwatch swatch;
-  std::unique_ptr<ClosestPointQuery> query;
+  std::unique_ptr<SwatchFaceTree> faces;
   SynthesisGrid grid{Vector2d(0, 0), 1.0, 20, 20};
   Vector3d t{5, 6, 0};
   TwoTori() {
@@ -26,7 +26,7 @@ struct TwoTori {
     b.V.col(0).array() += 4.0;
     append_mesh(m, b);
     swatch = prepare_swatch(m);
-    query = std::make_unique<ClosestPointQuery>(swatch.mesh.V, swatch.mesh.F);
+    faces = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
     for (int i = 0; i < grid.num_cells(); ++i) grid.set_processed(grid.cell(i));
   }
   // The swatch elements placed at t: the output the new patch matches exactly.
@@ -40,7 +40,7 @@ struct TwoTori {
                                grid.processed_snapshot());
     std::vector<int> candidates(output.size());
     for (size_t i = 0; i < output.size(); ++i) candidates[i] = static_cast<int>(i);
-    return find_correspondences(output, candidates, region, swatch, *query, t, o);
+    return find_correspondences(output, candidates, region, swatch, *faces, t, o);
   }
 };
 

@@ -107,6 +107,49 @@ TEST(TranslationCost, TreeQueryReportsTheEntryAttainingTheMinimum) {
   }
 }
 
+// With a distance cap only faces within it compete: the result is the minimum over those faces
+// (brute force), infinity with entry -1 when none is that near. Correspondences rely on it.
+TEST(TranslationCost, TreeQueryWithADistanceCapRanksOnlyFacesWithinIt) {
+  const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
+  const MatrixX3d FN = face_normals(torus.V, torus.F);
+  std::mt19937_64 rng(13);
+  int capped = 0, empty = 0;
+  for (int leaf : {1, 64}) {
+    const SwatchFaceTree tree(torus.V, torus.F, leaf);
+    for (double lambda : {0.0, 1.0}) {
+      for (int i = 0; i < 60; ++i) {
+        const Vector3d q(uniform(rng, -3, 3), uniform(rng, -3, 3), uniform(rng, -1, 1));
+        const Vector3d n = Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), 0.3).normalized();
+        const double cap = uniform(rng, 0.0, 0.6);
+        double expected = std::numeric_limits<double>::infinity();
+        for (int f = 0; f < torus.num_faces(); ++f) {
+          const Vector3d a = torus.V.row(torus.F(f, 0)), b = torus.V.row(torus.F(f, 1)),
+                         c = torus.V.row(torus.F(f, 2));
+          const double d2 = point_triangle_squared_distance<double>(q, a, b, c);
+          if (d2 > cap * cap) continue;
+          expected = std::min(
+              expected, (1 + lambda * std::sqrt(d2)) * (1 + (n - Vector3d(FN.row(f))).norm()));
+        }
+        int entry = -2;
+        const double got = tree.min_face_cost(q, n, lambda, &entry, cap);
+        if (std::isinf(expected)) {
+          ++empty;
+          EXPECT_TRUE(std::isinf(got));
+          EXPECT_EQ(entry, -1);
+          continue;
+        }
+        ++capped;
+        ASSERT_GE(entry, 0);
+        EXPECT_NEAR(got, expected, 1e-12 * expected) << "q " << q.transpose() << " cap " << cap;
+        EXPECT_GE(got, tree.min_face_cost(q, n, lambda));  // never below the uncapped minimum
+      }
+    }
+  }
+  // Both outcomes occurred, so the test covers them.
+  EXPECT_GT(capped, 20);
+  EXPECT_GT(empty, 20);
+}
+
 TEST(TranslationCost, TreeHoldsEveryFaceOnceInBoundedLeaves) {
   const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
   const int leaf = 8;
