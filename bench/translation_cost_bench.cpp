@@ -6,6 +6,8 @@
 
 #include <memory>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "core/geometry_measures.h"
 #include "core/mesh_io.h"
@@ -105,6 +107,49 @@ void BM_TranslationCostTbbMatchingWeight(benchmark::State& state) {
   set_counters(state, fx.problem, fx.swatch.num_faces());
 }
 BENCHMARK(BM_TranslationCostTbbMatchingWeight)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Matching-sized problems, where a launch's fixed cost matters: arguments (stride, offsets per
+// axis); (184, 5) is a screening pass (32 points x 25 offsets), (16, 2) a finalist pass (~370
+// points x 4 offsets), larger ones where the device starts to pay. The OpenCL evaluator is
+// forced onto the device at every size (min_device_pairs = 0).
+void small_problem_args(benchmark::internal::Benchmark* b) {
+  for (const auto& [stride, n] :
+       std::vector<std::pair<int, int>>{{184, 5}, {16, 2}, {48, 6}, {24, 8}, {12, 10}, {6, 12}})
+    b->Args({stride, n});
+}
+
+void BM_TranslationCostOpenCLSmall(benchmark::State& state) {
+  if (!cl::Runtime::available()) {
+    state.SkipWithError("no OpenCL platform");
+    return;
+  }
+  const Fixture fx =
+      make_fixture(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 8.0);
+  const SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
+  TranslationCostOpenCL::Options options;
+  options.min_device_pairs = 0;
+  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>(), options);
+  benchmark::DoNotOptimize(ocl.evaluate(tree, fx.problem));
+  for (auto _ : state) benchmark::DoNotOptimize(ocl.evaluate(tree, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostOpenCLSmall)
+    ->Apply(small_problem_args)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+void BM_TranslationCostTbbSmall(benchmark::State& state) {
+  const Fixture fx =
+      make_fixture(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)), 8.0);
+  const SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  for (auto _ : state) benchmark::DoNotOptimize(cpu.evaluate(tree, fx.problem));
+  set_counters(state, fx.problem, fx.swatch.num_faces());
+}
+BENCHMARK(BM_TranslationCostTbbSmall)
+    ->Apply(small_problem_args)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 void BM_TranslationCostBruteForceReduced(benchmark::State& state) {
   const Fixture fx = make_fixture(30, 4);  // ~200 points x 16 offsets

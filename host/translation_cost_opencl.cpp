@@ -24,8 +24,9 @@ cl::Buffer upload_array(cl_context context, const T* data, std::size_t count) {
 
 }  // namespace
 
-TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime)
-    : runtime_(std::move(runtime)) {
+TranslationCostOpenCL::TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime,
+                                             const Options& options)
+    : runtime_(std::move(runtime)), options_(options) {
   MQ_CHECK(runtime_, InvalidInput, "TranslationCostOpenCL: null runtime");
   MQ_CHECK(runtime_->has_fp64(), DeviceError, "OpenCL device \"", runtime_->device_name(),
            "\" lacks cl_khr_fp64 (double precision), required by the translation-cost kernel");
@@ -59,6 +60,7 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchFaceTree& tree,
   const std::size_t T = static_cast<std::size_t>(problem.offsets.rows());
   Eigen::VectorXd E = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(T));
   if (P == 0 || T == 0) return E;
+  if (P * T < options_.min_device_pairs) return host_.evaluate(tree, problem);
   MQ_CHECK(P <= kMaxMinimaPerLaunch, InvalidInput, "translation cost: too many points (", P, ")");
 
   const DeviceTree& dt = upload(tree);

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "core/translation_cost.h"
 #include "host/opencl_handles.h"
@@ -21,9 +22,19 @@ namespace mq {
 // Swatch trees are uploaded once and cached by their fingerprint (a few trees at a time).
 class TranslationCostOpenCL final : public TranslationCostEvaluator {
  public:
+  struct Options {
+    // Problems with fewer (point, offset) pairs than this are evaluated by the host path
+    // (TranslationCostCpu, the same tree and maths, bitwise the same sums on PoCL): a launch
+    // with its transfers costs PoCL ~0.7 ms, more than the host needs for a few thousand
+    // pairs (bench/translation_cost_bench, BM_TranslationCost*Small). 0 = always the device.
+    std::size_t min_device_pairs = 16384;
+  };
+
   // Builds the kernel through the runtime's program cache. Throws DeviceError when the device
   // lacks cl_khr_fp64 or the build fails; InvalidInput when runtime is null.
-  explicit TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime);
+  explicit TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime)
+      : TranslationCostOpenCL(std::move(runtime), Options()) {}
+  TranslationCostOpenCL(std::shared_ptr<cl::Runtime> runtime, const Options& options);
 
   Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                            const TranslationCostProblem& problem) override;
@@ -40,6 +51,8 @@ class TranslationCostOpenCL final : public TranslationCostEvaluator {
   const DeviceTree& upload(const SwatchFaceTree& tree);
 
   std::shared_ptr<cl::Runtime> runtime_;
+  Options options_;
+  TranslationCostCpu host_;  // below options_.min_device_pairs
   cl::Kernel kernel_;
   std::size_t group_ = 1;  // work-group size along the points
   std::map<std::uint64_t, DeviceTree> trees_;

@@ -13,6 +13,7 @@
 #include "core/mesh_io.h"
 #include "core/planar_quilting.h"
 #include "host/translation_cost_evaluator.h"
+#include "host/translation_cost_opencl.h"
 #include "tests/core/planar_checks.h"
 #include "tests/test_support.h"
 
@@ -105,7 +106,10 @@ TEST(PlanarQuilting, SameSeedSameOutputWhateverTheThreadCount) {
 TEST(PlanarQuilting, CpuAndOpenClEvaluatorsGiveTheSameOutput) {
   std::unique_ptr<TranslationCostEvaluator> ocl;
   try {
-    ocl = make_translation_cost_evaluator(Device::OpenCL);
+    // Every evaluation on the device, however small, so the two paths really are compared.
+    TranslationCostOpenCL::Options options;
+    options.min_device_pairs = 0;
+    ocl = std::make_unique<TranslationCostOpenCL>(std::make_shared<cl::Runtime>(), options);
   } catch (const DeviceError& e) {
     GTEST_SKIP() << "no OpenCL device: " << e.what();
   }

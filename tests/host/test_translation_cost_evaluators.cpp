@@ -61,7 +61,10 @@ class TranslationCostPaths : public ::testing::TestWithParam<Device> {
       evaluator_ = std::make_unique<TranslationCostCpu>();
     } else {
       if (!runtime_) GTEST_SKIP() << "no OpenCL platform";
-      evaluator_ = std::make_unique<TranslationCostOpenCL>(runtime_);
+      // Every problem on the device, however small (the default sends small ones to the host).
+      TranslationCostOpenCL::Options options;
+      options.min_device_pairs = 0;
+      evaluator_ = std::make_unique<TranslationCostOpenCL>(runtime_, options);
     }
   }
 
@@ -186,7 +189,9 @@ INSTANTIATE_TEST_SUITE_P(Paths, TranslationCostPaths,
 
 TEST(TranslationCostOpenCL, SwatchGridIsUploadedOncePerGrid) {
   if (!cl::Runtime::available()) GTEST_SKIP() << "no OpenCL platform";
-  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>());
+  TranslationCostOpenCL::Options options;
+  options.min_device_pairs = 0;
+  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>(), options);
   const TriMesh a = test::torus(2.0, 0.5, 16, 8), b = test::unit_cube();
   const SwatchFaceTree ga(a.V, a.F), gb(b.V, b.F);
   TranslationCostProblem pb;
@@ -202,6 +207,33 @@ TEST(TranslationCostOpenCL, SwatchGridIsUploadedOncePerGrid) {
   // The cached buffers belong to the right tree.
   EXPECT_EQ(ocl.evaluate(ga, pb)(0), first(0));
   EXPECT_NE(cube(0), first(0));
+}
+
+// Below min_device_pairs the host path answers (nothing is uploaded) with the same costs; at or
+// above it the kernel runs.
+TEST(TranslationCostOpenCL, SmallProblemsStayOnTheHost) {
+  if (!cl::Runtime::available()) GTEST_SKIP() << "no OpenCL platform";
+  TranslationCostOpenCL::Options options;
+  options.min_device_pairs = 8;
+  TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>(), options);
+  const TriMesh m = test::torus(2.0, 0.5, 16, 8);
+  const SwatchFaceTree tree(m.V, m.F);
+  const MatrixX3d N = vertex_normals(m.V, m.F);
+  TranslationCostProblem pb;
+  pb.points = m.V.topRows(3);
+  pb.point_normals = N.topRows(3);
+  pb.offsets = MatrixX3d::Zero(2, 3);
+  pb.offsets(1, 0) = 0.3;
+  TranslationCostCpu cpu;
+  const Eigen::VectorXd small = ocl.evaluate(tree, pb);  // 6 pairs
+  EXPECT_EQ(ocl.num_cached_trees(), 0u);
+  EXPECT_EQ(small, cpu.evaluate(tree, pb));
+  pb.points = m.V.topRows(4);
+  pb.point_normals = N.topRows(4);
+  const Eigen::VectorXd large = ocl.evaluate(tree, pb);  // 8 pairs
+  EXPECT_EQ(ocl.num_cached_trees(), 1u);
+  const Eigen::VectorXd reference = cpu.evaluate(tree, pb);
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(large(i), reference(i), 1e-9 * reference(i));
 }
 
 TEST(TranslationCostFactory, ChoosesThePath) {
