@@ -106,6 +106,20 @@ void BM_LaplacianDeformer_Precompute(benchmark::State& state) {
 }
 BENCHMARK(BM_LaplacianDeformer_Precompute)->Unit(benchmark::kMicrosecond);
 
+// The same element with its topology taken from a cache (a copy of a swatch element): only
+// delta = L V and L^T delta remain.
+void BM_LaplacianDeformer_PrecomputeSharedTopology(benchmark::State& state) {
+  const TriMesh m = ring(40, 25, Vector3d::Zero());
+  LaplacianTopologyCache cache;
+  cache.add(m.F, m.num_vertices());
+  const auto topology = cache.find(m.F, m.num_vertices());
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(cache.find(m.F, m.num_vertices()));
+    benchmark::DoNotOptimize(LaplacianDeformer(topology, m.V));
+  }
+}
+BENCHMARK(BM_LaplacianDeformer_PrecomputeSharedTopology)->Unit(benchmark::kMicrosecond);
+
 void BM_LaplacianDeformer_Solve(benchmark::State& state) {
   const std::vector<TriMesh> meshes{ring(40, 25, Vector3d::Zero())};
   const std::vector<DeformationJob> jobs = make_jobs(meshes, 1, 100);

@@ -117,15 +117,9 @@ SpMat uniform_laplacian(const MatrixX3i& F, int num_vertices) {
   return L;
 }
 
-LaplacianDeformer::LaplacianDeformer(const MatrixX3d& V, const MatrixX3i& F,
-                                     const DeformationOptions& options)
-    : V_(V), options_(options) {
-  MQ_CHECK(std::isfinite(options.mu) && options.mu > 0.0, InvalidInput,
-           "deformation weight mu must be positive and finite, got ", options.mu);
-  MQ_CHECK(V.allFinite(), InvalidInput, "element vertex positions are not finite");
-  const int n = static_cast<int>(V.rows());
-  L_ = uniform_laplacian(F, n);
-  delta_ = L_ * V_;
+LaplacianTopology::LaplacianTopology(const MatrixX3i& F, int num_vertices) : F_(F) {
+  const int n = num_vertices;
+  L_ = uniform_laplacian(F, n);  // checks n and the indices
   num_components_ = laplacian_components(L_, component_);
   perm_.resize(n);
   if (n == 0) return;
@@ -148,26 +142,90 @@ LaplacianDeformer::LaplacianDeformer(const MatrixX3d& V, const MatrixX3i& F,
   system_.resize(n, n);
   system_.selfadjointView<Eigen::Upper>() = Q.selfadjointView<Eigen::Upper>().twistedBy(P);
   system_.makeCompressed();
+}
 
+namespace {
+
+std::uint64_t faces_hash(const MatrixX3i& F, int num_vertices) {
+  std::uint64_t h = 14695981039346656037ull;
+  auto mix = [&h](std::uint64_t x) {
+    h ^= x;
+    h *= 1099511628211ull;
+  };
+  mix(static_cast<std::uint64_t>(num_vertices));
+  mix(static_cast<std::uint64_t>(F.rows()));
+  for (Eigen::Index i = 0; i < F.size(); ++i) mix(static_cast<std::uint32_t>(F.data()[i]));
+  return h;
+}
+
+}  // namespace
+
+void LaplacianTopologyCache::add(const MatrixX3i& F, int num_vertices) {
+  if (find(F, num_vertices)) return;
+  by_hash_[faces_hash(F, num_vertices)].push_back(
+      std::make_shared<const LaplacianTopology>(F, num_vertices));
+  ++size_;
+}
+
+std::shared_ptr<const LaplacianTopology> LaplacianTopologyCache::find(const MatrixX3i& F,
+                                                                      int num_vertices) const {
+  const auto it = by_hash_.find(faces_hash(F, num_vertices));
+  if (it == by_hash_.end()) return nullptr;
+  for (const auto& t : it->second)
+    if (t->num_vertices() == num_vertices && t->faces() == F) return t;
+  return nullptr;
+}
+
+LaplacianDeformer::LaplacianDeformer(const MatrixX3d& V, const MatrixX3i& F,
+                                     const DeformationOptions& options)
+    : V_(V), options_(options) {
+  MQ_CHECK(std::isfinite(options.mu) && options.mu > 0.0, InvalidInput,
+           "deformation weight mu must be positive and finite, got ", options.mu);
+  MQ_CHECK(V.allFinite(), InvalidInput, "element vertex positions are not finite");
+  topology_ = std::make_shared<const LaplacianTopology>(F, static_cast<int>(V.rows()));
+  init_values();
+}
+
+LaplacianDeformer::LaplacianDeformer(std::shared_ptr<const LaplacianTopology> topology,
+                                     const MatrixX3d& V, const DeformationOptions& options)
+    : topology_(std::move(topology)), V_(V), options_(options) {
+  MQ_CHECK(topology_, InvalidInput, "Laplacian deformer: null topology");
+  MQ_CHECK(V.rows() == topology_->num_vertices(), InvalidInput, "Laplacian deformer: ", V.rows(),
+           " positions for a topology of ", topology_->num_vertices(), " vertices");
+  MQ_CHECK(std::isfinite(options.mu) && options.mu > 0.0, InvalidInput,
+           "deformation weight mu must be positive and finite, got ", options.mu);
+  MQ_CHECK(V.allFinite(), InvalidInput, "element vertex positions are not finite");
+  init_values();
+}
+
+void LaplacianDeformer::init_values() {
+  const SpMat& L = topology_->laplacian();
+  const std::vector<int>& perm = topology_->permutation();
+  delta_ = L * V_;
+  const int n = num_vertices();
+  if (n == 0) return;
+  const SpMat Lt = L.transpose();
   const Eigen::MatrixXd b = Lt * delta_;
   rhs_.resize(n, 3);
-  for (int i = 0; i < n; ++i) rhs_.row(perm_[i]) = b.row(i);
+  for (int i = 0; i < n; ++i) rhs_.row(perm[i]) = b.row(i);
 }
 
 MatrixX3d LaplacianDeformer::solve(const std::vector<LinearConstraint>& constraints) const {
   const int n = num_vertices();
   const double mu = options_.mu;
+  const std::vector<int>& component = topology_->vertex_components();
+  const std::vector<int>& perm = topology_->permutation();
 
   std::vector<ActiveTerms> terms(constraints.size());
-  std::vector<char> constrained(num_components_, 0);
+  std::vector<char> constrained(topology_->num_components(), 0);
   for (size_t c = 0; c < constraints.size(); ++c) {
-    terms[c] = validate_constraint(constraints[c], c, component_);
-    constrained[component_[terms[c].vertex[0]]] = 1;
+    terms[c] = validate_constraint(constraints[c], c, component);
+    constrained[component[terms[c].vertex[0]]] = 1;
   }
   if (std::find(constrained.begin(), constrained.end(), 1) == constrained.end()) return V_;
 
   // Normal equations (L^T L + mu C^T C) W = L^T delta + mu C^T c, in the permuted numbering.
-  SpMat A = system_;
+  SpMat A = topology_->permuted_normal_matrix();
   Eigen::MatrixXd B = rhs_;
 
   // Constraints between vertices not coupled by L^T L (not face-adjacent) extend the pattern.
@@ -175,7 +233,7 @@ MatrixX3d LaplacianDeformer::solve(const std::vector<LinearConstraint>& constrai
   for (const ActiveTerms& t : terms)
     for (int k = 0; k < t.count; ++k)
       for (int l = 0; l < t.count; ++l) {
-        const int r = perm_[t.vertex[k]], s = perm_[t.vertex[l]];
+        const int r = perm[t.vertex[k]], s = perm[t.vertex[l]];
         if (r <= s && entry_index(A, r, s) < 0) extra.emplace_back(r, s, 0.0);
       }
   if (!extra.empty()) {
@@ -190,10 +248,10 @@ MatrixX3d LaplacianDeformer::solve(const std::vector<LinearConstraint>& constrai
   for (size_t c = 0; c < constraints.size(); ++c) {
     const ActiveTerms& t = terms[c];
     for (int k = 0; k < t.count; ++k) {
-      const int r = perm_[t.vertex[k]];
+      const int r = perm[t.vertex[k]];
       B.row(r) += (mu * t.weight[k]) * constraints[c].target.transpose();
       for (int l = 0; l < t.count; ++l) {
-        const int s = perm_[t.vertex[l]];
+        const int s = perm[t.vertex[l]];
         if (r > s) continue;  // upper triangle; r == s is reached from both orders
         const Eigen::Index e = entry_index(A, r, s);
         MQ_ASSERT(e >= 0);
@@ -205,8 +263,8 @@ MatrixX3d LaplacianDeformer::solve(const std::vector<LinearConstraint>& constrai
   // Components without constraints are excluded: identity rows pin them to their positions.
   // L^T L couples only vertices of one component, so zeroing their columns clears them fully.
   for (int i = 0; i < n; ++i) {
-    if (constrained[component_[i]]) continue;
-    const int col = perm_[i];
+    if (constrained[component[i]]) continue;
+    const int col = perm[i];
     for (Eigen::Index e = A.outerIndexPtr()[col]; e < A.outerIndexPtr()[col + 1]; ++e)
       values[e] = A.innerIndexPtr()[e] == col ? 1.0 : 0.0;
     B.row(col) = V_.row(i);
@@ -225,8 +283,8 @@ MatrixX3d LaplacianDeformer::solve(const std::vector<LinearConstraint>& constrai
 
   MatrixX3d W(n, 3);
   for (int i = 0; i < n; ++i) {
-    if (constrained[component_[i]])
-      W.row(i) = X.row(perm_[i]);
+    if (constrained[component[i]])
+      W.row(i) = X.row(perm[i]);
     else
       W.row(i) = V_.row(i);
   }
@@ -240,7 +298,8 @@ MatrixX3d deform_element(const MatrixX3d& V, const MatrixX3i& F,
 }
 
 std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
-                                       const DeformationOptions& options) {
+                                       const DeformationOptions& options,
+                                       const LaplacianTopologyCache* topologies) {
   for (size_t j = 0; j < jobs.size(); ++j)
     MQ_CHECK(jobs[j].V && jobs[j].F, InvalidInput, "deformation job ", j,
              " has no vertices or faces");
@@ -250,7 +309,13 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
       tbb::blocked_range<size_t>(0, jobs.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t j = range.begin(); j != range.end(); ++j) {
           try {
-            results[j] = deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options);
+            std::shared_ptr<const LaplacianTopology> known =
+                topologies ? topologies->find(*jobs[j].F, static_cast<int>(jobs[j].V->rows()))
+                           : nullptr;
+            results[j] = known
+                             ? LaplacianDeformer(std::move(known), *jobs[j].V, options)
+                                   .solve(jobs[j].constraints)
+                             : deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options);
           } catch (...) {
             errors[j] = std::current_exception();
           }

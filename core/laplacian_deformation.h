@@ -4,6 +4,9 @@
 
 #include <Eigen/Sparse>
 #include <array>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "core/linear_constraint.h"
@@ -25,16 +28,65 @@ struct DeformationOptions {
 // Throws InvalidInput for a negative num_vertices or an index out of range.
 Eigen::SparseMatrix<double> uniform_laplacian(const MatrixX3i& F, int num_vertices);
 
+// The part of the deformation precompute that depends only on the faces: L, the vertex
+// components, a fill-reducing ordering of the pattern of L^T L and that matrix permuted. Every
+// copy of a swatch element (translated, bent, in another patch) shares it.
+class LaplacianTopology {
+ public:
+  //   F             #F by 3 vertex indices in [0, num_vertices)
+  // Throws InvalidInput for a negative num_vertices or an index out of range.
+  LaplacianTopology(const MatrixX3i& F, int num_vertices);
+
+  int num_vertices() const { return static_cast<int>(L_.rows()); }
+  const MatrixX3i& faces() const { return F_; }
+  const Eigen::SparseMatrix<double>& laplacian() const { return L_; }
+  int num_components() const { return num_components_; }
+  const std::vector<int>& vertex_components() const { return component_; }
+  // Vertex i is unknown permutation()[i] of the permuted system.
+  const std::vector<int>& permutation() const { return perm_; }
+  // P (L^T L) P^T, upper triangle, with every diagonal entry stored.
+  const Eigen::SparseMatrix<double>& permuted_normal_matrix() const { return system_; }
+
+ private:
+  MatrixX3i F_;
+  Eigen::SparseMatrix<double> L_;
+  std::vector<int> component_;
+  int num_components_ = 0;
+  std::vector<int> perm_;
+  Eigen::SparseMatrix<double> system_;
+};
+
+// Topologies of elements known in advance (a swatch's), looked up by their faces so that the
+// copies of an element skip the ordering and the products. Filled before use, then read-only:
+// find() is thread-safe.
+class LaplacianTopologyCache {
+ public:
+  // Adds the topology of F (#F by 3) over num_vertices vertices, unless an equal one is held.
+  // Throws like LaplacianTopology.
+  void add(const MatrixX3i& F, int num_vertices);
+  // The held topology with exactly these faces and vertex count, or null.
+  std::shared_ptr<const LaplacianTopology> find(const MatrixX3i& F, int num_vertices) const;
+  std::size_t size() const { return size_; }
+
+ private:
+  std::unordered_map<std::uint64_t, std::vector<std::shared_ptr<const LaplacianTopology>>> by_hash_;
+  std::size_t size_ = 0;
+};
+
 // Precompute-then-query form of deform_element for an element deformed repeatedly with different
-// constraint sets. Keeps L, delta = L V, L^T delta, the vertex components and a fill-reducing
-// ordering of the pattern of L^T L, so that each solve only fills values and factorises.
-// Each solve() is const and thread-safe.
+// constraint sets. Keeps the topology (above), delta = L V and L^T delta, so that each solve only
+// fills values and factorises. Each solve() is const and thread-safe.
 class LaplacianDeformer {
  public:
   //   V  #V by 3 rest positions (finite)
   //   F  #F by 3 vertex indices in [0, #V)
   // Throws InvalidInput for a non-finite position, an index out of range, or mu not > 0.
   LaplacianDeformer(const MatrixX3d& V, const MatrixX3i& F, const DeformationOptions& options = {});
+  // The same with a precomputed topology of the element's faces (topology->num_vertices() rows
+  // in V); bitwise the same solves. Throws InvalidInput for a null topology, a row count that
+  // differs, a non-finite position or mu not > 0.
+  LaplacianDeformer(std::shared_ptr<const LaplacianTopology> topology, const MatrixX3d& V,
+                    const DeformationOptions& options = {});
 
   // Minimises sum_i |L(w_i) - L(v_i)|^2 + mu sum_c |sum_k a_k w_{c,k} - target_c|^2 (Eqs. (5),
   // (6)) with the original, untransformed Laplacian coordinates, as the paper does. Connected
@@ -47,24 +99,22 @@ class LaplacianDeformer {
   MatrixX3d solve(const std::vector<LinearConstraint>& constraints) const;
 
   int num_vertices() const { return static_cast<int>(V_.rows()); }
-  int num_components() const { return num_components_; }
+  int num_components() const { return topology_->num_components(); }
   // Connected component of each vertex (through the edges of F), #V.
-  const std::vector<int>& vertex_components() const { return component_; }
-  const Eigen::SparseMatrix<double>& laplacian() const { return L_; }
+  const std::vector<int>& vertex_components() const { return topology_->vertex_components(); }
+  const Eigen::SparseMatrix<double>& laplacian() const { return topology_->laplacian(); }
   // Laplacian coordinates delta = L V of the rest positions, #V by 3.
   const MatrixX3d& laplacian_coordinates() const { return delta_; }
   const DeformationOptions& options() const { return options_; }
 
  private:
+  void init_values();
+
+  std::shared_ptr<const LaplacianTopology> topology_;
   MatrixX3d V_;
   DeformationOptions options_;
-  Eigen::SparseMatrix<double> L_;
   MatrixX3d delta_;
   Eigen::MatrixXd rhs_;  // P L^T delta, permuted, #V by 3
-  std::vector<int> component_;
-  int num_components_ = 0;
-  std::vector<int> perm_;               // vertex i is unknown perm_[i] of the permuted system
-  Eigen::SparseMatrix<double> system_;  // P (L^T L) P^T, upper triangle, with a full diagonal
 };
 
 // One-off form: LaplacianDeformer(V, F, options).solve(constraints). Same contract.
@@ -81,10 +131,12 @@ struct DeformationJob {
 
 // Deforms independent elements in parallel with oneTBB (the per-element loop of section 2.6).
 // Result j is exactly deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options),
-// whatever the thread count. Throws InvalidInput for a null V or F, and otherwise the exception
-// of the lowest-index failing job.
+// whatever the thread count; jobs whose faces are in `topologies` (optional) reuse them.
+// Throws InvalidInput for a null V or F, and otherwise the exception of the lowest-index
+// failing job.
 std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
-                                       const DeformationOptions& options = {});
+                                       const DeformationOptions& options = {},
+                                       const LaplacianTopologyCache* topologies = nullptr);
 
 }  // namespace mq
 

@@ -47,9 +47,15 @@ void accumulate(PatchCounts& a, const PatchCounts& b) {
   for (int k = 0; k < kStitchFailureKinds; ++k) a.stitch_failures[k] += b.stitch_failures[k];
 }
 
-void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
-                 const SwatchFaceTree& swatch_faces, const EmbreeDevice& embree, const Vector3d& t,
-                 const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
+LaplacianTopologyCache swatch_topologies(const PreparedSwatch& swatch) {
+  LaplacianTopologyCache cache;
+  for (const Element& e : swatch.elements) cache.add(e.F, static_cast<int>(e.V.rows()));
+  return cache;
+}
+
+void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const SwatchQueries& queries,
+                 const Vector3d& t, const OverlapRegion& region,
+                 const std::function<bool(const Element&)>& admissible,
                  const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
                  std::vector<int>* rejected) {
   if (rejected) rejected->clear();
@@ -72,8 +78,8 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
       frame.push_back(output.element(near[k]));
       local[k] = static_cast<int>(k);
     }
-    corr =
-        find_correspondences(frame, local, region, swatch, swatch_faces, t, options.correspondence);
+    corr = find_correspondences(frame, local, region, swatch, queries.faces, t,
+                                options.correspondence);
     counts.pairs += static_cast<long long>(corr.pairs.size());
     counts.relations += static_cast<long long>(corr.relations.size());
   }
@@ -147,7 +153,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
       }
       DeformationOptions d;
       d.mu = options.merging.mu;
-      std::vector<MatrixX3d> solved = deform_elements(jobs, d);
+      std::vector<MatrixX3d> solved = deform_elements(jobs, d, &queries.laplacians);
       for (size_t j = 0; j < solved.size(); ++j) {
         const auto [is_out, k] = owners[j];
         Element& e = is_out ? deformed_out[k] : moved[k];
@@ -213,7 +219,8 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     const Element& base = current(k);
     // The same element placed twice (nearly identical, or mostly the same footprint, as for two
     // apples slightly apart): keep the output one rather than stitching two halves.
-    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge, &embree) ||
+    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge,
+                          &queries.embree) ||
         footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
       ++counts.matched;
       busy[k] = 1;
@@ -221,7 +228,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
     }
     StitchFailure why = StitchFailure::None;
     std::optional<Element> joined =
-        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &embree);
+        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &queries.embree);
     std::vector<int> ignore = replaced_ids;
     ignore.push_back(near[k]);
     if (joined && fits(output, *joined, ignore)) {

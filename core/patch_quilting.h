@@ -11,6 +11,7 @@
 #include "core/element_correspondence.h"
 #include "core/element_merging.h"
 #include "core/embree_device.h"
+#include "core/laplacian_deformation.h"
 #include "core/stage_timer.h"
 
 namespace mq {
@@ -48,16 +49,24 @@ struct PatchCounts {
   std::array<int, kStitchFailureKinds> stitch_failures{};  // fallbacks by StitchFailure
 };
 
+// What quilt_patch needs besides the swatch's elements, built once per run (borrowed).
+struct SwatchQueries {
+  const SwatchFaceTree& faces;               // over swatch.mesh in the swatch frame (matching's)
+  const EmbreeDevice& embree;                // for the merging's temporary BVHs
+  const LaplacianTopologyCache& laplacians;  // the swatch elements' (swatch_topologies)
+};
+
+// The Laplacian topologies of the swatch's elements, shared by all their copies.
+LaplacianTopologyCache swatch_topologies(const PreparedSwatch& swatch);
+
 // Merges the swatch placed at translation t into `output`. `admissible(e)` says whether a swatch
 // element may enter the output at all (e.g. lies at least partly in the domain). Elements are
 // only ever added or changed so that no two of them intersect. Times go to the stages
 // "correspondence", "deformation" and "merging". `rejected`, when given, receives the indices
 // of the swatch elements that could not enter: not admissible, or intersecting the output.
-//   swatch_faces   face tree over swatch.mesh in the swatch frame (the matching's)
-//   embree         the device the merging's temporary BVHs are built on
-void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch,
-                 const SwatchFaceTree& swatch_faces, const EmbreeDevice& embree, const Vector3d& t,
-                 const OverlapRegion& region, const std::function<bool(const Element&)>& admissible,
+void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const SwatchQueries& queries,
+                 const Vector3d& t, const OverlapRegion& region,
+                 const std::function<bool(const Element&)>& admissible,
                  const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
                  std::vector<int>* rejected = nullptr);
 

@@ -145,10 +145,13 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
 
   std::unique_ptr<SwatchFaceTree> swatch_tree;
   const EmbreeDevice embree;  // for the merging's temporary BVHs
+  LaplacianTopologyCache laplacians;
   {
     ScopedStageTimer timer(times, "prepare");
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
+    laplacians = swatch_topologies(swatch);
   }
+  const SwatchQueries queries{*swatch_tree, embree, laplacians};
   OutputStore output(grid);
   std::mt19937_64 rng(options.seed);
 
@@ -212,8 +215,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
 
     // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
-    quilt_patch(output, swatch, *swatch_tree, embree, t, region, in_domain, patch_options,
-                stats.counts, times);
+    quilt_patch(output, swatch, queries, t, region, in_domain, patch_options, stats.counts, times);
     mark_patch(patch_lo, patch_hi);
     grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
     report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());

@@ -378,6 +378,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   MatrixX3d field;
   std::unique_ptr<SwatchFaceTree> swatch_tree;
   const EmbreeDevice embree;  // one device for every BVH of the run
+  LaplacianTopologyCache laplacians;
   EdgeTopology topo;
   MatrixX3i TT;
   {
@@ -390,6 +391,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     swatch = prepare_swatch(scaled);
     stats.swatch_scale = factor;
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
+    laplacians = swatch_topologies(swatch);
     field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
     topo = edge_topology(base.F, base.num_vertices());
     TT = face_adjacency(topo);
@@ -544,8 +546,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     };
     PatchCounts counts;
     std::vector<int> rejected;
-    quilt_patch(framed, swatch, *swatch_tree, embree, t, region, admissible, options.patch, counts,
-                times, &rejected);
+    quilt_patch(framed, swatch, SwatchQueries{*swatch_tree, embree, laplacians}, t, region,
+                admissible, options.patch, counts, times, &rejected);
     accumulate(stats.counts, counts);
     stats.rejected_outside_patch += outside;
 

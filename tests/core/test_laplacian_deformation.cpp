@@ -417,6 +417,61 @@ TEST(LaplacianDeformation, ParallelJobsMatchSerialAndAreThreadCountIndependent) 
   EXPECT_THROW(deform_elements(jobs), InvalidInput);
 }
 
+// A topology shared between copies of an element (other positions, other constraints) gives
+// bitwise the solves of a deformer built from scratch; the cache finds a topology only for
+// exactly the same faces and vertex count; deform_elements with the cache matches without.
+TEST(LaplacianDeformation, SharedTopologyGivesTheSameSolves) {
+  const std::vector<TriMesh> rings = load_rings(2);
+  ASSERT_EQ(rings.size(), 2u);
+  const TriMesh torus = test::torus(2.0, 0.5, 20, 10);
+  LaplacianTopologyCache cache;
+  cache.add(rings[0].F, rings[0].num_vertices());
+  cache.add(torus.F, torus.num_vertices());
+  cache.add(torus.F, torus.num_vertices());  // held once
+  EXPECT_EQ(cache.size(), 2u);
+  ASSERT_TRUE(cache.find(torus.F, torus.num_vertices()));
+  EXPECT_FALSE(cache.find(torus.F, torus.num_vertices() + 1));
+  MatrixX3i flipped = torus.F;
+  std::swap(flipped(3, 0), flipped(3, 1));
+  EXPECT_FALSE(cache.find(flipped, torus.num_vertices()));
+
+  std::mt19937_64 rng(99);
+  std::vector<MatrixX3d> positions;
+  std::vector<DeformationJob> jobs;
+  // Copies of the torus moved and bent, and ring 1, whose topology is not cached.
+  for (int j = 0; j < 6; ++j) {
+    const TriMesh& m = j < 4 ? torus : rings[1];
+    MatrixX3d V = m.V;
+    V.rowwise() += Eigen::RowVector3d(3.0 * j, -1.0, 0.5);
+    if (j % 2) V.col(2) += 0.1 * V.col(0).array().sin().matrix();
+    positions.push_back(V);
+  }
+  for (int j = 0; j < 6; ++j) {
+    const TriMesh& m = j < 4 ? torus : rings[1];
+    DeformationJob job{&positions[static_cast<size_t>(j)], &m.F, {}};
+    const double h = mean_edge_length(m.V, m.F);
+    for (int c = 0; c < 20; ++c) {
+      const int v = static_cast<int>(rng() % m.num_vertices());
+      job.constraints.push_back(LinearConstraint::point(
+          v, positions[static_cast<size_t>(j)].row(v).transpose() + 0.3 * h * random_vector(rng)));
+    }
+    jobs.push_back(std::move(job));
+  }
+  const auto shared = cache.find(torus.F, torus.num_vertices());
+  for (int j = 0; j < 4; ++j) {
+    const MatrixX3d fresh = deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints);
+    const MatrixX3d reused = LaplacianDeformer(shared, *jobs[j].V).solve(jobs[j].constraints);
+    EXPECT_EQ((fresh - reused).cwiseAbs().maxCoeff(), 0.0) << "copy " << j;
+    EXPECT_GT((fresh - *jobs[j].V).cwiseAbs().maxCoeff(), 0.0) << "copy " << j;
+  }
+  const std::vector<MatrixX3d> without = deform_elements(jobs),
+                               with = deform_elements(jobs, {}, &cache);
+  for (size_t j = 0; j < jobs.size(); ++j)
+    EXPECT_EQ((without[j] - with[j]).cwiseAbs().maxCoeff(), 0.0) << "job " << j;
+  EXPECT_THROW(LaplacianDeformer(shared, rings[1].V), InvalidInput);  // other vertex count
+  EXPECT_THROW(LaplacianDeformer(nullptr, torus.V), InvalidInput);
+}
+
 TEST(LaplacianDeformation, InvalidInputThrows) {
   const TriMesh m = test::torus(2.0, 0.5, 8, 6);
   const int n = m.num_vertices();
