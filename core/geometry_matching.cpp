@@ -193,12 +193,20 @@ OffsetChoice choose_offset(const SwatchFaceTree& swatch, TranslationCostEvaluato
     for (int i = 0; i < options.screen_keep; ++i)
       finalists.row(i) = candidates.row(order[static_cast<size_t>(i)]);
   }
-  problem.points = P;
-  problem.point_normals = NP;
+  // The finalists are scored on the points the refinement polishes with: the offset it returns
+  // minimises that subset's cost, so the start is chosen by the same measure. Without
+  // refinement, on every point.
+  const bool refine = options.refine_to > 0;
+  if (refine && P.rows() > options.refine_points) {
+    strided_subset(P, NP, options.refine_points, problem.points, problem.point_normals);
+  } else {
+    problem.points = P;
+    problem.point_normals = NP;
+  }
   problem.offsets = finalists;
   const Eigen::VectorXd costs = evaluator.evaluate(swatch, problem);
   choice.evaluations += static_cast<int>(costs.size());
-  choice.point_offsets += static_cast<long long>(costs.size()) * P.rows();
+  choice.point_offsets += static_cast<long long>(costs.size()) * problem.points.rows();
   int best = best_offset(costs);
   if (options.epsilon > 0) {
     std::vector<int> near;
@@ -208,17 +216,15 @@ OffsetChoice choose_offset(const SwatchFaceTree& swatch, TranslationCostEvaluato
   }
   Vector3d t = finalists.row(best).transpose();
   double cost = costs(best);
-  if (options.refine_to > 0) {
-    // The refinement only polishes a placement already chosen exactly among whole cells, so it
-    // matches a fixed, evenly strided subset of the sub-patch.
-    MatrixX3d Ps = P, Ns = NP;
-    if (P.rows() > options.refine_points) strided_subset(P, NP, options.refine_points, Ps, Ns);
-    const RefinedOffset refined =
-        refine_offset(swatch, Ps, Ns, t, t_min, t_max.cwiseMax(t_min), cell_size, options);
+  if (refine) {
+    // The refinement only polishes a placement already chosen among whole cells, so it matches
+    // the fixed, evenly strided subset of the sub-patch the finalists were scored on.
+    const RefinedOffset refined = refine_offset(swatch, problem.points, problem.point_normals, t,
+                                                t_min, t_max.cwiseMax(t_min), cell_size, options);
     t = refined.offset;
     cost = refined.cost;  // on the refinement subset
     choice.evaluations += refined.evaluations;
-    choice.point_offsets += static_cast<long long>(refined.evaluations) * Ps.rows();
+    choice.point_offsets += static_cast<long long>(refined.evaluations) * problem.points.rows();
   }
   choice.offset = t;
   choice.cost = cost;  // on the refinement subset when it was used

@@ -233,40 +233,54 @@ TEST(GeometryMatching, EdgeCases) {
 namespace mq {
 namespace {
 
+// A sub-patch taken from an apple layer itself, mirrored and shifted: close to the swatch,
+// never on it; 25 whole-cell candidates around zero.
+struct MirroredApples {
+  TriMesh swatch;
+  MatrixX3d P, NP, T;
+  double cell = 0;
+  MirroredApples() {
+    AppleOptions apples;
+    apples.count = 9;
+    swatch = apple_layer(apples);
+    const BoundingBox box = bounding_box(swatch.V, swatch.F);
+    const Vector3d mid = 0.5 * (box.min + box.max);
+    const MatrixX3d FN = face_normals(swatch.V, swatch.F);
+    std::vector<Vector3d> points, normals;
+    for (int f = 0; f < swatch.num_faces(); f += 3) {
+      Vector3d c = (swatch.V.row(swatch.F(f, 0)) + swatch.V.row(swatch.F(f, 1)) +
+                    swatch.V.row(swatch.F(f, 2)))
+                       .transpose() /
+                   3.0;
+      if ((c - mid).head<2>().norm() > 0.3 * (box.max - box.min).head<2>().norm()) continue;
+      c.x() = 2 * mid.x() - c.x();
+      points.push_back(c + Vector3d(0.13, -0.07, 0));
+      normals.push_back(Vector3d(-FN(f, 0), FN(f, 1), FN(f, 2)));
+    }
+    P.resize(static_cast<Eigen::Index>(points.size()), 3);
+    NP.resize(P.rows(), 3);
+    for (size_t i = 0; i < points.size(); ++i) {
+      P.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+      NP.row(static_cast<Eigen::Index>(i)) = normals[i].transpose();
+    }
+    cell = 0.25 * (box.max - box.min).head<2>().minCoeff();
+    T.resize(25, 3);
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 5; ++i) T.row(j * 5 + i) << (i - 2) * cell, (j - 2) * cell, 0.0;
+  }
+};
+
 // The sub-cell refinement reports the exact Eq. (3) cost of the offset it returns, and that
 // cost is never above the cost of the whole-cell offset it started from (each accepted
 // majorize-minimize round lowers the exact cost), on a swatch with no exact match.
 TEST(GeometryMatching, RefinementLowersTheExactCost) {
-  AppleOptions apples;
-  apples.count = 9;
-  const TriMesh swatch = apple_layer(apples);
+  const MirroredApples fx;
+  const TriMesh& swatch = fx.swatch;
+  const MatrixX3d &P = fx.P, &NP = fx.NP, &T = fx.T;
+  const double cell = fx.cell;
+  ASSERT_GT(P.rows(), 20);
   const SwatchFaceTree tree(swatch.V, swatch.F);
   TranslationCostCpu cpu;
-  // A sub-patch from the swatch itself, mirrored and shifted: close to it, never on it.
-  const BoundingBox box = bounding_box(swatch.V, swatch.F);
-  const Vector3d mid = 0.5 * (box.min + box.max);
-  const MatrixX3d FN = face_normals(swatch.V, swatch.F);
-  std::vector<Vector3d> points, normals;
-  for (int f = 0; f < swatch.num_faces(); f += 3) {
-    Vector3d c =
-        (swatch.V.row(swatch.F(f, 0)) + swatch.V.row(swatch.F(f, 1)) + swatch.V.row(swatch.F(f, 2)))
-            .transpose() /
-        3.0;
-    if ((c - mid).head<2>().norm() > 0.3 * (box.max - box.min).head<2>().norm()) continue;
-    c.x() = 2 * mid.x() - c.x();
-    points.push_back(c + Vector3d(0.13, -0.07, 0));
-    normals.push_back(Vector3d(-FN(f, 0), FN(f, 1), FN(f, 2)));
-  }
-  ASSERT_GT(points.size(), 20u);
-  MatrixX3d P(static_cast<Eigen::Index>(points.size()), 3), NP(P.rows(), 3);
-  for (size_t i = 0; i < points.size(); ++i) {
-    P.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
-    NP.row(static_cast<Eigen::Index>(i)) = normals[i].transpose();
-  }
-  const double cell = 0.25 * (box.max - box.min).head<2>().minCoeff();
-  MatrixX3d T(25, 3);
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < 5; ++i) T.row(j * 5 + i) << (i - 2) * cell, (j - 2) * cell, 0.0;
   MatchingOptions options;
   options.lambda = 1.0 / cell;
   options.refine_points = P.rows();  // refine on every point, so the costs are comparable
@@ -294,6 +308,50 @@ TEST(GeometryMatching, RefinementLowersTheExactCost) {
     EXPECT_GE(refined.offset(k), lo(k));
     EXPECT_LE(refined.offset(k), hi(k));
   }
+}
+
+// When refining, the finalists are scored on the refinement's strided subset: choosing with
+// all the points equals choosing with that subset alone, and the reported cost is the subset's
+// exact Eq. (3) cost at the returned offset.
+TEST(GeometryMatching, FinalistsAreScoredOnTheRefinementSubset) {
+  const MirroredApples fx;
+  ASSERT_GT(fx.P.rows(), 40);
+  const SwatchFaceTree tree(fx.swatch.V, fx.swatch.F);
+  TranslationCostCpu cpu;
+  MatchingOptions options;
+  options.lambda = 1.0 / fx.cell;
+  options.refine_points = 16;
+  options.screen_keep = 0;  // every candidate is a finalist
+  const Eigen::Index n = options.refine_points;
+  MatrixX3d Ps(n, 3), Ns(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Ps.row(i) = fx.P.row(i * fx.P.rows() / n);
+    Ns.row(i) = fx.NP.row(i * fx.P.rows() / n);
+  }
+  std::mt19937_64 rng(1);
+  const Vector2d lo(-2 * fx.cell, -2 * fx.cell), hi(2 * fx.cell, 2 * fx.cell);
+  const OffsetChoice all =
+      choose_offset(tree, cpu, fx.P, fx.NP, fx.T, lo, hi, fx.cell, options, rng);
+  const OffsetChoice subset = choose_offset(tree, cpu, Ps, Ns, fx.T, lo, hi, fx.cell, options, rng);
+  EXPECT_EQ(all.offset, subset.offset);
+  EXPECT_EQ(all.cost, subset.cost);
+  EXPECT_EQ(all.point_offsets, subset.point_offsets);  // no evaluation used the other points
+  TranslationCostProblem problem;
+  problem.points = Ps;
+  problem.point_normals = Ns;
+  problem.lambda = options.lambda;
+  problem.offsets = all.offset.transpose();
+  const Eigen::VectorXd E = translation_cost_brute_force(fx.swatch.V, fx.swatch.F, problem);
+  EXPECT_NEAR(all.cost, E(0), 1e-9 * E(0));
+  // Without refinement every point counts: the reported cost is the all-points cost.
+  options.refine_to = 0;
+  const OffsetChoice whole =
+      choose_offset(tree, cpu, fx.P, fx.NP, fx.T, lo, hi, fx.cell, options, rng);
+  problem.points = fx.P;
+  problem.point_normals = fx.NP;
+  problem.offsets = whole.offset.transpose();
+  const Eigen::VectorXd W = translation_cost_brute_force(fx.swatch.V, fx.swatch.F, problem);
+  EXPECT_NEAR(whole.cost, W(0), 1e-9 * W(0));
 }
 
 }  // namespace
