@@ -104,9 +104,10 @@ struct RefinedOffset {
 // (four axis moves, halving the step from half a cell down to refine_to cells) on the cost
 // with the assignments frozen, which needs point-triangle distances only. The frozen cost
 // bounds the true one from above, so every accepted round lowers the exact E; rounds stop
-// when the compass finds no better frozen placement or the exact cost stops falling. About
-// one exact evaluation per round instead of four per compass step. It queries the tree on the
-// host whatever the evaluator: a round scores ~128 points, too few to pay for a kernel launch.
+// when the compass finds no better frozen placement or a round lowers the exact cost by less
+// than the relative refine_tolerance (it is then kept). About one exact evaluation per round
+// instead of four per compass step. It queries the tree on the host whatever the evaluator: a
+// round scores ~128 points, too few to pay for a kernel launch.
 RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, const MatrixX3d& NP,
                             Vector3d t, const Vector2d& lo, const Vector2d& hi, double cell_size,
                             const MatchingOptions& options) {
@@ -149,9 +150,11 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
     const double moved = assigned_cost(swatch, P, NP, u, options.lambda, next_entry);
     ++result.evaluations;
     if (!(moved < cost * (1 - 1e-9))) break;
+    const bool converged = moved > cost * (1 - options.refine_tolerance);
     t = u;
     cost = moved;
     entry.swap(next_entry);
+    if (converged) break;
   }
   result.offset = t;
   result.cost = cost;
