@@ -61,7 +61,8 @@ int run_plane(int argc, char** argv, int first) {
   cl.option("cell", "SIZE", "grid cell size (default: from the swatch's element size)");
   cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
   cl.option("subpatch", "FRACTION", "sub-patch side as a fraction of the swatch side", "0.5");
-  cl.option("device", "auto|cpu|opencl", "where the translation cost runs", "auto");
+  cl.option("device", "auto|cpu|opencl",
+            "where large translation-cost evaluations run (small ones stay on the CPU)", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
   cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
   add_run_options(cl);

@@ -90,7 +90,8 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("keys", "FILE", "guidance: 'vertex x y z' key vectors diffused over the surface");
   cl.option("seed", "N", "random seed (used with --variety)", "1");
   cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
-  cl.option("device", "auto|cpu|opencl", "where the translation cost runs", "auto");
+  cl.option("device", "auto|cpu|opencl",
+            "where large translation-cost evaluations run (small ones stay on the CPU)", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
   cl.flag("no-stretch-opt", "skip the shell map's stretch minimisation (on by default)");
   cl.option("embedding", "shell|normal",
