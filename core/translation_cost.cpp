@@ -165,6 +165,15 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
     entry_spheres_[4 * j + 3] = r * (1 + 1e-12) + 1e-12 * scale;
   }
 
+  normal_x_.resize(static_cast<std::size_t>(nf));
+  normal_y_.resize(static_cast<std::size_t>(nf));
+  normal_z_.resize(static_cast<std::size_t>(nf));
+  for (std::size_t j = 0; j < static_cast<std::size_t>(nf); ++j) {
+    normal_x_[j] = entry_normals_[4 * j];
+    normal_y_[j] = entry_normals_[4 * j + 1];
+    normal_z_[j] = entry_normals_[4 * j + 2];
+  }
+
   std::uint64_t fp = 14695981039346656037ull;
   fnv1a(fp, &slack_, sizeof(double));
   fnv1a(fp, node_links_.data(), sizeof(int) * node_links_.size());
@@ -237,25 +246,51 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
       // |n - n_f| >= best / df - 1 (updated whenever best improves).
       double r = best / df - 1.0;
       double r2 = r * r * (1.0 + 1e-12);
-      for (int j = j0; j < j1; ++j) {
-        const double* fn = &entry_normals_[4 * static_cast<std::size_t>(j)];
-        const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
-        const double dn2 = nx * nx + ny * ny + nz * nz;
-        if (dn2 >= r2) continue;
-        const double nfac = 1.0 + std::sqrt(dn2);
-        const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
-        const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
-        const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp4[3];
-        if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best || sphere_lb - slack > cap)
-          continue;
-        const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
-        const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
-        if (cost < best && dist2 <= max_dist2) {
-          best = cost;
-          if (entry) *entry = j;
-          update_reach();
-          r = best / df - 1.0;
-          r2 = r * r * (1.0 + 1e-12);
+      // Blocks of kBlock entries (most fail the normal bound: on the apples ~316 entries are
+      // scanned per query and ~14 reach a distance): a branch-free pass computes the block's
+      // normal distances from per-coordinate arrays (vectorised) and lists the entries within
+      // the bound as it stands; only those are visited, and since the bound only tightens the
+      // visit re-tests it, so exactly the entries of a one-by-one scan are examined. On
+      // recorded queries of plane + apple / the ivy wall, 2.41 -> 2.15 / 1.47 -> 1.33 us.
+      constexpr int kBlock = 16;
+      for (int b0 = j0; b0 < j1; b0 += kBlock) {
+        const int bn = std::min(kBlock, j1 - b0);
+        const double* bx = &normal_x_[static_cast<std::size_t>(b0)];
+        const double* by = &normal_y_[static_cast<std::size_t>(b0)];
+        const double* bz = &normal_z_[static_cast<std::size_t>(b0)];
+        const double n0 = n(0), n1 = n(1), n2 = n(2);
+        double block_dn2[kBlock];
+        for (int k = 0; k < bn; ++k) {
+          const double nx = n0 - bx[k], ny = n1 - by[k], nz = n2 - bz[k];
+          block_dn2[k] = nx * nx + ny * ny + nz * nz;
+        }
+        int within[kBlock];
+        int count = 0;
+        for (int k = 0; k < bn; ++k) {
+          within[count] = k;
+          count += block_dn2[k] < r2 ? 1 : 0;
+        }
+        for (int m = 0; m < count; ++m) {
+          const int k = within[m];
+          const double dn2 = block_dn2[k];
+          if (dn2 >= r2) continue;
+          const int j = b0 + k;
+          const double nfac = 1.0 + std::sqrt(dn2);
+          const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
+          const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
+          const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp4[3];
+          if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best || sphere_lb - slack > cap)
+            continue;
+          const double dist2 =
+              triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
+          const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
+          if (cost < best && dist2 <= max_dist2) {
+            best = cost;
+            if (entry) *entry = j;
+            update_reach();
+            r = best / df - 1.0;
+            r2 = r * r * (1.0 + 1e-12);
+          }
         }
       }
       continue;

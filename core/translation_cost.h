@@ -106,6 +106,9 @@ class SwatchFaceTree {
   std::vector<double> entry_triangles_;
   std::vector<double> entry_normals_;
   std::vector<double> entry_spheres_;
+  // The entries' unit normals again, one array per coordinate: the leaf scan's first pass
+  // tests a block of them at once.
+  std::vector<double> normal_x_, normal_y_, normal_z_;
   std::uint64_t fingerprint_ = 0;
 };
 
