@@ -61,34 +61,48 @@ void strided_subset(const MatrixX3d& P, const MatrixX3d& NP, Eigen::Index n, Mat
   }
 }
 
-// E(t) of Eq. (3) on the points P (normals NP) with, per point, the swatch entry attaining its
-// minimum. Points in parallel; the sum in point order (deterministic).
+// Each point's swatch entry attaining its minimum (-1 when none), with that entry's normal
+// factor, which stays fixed while the point moves with t.
+struct Assignment {
+  std::vector<int> entry;
+  std::vector<double> normal_factor;
+};
+
+// E(t) of Eq. (3) on the points P (normals NP), recording the assignment. Points in parallel;
+// the sum in point order (deterministic).
 double assigned_cost(const SwatchFaceTree& swatch, const MatrixX3d& P, const MatrixX3d& NP,
-                     const Vector3d& t, double lambda, std::vector<int>& entry) {
+                     const Vector3d& t, double lambda, Assignment& assignment) {
   const Eigen::Index n = P.rows();
-  entry.assign(static_cast<size_t>(n), -1);
+  assignment.entry.assign(static_cast<size_t>(n), -1);
+  assignment.normal_factor.assign(static_cast<size_t>(n), 0.0);
   std::vector<double> minima(static_cast<size_t>(n));
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 16),
-                    [&](const tbb::blocked_range<Eigen::Index>& r) {
-                      for (Eigen::Index i = r.begin(); i != r.end(); ++i)
-                        minima[static_cast<size_t>(i)] =
-                            swatch.min_face_cost(P.row(i).transpose() - t, NP.row(i).transpose(),
-                                                 lambda, &entry[static_cast<size_t>(i)]);
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<Eigen::Index>(0, n, 16), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
+          const size_t k = static_cast<size_t>(i);
+          minima[k] = swatch.min_face_cost(P.row(i).transpose() - t, NP.row(i).transpose(), lambda,
+                                           &assignment.entry[k]);
+          if (assignment.entry[k] >= 0)
+            assignment.normal_factor[k] =
+                swatch.entry_normal_factor(assignment.entry[k], NP.row(i).transpose());
+        }
+      });
   double sum = 0;
   for (const double m : minima) sum += m;
   return sum;
 }
 
 // The same sum with every point kept on its assigned entry: never below E(t + d), and equal
-// to it at d = 0, so lowering it lowers E (a majorize-minimize step).
-double surrogate_cost(const SwatchFaceTree& swatch, const MatrixX3d& P, const MatrixX3d& NP,
-                      const std::vector<int>& entry, const Vector3d& t, double lambda) {
+// to it at d = 0 (bitwise: entry_cost_with_factor repeats min_face_cost's arithmetic), so
+// lowering it lowers E (a majorize-minimize step).
+double surrogate_cost(const SwatchFaceTree& swatch, const MatrixX3d& P,
+                      const Assignment& assignment, const Vector3d& t, double lambda) {
   double sum = 0;
   for (Eigen::Index i = 0; i < P.rows(); ++i) {
-    if (entry[static_cast<size_t>(i)] < 0) return std::numeric_limits<double>::infinity();
-    sum += swatch.entry_cost(entry[static_cast<size_t>(i)], P.row(i).transpose() - t,
-                             NP.row(i).transpose(), lambda);
+    const size_t k = static_cast<size_t>(i);
+    if (assignment.entry[k] < 0) return std::numeric_limits<double>::infinity();
+    sum += swatch.entry_cost_with_factor(assignment.entry[k], P.row(i).transpose() - t,
+                                         assignment.normal_factor[k], lambda);
   }
   return sum;
 }
@@ -113,8 +127,8 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
                             const MatchingOptions& options) {
   constexpr int kMaxRounds = 32;  // a bound only: rounds strictly lower E
   RefinedOffset result;
-  std::vector<int> entry, next_entry;
-  double cost = assigned_cost(swatch, P, NP, t, options.lambda, entry);
+  Assignment assignment, next_assignment;
+  double cost = assigned_cost(swatch, P, NP, t, options.lambda, assignment);
   result.evaluations = 1;
   // Later rounds start with a step of twice the previous round's largest move: the faces
   // reassigned after a short move only shift the optimum by about that much.
@@ -130,7 +144,7 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
         Vector3d c = u + moves[k];
         c.x() = std::clamp(c.x(), lo.x(), hi.x());
         c.y() = std::clamp(c.y(), lo.y(), hi.y());
-        const double e = surrogate_cost(swatch, P, NP, entry, c, options.lambda);
+        const double e = surrogate_cost(swatch, P, assignment, c, options.lambda);
         if (e < best_cost) {
           best_cost = e;
           best_c = c;
@@ -147,13 +161,13 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
     if (u == t) break;
     const double moved_by = (u - t).cwiseAbs().maxCoeff();
     first_step = std::min(0.5 * cell_size, std::max(2.0 * moved_by, options.refine_to * cell_size));
-    const double moved = assigned_cost(swatch, P, NP, u, options.lambda, next_entry);
+    const double moved = assigned_cost(swatch, P, NP, u, options.lambda, next_assignment);
     ++result.evaluations;
     if (!(moved < cost * (1 - 1e-9))) break;
     const bool converged = moved > cost * (1 - options.refine_tolerance);
     t = u;
     cost = moved;
-    entry.swap(next_entry);
+    std::swap(assignment, next_assignment);
     if (converged) break;
   }
   result.offset = t;

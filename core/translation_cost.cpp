@@ -186,15 +186,23 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
   fingerprint_ = fp;
 }
 
+double SwatchFaceTree::entry_normal_factor(int entry, const Vector3d& n) const {
+  MQ_ASSERT(entry >= 0 && entry < num_faces());
+  const double* fn = &entry_normals_[4 * static_cast<std::size_t>(entry)];
+  const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
+  return 1.0 + std::sqrt(nx * nx + ny * ny + nz * nz);  // as in min_face_cost's leaf loop
+}
+
+double SwatchFaceTree::entry_cost_with_factor(int entry, const Vector3d& q, double normal_factor,
+                                              double lambda) const {
+  MQ_ASSERT(entry >= 0 && entry < num_faces());
+  const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(entry)]);
+  return (1.0 + lambda * std::sqrt(dist2)) * normal_factor;  // as in min_face_cost's leaf loop
+}
+
 double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& n,
                                   double lambda) const {
-  MQ_ASSERT(entry >= 0 && entry < num_faces());
-  const std::size_t j = static_cast<std::size_t>(entry);
-  const double* fn = &entry_normals_[4 * j];
-  const double nx = n(0) - fn[0], ny = n(1) - fn[1], nz = n(2) - fn[2];
-  const double nfac = 1.0 + std::sqrt(nx * nx + ny * ny + nz * nz);
-  const double dist2 = triangle_dist2(q, &entry_triangles_[9 * j]);
-  return (1.0 + lambda * std::sqrt(dist2)) * nfac;  // as in min_face_cost's leaf loop
+  return entry_cost_with_factor(entry, q, entry_normal_factor(entry, n), lambda);
 }
 
 double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,

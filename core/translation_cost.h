@@ -69,6 +69,13 @@ class SwatchFaceTree {
   // computes for it (so a sum of entry costs bounds a sum of minima exactly).
   // Precondition: 0 <= entry < num_faces() (InternalError otherwise).
   double entry_cost(int entry, const Vector3d& q, const Vector3d& n, double lambda) const;
+  // The two factors of entry_cost apart, for a point kept on one entry while q moves (the
+  // normal factor does not depend on q): entry_cost(entry, q, n, lambda) is bitwise
+  // entry_cost_with_factor(entry, q, entry_normal_factor(entry, n), lambda).
+  // Precondition: 0 <= entry < num_faces() (InternalError otherwise).
+  double entry_normal_factor(int entry, const Vector3d& n) const;
+  double entry_cost_with_factor(int entry, const Vector3d& q, double normal_factor,
+                                double lambda) const;
 
   int num_faces() const { return static_cast<int>(entry_faces_.size()); }
   int num_nodes() const { return static_cast<int>(node_links_.size() / 2); }

@@ -95,6 +95,8 @@ TEST(TranslationCost, TreeQueryReportsTheEntryAttainingTheMinimum) {
         ASSERT_GE(entry, 0);
         ASSERT_LT(entry, tree.num_faces());
         EXPECT_EQ(tree.entry_cost(entry, q, n, lambda), best);
+        EXPECT_EQ(tree.entry_cost_with_factor(entry, q, tree.entry_normal_factor(entry, n), lambda),
+                  best);
         const int f = tree.entry_faces()[static_cast<size_t>(entry)];
         const Vector3d a = torus.V.row(torus.F(f, 0)), b = torus.V.row(torus.F(f, 1)),
                        c = torus.V.row(torus.F(f, 2));
