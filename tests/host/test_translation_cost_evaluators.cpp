@@ -238,14 +238,34 @@ TEST(TranslationCostOpenCL, SmallProblemsStayOnTheHost) {
 
 TEST(TranslationCostFactory, ChoosesThePath) {
   EXPECT_EQ(make_translation_cost_evaluator(Device::Cpu)->name(), "cpu");
-  const auto automatic = make_translation_cost_evaluator(Device::Auto);
   if (cl::Runtime::available()) {
-    EXPECT_EQ(automatic->name(), "opencl");
     EXPECT_EQ(make_translation_cost_evaluator(Device::OpenCL)->name(), "opencl");
   } else {
-    EXPECT_EQ(automatic->name(), "cpu");
     EXPECT_THROW(make_translation_cost_evaluator(Device::OpenCL), DeviceError);
   }
+  // Auto answers small problems on the host without touching OpenCL, and takes the device (when
+  // there is one) for the first problem of min_device_pairs pairs; the costs are the same.
+  const auto automatic = make_translation_cost_evaluator(Device::Auto);
+  const TriMesh m = test::torus(2.0, 0.5, 16, 8);
+  const SwatchFaceTree tree(m.V, m.F);
+  const MatrixX3d N = vertex_normals(m.V, m.F);
+  TranslationCostProblem pb;
+  pb.points = m.V.topRows(64);
+  pb.point_normals = N.topRows(64);
+  pb.offsets = MatrixX3d::Zero(4, 3);
+  TranslationCostCpu cpu;
+  EXPECT_EQ(automatic->evaluate(tree, pb), cpu.evaluate(tree, pb));
+  EXPECT_EQ(automatic->name(), "cpu");
+  const std::size_t pairs = TranslationCostOpenCL::Options().min_device_pairs;
+  pb.offsets = MatrixX3d::Zero(static_cast<Eigen::Index>(pairs / 64 + 1), 3);
+  for (Eigen::Index i = 0; i < pb.offsets.rows(); ++i)
+    pb.offsets(i, 0) = 0.01 * static_cast<double>(i);
+  const Eigen::VectorXd large = automatic->evaluate(tree, pb);
+  EXPECT_EQ(automatic->name(), cl::Runtime::available() ? "opencl" : "cpu");
+  const Eigen::VectorXd reference = cpu.evaluate(tree, pb);
+  ASSERT_EQ(large.size(), reference.size());
+  for (Eigen::Index i = 0; i < large.size(); ++i)
+    EXPECT_NEAR(large(i), reference(i), 1e-9 * reference(i)) << "offset " << i;
 }
 
 }  // namespace
