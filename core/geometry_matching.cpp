@@ -138,18 +138,24 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
     double frozen = cost;
     for (double step = first_step; step >= options.refine_to * cell_size;) {
       const Vector3d moves[4] = {{step, 0, 0}, {-step, 0, 0}, {0, step, 0}, {0, -step, 0}};
+      // The four moves' frozen costs in parallel (each sums its points in order), then the
+      // best in move order: the same choice as evaluating them one after another.
+      Vector3d c[4];
+      double e[4];
+      for (int k = 0; k < 4; ++k) {
+        c[k] = u + moves[k];
+        c[k].x() = std::clamp(c[k].x(), lo.x(), hi.x());
+        c[k].y() = std::clamp(c[k].y(), lo.y(), hi.y());
+      }
+      tbb::parallel_for(
+          0, 4, [&](int k) { e[k] = surrogate_cost(swatch, P, assignment, c[k], options.lambda); });
       double best_cost = frozen;
       Vector3d best_c = u;
-      for (int k = 0; k < 4; ++k) {
-        Vector3d c = u + moves[k];
-        c.x() = std::clamp(c.x(), lo.x(), hi.x());
-        c.y() = std::clamp(c.y(), lo.y(), hi.y());
-        const double e = surrogate_cost(swatch, P, assignment, c, options.lambda);
-        if (e < best_cost) {
-          best_cost = e;
-          best_c = c;
+      for (int k = 0; k < 4; ++k)
+        if (e[k] < best_cost) {
+          best_cost = e[k];
+          best_c = c[k];
         }
-      }
       // Require a real improvement so float noise cannot make the search wander.
       if (best_cost < frozen * (1 - 1e-9)) {
         u = best_c;
