@@ -211,6 +211,17 @@ TEST(TranslationCostOpenCL, SwatchGridIsUploadedOncePerGrid) {
 
 // Below min_device_pairs the host path answers (nothing is uploaded) with the same costs; at or
 // above it the kernel runs.
+// The first num_points vertices of a small torus (with their normals) against num_offsets
+// offsets along x, 0.01 apart.
+TranslationCostProblem torus_problem(const TriMesh& torus, int num_points, int num_offsets) {
+  TranslationCostProblem pb;
+  pb.points = torus.V.topRows(num_points);
+  pb.point_normals = vertex_normals(torus.V, torus.F).topRows(num_points);
+  pb.offsets = MatrixX3d::Zero(num_offsets, 3);
+  for (int i = 0; i < num_offsets; ++i) pb.offsets(i, 0) = 0.01 * i;
+  return pb;
+}
+
 TEST(TranslationCostOpenCL, SmallProblemsStayOnTheHost) {
   if (!cl::Runtime::available()) GTEST_SKIP() << "no OpenCL platform";
   TranslationCostOpenCL::Options options;
@@ -218,18 +229,12 @@ TEST(TranslationCostOpenCL, SmallProblemsStayOnTheHost) {
   TranslationCostOpenCL ocl(std::make_shared<cl::Runtime>(), options);
   const TriMesh m = test::torus(2.0, 0.5, 16, 8);
   const SwatchFaceTree tree(m.V, m.F);
-  const MatrixX3d N = vertex_normals(m.V, m.F);
-  TranslationCostProblem pb;
-  pb.points = m.V.topRows(3);
-  pb.point_normals = N.topRows(3);
-  pb.offsets = MatrixX3d::Zero(2, 3);
-  pb.offsets(1, 0) = 0.3;
+  TranslationCostProblem pb = torus_problem(m, 3, 2);
   TranslationCostCpu cpu;
   const Eigen::VectorXd small = ocl.evaluate(tree, pb);  // 6 pairs
   EXPECT_EQ(ocl.num_cached_trees(), 0u);
   EXPECT_EQ(small, cpu.evaluate(tree, pb));
-  pb.points = m.V.topRows(4);
-  pb.point_normals = N.topRows(4);
+  pb = torus_problem(m, 4, 2);
   const Eigen::VectorXd large = ocl.evaluate(tree, pb);  // 8 pairs
   EXPECT_EQ(ocl.num_cached_trees(), 1u);
   const Eigen::VectorXd reference = cpu.evaluate(tree, pb);
@@ -248,18 +253,12 @@ TEST(TranslationCostFactory, ChoosesThePath) {
   const auto automatic = make_translation_cost_evaluator(Device::Auto);
   const TriMesh m = test::torus(2.0, 0.5, 16, 8);
   const SwatchFaceTree tree(m.V, m.F);
-  const MatrixX3d N = vertex_normals(m.V, m.F);
-  TranslationCostProblem pb;
-  pb.points = m.V.topRows(64);
-  pb.point_normals = N.topRows(64);
-  pb.offsets = MatrixX3d::Zero(4, 3);
+  TranslationCostProblem pb = torus_problem(m, 64, 4);
   TranslationCostCpu cpu;
   EXPECT_EQ(automatic->evaluate(tree, pb), cpu.evaluate(tree, pb));
   EXPECT_EQ(automatic->name(), "cpu");
-  const std::size_t pairs = TranslationCostOpenCL::Options().min_device_pairs;
-  pb.offsets = MatrixX3d::Zero(static_cast<Eigen::Index>(pairs / 64 + 1), 3);
-  for (Eigen::Index i = 0; i < pb.offsets.rows(); ++i)
-    pb.offsets(i, 0) = 0.01 * static_cast<double>(i);
+  const int enough = static_cast<int>(TranslationCostOpenCL::Options().min_device_pairs / 64 + 1);
+  pb = torus_problem(m, 64, enough);
   const Eigen::VectorXd large = automatic->evaluate(tree, pb);
   EXPECT_EQ(automatic->name(), cl::Runtime::available() ? "opencl" : "cpu");
   const Eigen::VectorXd reference = cpu.evaluate(tree, pb);
