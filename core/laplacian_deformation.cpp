@@ -10,6 +10,7 @@
 #include <exception>
 
 #include "core/errors.h"
+#include "core/fnv1a.h"
 #include "core/mesh_topology.h"
 
 namespace mq {
@@ -147,14 +148,11 @@ LaplacianTopology::LaplacianTopology(const MatrixX3i& F, int num_vertices) : F_(
 namespace {
 
 std::uint64_t faces_hash(const MatrixX3i& F, int num_vertices) {
-  std::uint64_t h = 14695981039346656037ull;
-  auto mix = [&h](std::uint64_t x) {
-    h ^= x;
-    h *= 1099511628211ull;
-  };
-  mix(static_cast<std::uint64_t>(num_vertices));
-  mix(static_cast<std::uint64_t>(F.rows()));
-  for (Eigen::Index i = 0; i < F.size(); ++i) mix(static_cast<std::uint32_t>(F.data()[i]));
+  std::uint64_t h = kFnv1aOffset;
+  const Eigen::Index rows = F.rows();
+  fnv1a(h, &num_vertices, sizeof num_vertices);
+  fnv1a(h, &rows, sizeof rows);
+  fnv1a(h, F.data(), sizeof(int) * static_cast<std::size_t>(F.size()));
   return h;
 }
 
@@ -164,7 +162,12 @@ void LaplacianTopologyCache::add(const MatrixX3i& F, int num_vertices) {
   if (find(F, num_vertices)) return;
   by_hash_[faces_hash(F, num_vertices)].push_back(
       std::make_shared<const LaplacianTopology>(F, num_vertices));
-  ++size_;
+}
+
+std::size_t LaplacianTopologyCache::size() const {
+  std::size_t n = 0;
+  for (const auto& bucket : by_hash_) n += bucket.second.size();
+  return n;
 }
 
 std::shared_ptr<const LaplacianTopology> LaplacianTopologyCache::find(const MatrixX3i& F,

@@ -66,11 +66,11 @@ class LaplacianTopologyCache {
   void add(const MatrixX3i& F, int num_vertices);
   // The held topology with exactly these faces and vertex count, or null.
   std::shared_ptr<const LaplacianTopology> find(const MatrixX3i& F, int num_vertices) const;
-  std::size_t size() const { return size_; }
+  // Number of topologies held.
+  std::size_t size() const;
 
  private:
   std::unordered_map<std::uint64_t, std::vector<std::shared_ptr<const LaplacianTopology>>> by_hash_;
-  std::size_t size_ = 0;
 };
 
 // Precompute-then-query form of deform_element for an element deformed repeatedly with different

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/fnv1a.h"
 #include "core/geometry_measures.h"
 #include "core/point_triangle.h"
 
@@ -34,14 +35,6 @@ inline double triangle_dist2(const Vector3d& q, const double* t) {
 }
 
 bool all_finite(const MatrixX3d& M) { return M.allFinite(); }
-
-void fnv1a(std::uint64_t& h, const void* data, std::size_t bytes) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ull;
-  }
-}
 
 // Per-offset sums of per-(offset, point) minima, in point order (deterministic).
 Eigen::VectorXd sum_per_offset(const std::vector<double>& minima, Eigen::Index num_points,
@@ -174,7 +167,7 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
     normal_z_[j] = entry_normals_[4 * j + 2];
   }
 
-  std::uint64_t fp = 14695981039346656037ull;
+  std::uint64_t fp = kFnv1aOffset;
   fnv1a(fp, &slack_, sizeof(double));
   fnv1a(fp, node_links_.data(), sizeof(int) * node_links_.size());
   fnv1a(fp, node_boxes_.data(), sizeof(double) * node_boxes_.size());
