@@ -396,6 +396,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     topo = edge_topology(base.F, base.num_vertices());
     TT = face_adjacency(topo);
   }
+  const SwatchQueries queries{*swatch_tree, embree, laplacians};
   const double H = swatch.size.z();
   stats.shell_height = H;
   const double cell = std::min(0.5 * swatch.mean_element_diameter,
@@ -546,8 +547,8 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
     };
     PatchCounts counts;
     std::vector<int> rejected;
-    quilt_patch(framed, swatch, SwatchQueries{*swatch_tree, embree, laplacians}, t, region,
-                admissible, options.patch, counts, times, &rejected);
+    quilt_patch(framed, swatch, queries, t, region, admissible, options.patch, counts, times,
+                &rejected);
     accumulate(stats.counts, counts);
     stats.rejected_outside_patch += outside;
 

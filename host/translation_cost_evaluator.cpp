@@ -19,10 +19,7 @@ class TranslationCostAuto final : public TranslationCostEvaluator {
 
   Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                            const TranslationCostProblem& problem) override {
-    const auto pairs = static_cast<std::size_t>(problem.points.rows()) *
-                       static_cast<std::size_t>(problem.offsets.rows());
-    if (pairs < TranslationCostOpenCL::Options().min_device_pairs)
-      return host_.evaluate(tree, problem);
+    if (!TranslationCostOpenCL::Options().on_device(problem)) return host_.evaluate(tree, problem);
     if (!tried_device_) {
       tried_device_ = true;
       try {

@@ -60,7 +60,7 @@ Eigen::VectorXd TranslationCostOpenCL::evaluate(const SwatchFaceTree& tree,
   const std::size_t T = static_cast<std::size_t>(problem.offsets.rows());
   Eigen::VectorXd E = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(T));
   if (P == 0 || T == 0) return E;
-  if (P * T < options_.min_device_pairs) return host_.evaluate(tree, problem);
+  if (!options_.on_device(problem)) return host_.evaluate(tree, problem);
   MQ_CHECK(P <= kMaxMinimaPerLaunch, InvalidInput, "translation cost: too many points (", P, ")");
 
   const DeviceTree& dt = upload(tree);

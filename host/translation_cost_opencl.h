@@ -28,6 +28,12 @@ class TranslationCostOpenCL final : public TranslationCostEvaluator {
     // with its transfers costs PoCL ~0.7 ms, more than the host needs for a few thousand
     // pairs (bench/translation_cost_bench, BM_TranslationCost*Small). 0 = always the device.
     std::size_t min_device_pairs = 16384;
+    // Whether a problem is large enough for the device under this rule.
+    bool on_device(const TranslationCostProblem& problem) const {
+      return static_cast<std::size_t>(problem.points.rows()) *
+                 static_cast<std::size_t>(problem.offsets.rows()) >=
+             min_device_pairs;
+    }
   };
 
   // Builds the kernel through the runtime's program cache. Throws DeviceError when the device
