@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/point_triangle.h"
-
 namespace mq {
 
 namespace {
@@ -83,23 +81,17 @@ Correspondences find_correspondences(const std::vector<Element>& output,
       int entry = -1;
       swatch_faces.min_face_cost(q, n, options.lambda, &entry, max_distance);
       if (entry < 0) continue;
-      const size_t j = static_cast<size_t>(entry);
-      const double* fn = &swatch_faces.entry_normals()[4 * j];
-      if (n.dot(Vector3d(fn[0], fn[1], fn[2])) < options.min_normal_dot) continue;
-      const double* tri = &swatch_faces.entry_triangles()[9 * j];
-      const Vector3d a(tri[0], tri[1], tri[2]), b(tri[3], tri[4], tri[5]),
-          c(tri[6], tri[7], tri[8]);
-      const Vector3d w = closest_point_barycentric<double>(q, a, b, c);
-      const Vector3d closest = w(0) * a + w(1) * b + w(2) * c;
-      const int face = swatch_faces.entry_faces()[j];
+      if (n.dot(swatch_faces.entry_normal(entry)) < options.min_normal_dot) continue;
+      const SwatchFaceTree::FacePoint closest = swatch_faces.entry_closest_point(entry, q);
+      const int face = swatch_faces.entry_faces()[static_cast<size_t>(entry)];
       VertexFacePair pair;
       pair.out_element = o;
       pair.out_vertex = v;
       pair.in_element = swatch.face_element[face];
       pair.in_face = face - swatch.element_first_face[pair.in_element];
-      pair.barycentric = w;
-      pair.closest = closest + t;
-      pair.distance = (q - closest).norm();
+      pair.barycentric = closest.barycentric;
+      pair.closest = closest.point + t;
+      pair.distance = (q - closest.point).norm();
       pairs.push_back(pair);
     }
   });

@@ -193,6 +193,22 @@ double SwatchFaceTree::entry_cost_with_factor(int entry, const Vector3d& q, doub
   return (1.0 + lambda * std::sqrt(dist2)) * normal_factor;  // as in min_face_cost's leaf loop
 }
 
+Vector3d SwatchFaceTree::entry_normal(int entry) const {
+  MQ_ASSERT(entry >= 0 && entry < num_faces());
+  const double* fn = &entry_normals_[4 * static_cast<std::size_t>(entry)];
+  return Vector3d(fn[0], fn[1], fn[2]);
+}
+
+SwatchFaceTree::FacePoint SwatchFaceTree::entry_closest_point(int entry, const Vector3d& q) const {
+  MQ_ASSERT(entry >= 0 && entry < num_faces());
+  const double* t = &entry_triangles_[9 * static_cast<std::size_t>(entry)];
+  const Vector3d a(t[0], t[1], t[2]), b(t[3], t[4], t[5]), c(t[6], t[7], t[8]);
+  FacePoint result;
+  result.barycentric = closest_point_barycentric<double>(q, a, b, c);
+  result.point = result.barycentric(0) * a + result.barycentric(1) * b + result.barycentric(2) * c;
+  return result;
+}
+
 double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& n,
                                   double lambda) const {
   return entry_cost_with_factor(entry, q, entry_normal_factor(entry, n), lambda);

@@ -76,6 +76,15 @@ class SwatchFaceTree {
   double entry_normal_factor(int entry, const Vector3d& n) const;
   double entry_cost_with_factor(int entry, const Vector3d& q, double normal_factor,
                                 double lambda) const;
+  // Unit normal of an entry's face (zero for a degenerate face).
+  Vector3d entry_normal(int entry) const;
+  // The point of an entry's face closest to q, with its barycentric weights on the face's
+  // corners in F's order (core/point_triangle.h).
+  struct FacePoint {
+    Vector3d barycentric;
+    Vector3d point;
+  };
+  FacePoint entry_closest_point(int entry, const Vector3d& q) const;
 
   int num_faces() const { return static_cast<int>(entry_faces_.size()); }
   int num_nodes() const { return static_cast<int>(node_links_.size() / 2); }

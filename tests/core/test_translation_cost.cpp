@@ -101,6 +101,14 @@ TEST(TranslationCost, TreeQueryReportsTheEntryAttainingTheMinimum) {
         const Vector3d a = torus.V.row(torus.F(f, 0)), b = torus.V.row(torus.F(f, 1)),
                        c = torus.V.row(torus.F(f, 2));
         const double d = std::sqrt(point_triangle_squared_distance<double>(q, a, b, c));
+        // The entry's face geometry as the tree hands it to callers (correspondences).
+        const SwatchFaceTree::FacePoint on_face = tree.entry_closest_point(entry, q);
+        EXPECT_EQ((q - on_face.point).norm(), d);
+        EXPECT_NEAR((on_face.barycentric(0) * a + on_face.barycentric(1) * b +
+                     on_face.barycentric(2) * c - on_face.point)
+                        .norm(),
+                    0.0, 1e-12);
+        EXPECT_EQ(tree.entry_normal(entry), Vector3d(FN.row(f).transpose()));
         const double reference = (1 + lambda * d) * (1 + (n - Vector3d(FN.row(f))).norm());
         EXPECT_NEAR(reference, best, 1e-12 * best);
         EXPECT_NEAR(min_face_cost_reference(torus.V, torus.F, q, n, lambda), best, 1e-12 * best);
