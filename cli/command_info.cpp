@@ -1,36 +1,83 @@
 // meshquilt info FILE: counts, bounding box and topology of a mesh.
 #include <cstdio>
+#include <memory>
+#include <optional>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/json_writer.h"
+#include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/closest_point_query.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
+#include "core/texture_structure.h"
 
 namespace mq::cli {
 
 int run_info(int argc, char** argv, int first) {
-  CommandLine cl("info", "FILE [--json]",
+  CommandLine cl("info", "FILE [--json] [--intersections] [--links [--swatch SW] [--base BASE]]",
                  "Prints the faces, vertices, geometry elements (connected components), bounding\n"
                  "box, thickness (smallest box side), closedness and manifoldness of a mesh file\n"
-                 "(OBJ, PLY or OFF).");
+                 "(OBJ, PLY or OFF). --links measures the texture's structure: how many rings\n"
+                 "each ring-shaped element is interlinked with (linking number of centre loops),\n"
+                 "where long elements (threads, vines) end, and elements per unit area; with\n"
+                 "--swatch, how that compares with the swatch's own structure.");
   cl.positional("FILE", "mesh file to inspect");
   cl.flag("json", "print the same figures as JSON");
-  cl.flag("intersections", "also count pairs of intersecting faces between different elements");
+  cl.flag("intersections",
+          "also count pairs of intersecting faces between different elements, and elements "
+          "that intersect themselves");
+  cl.flag("links", "measure links between rings, ends of long elements and density");
+  cl.option("swatch", "FILE", "with --links: the swatch the mesh was made from");
+  cl.option("base", "FILE",
+            "with --links: the base mesh of a surface result (its area and boundary)");
+  cl.option("scale", "S",
+            "with --swatch: output units per swatch unit (default: from the element sizes)");
   if (!cl.parse(argc, argv, first)) return 0;
   const std::string path = cl.positional_value("FILE");
+  const bool links = cl.has("links");
+  if (!links && (cl.has("swatch") || cl.has("base") || cl.has("scale")))
+    throw UsageError("--swatch, --base and --scale need --links");
+  const double linear_scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
   const TriMesh mesh = read_mesh(path);
+  std::optional<SwatchStructure> swatch;
+  StructureReport structure;
+  std::optional<StructureComparison> comparison;
+  std::shared_ptr<ClosestPointQuery> base_query;
+  MatrixX3d base_normals;
+  if (links) {
+    StructureOptions so;
+    if (cl.has("base")) {
+      const TriMesh base = read_mesh(cl.get("base"));
+      so.automatic_border = false;
+      so.border = mesh_border(base.V, base.F);
+      so.area = surface_area(base.V, base.F);
+      base_query = std::make_shared<ClosestPointQuery>(base.V, base.F);
+      base_normals = face_normals(base.V, base.F);
+      so.surface_normal = [&](const Vector3d& p) -> Vector3d {
+        return base_normals.row(base_query->closest(p).face).transpose();
+      };
+    }
+    structure = measure_structure(mesh, so);
+    if (cl.has("swatch")) {
+      swatch = measure_swatch_structure(read_mesh(cl.get("swatch")));
+      comparison = compare_structure(structure, *swatch, linear_scale);
+    }
+  }
   const TopologyReport topo = topology_report(mesh);
   const BoundingBox box = bounding_box(mesh.V, mesh.F);
   const Vector3d size = box.extent();
   const double area = surface_area(mesh.V, mesh.F);
   const double edge = mean_edge_length(mesh.V, mesh.F);
   const bool check = cl.has("intersections");
-  long long crossing = -1;
-  if (check) crossing = static_cast<long long>(intersecting_face_pairs(mesh.V, mesh.F).size());
+  long long crossing = -1, self_crossing = -1;
+  if (check) {
+    crossing = static_cast<long long>(intersecting_face_pairs(mesh.V, mesh.F).size());
+    self_crossing = static_cast<long long>(self_intersecting_components(mesh.V, mesh.F).size());
+  }
   if (cl.has("json")) {
     JsonWriter j;
     j.begin_object()
@@ -52,7 +99,12 @@ int run_info(int argc, char** argv, int first) {
         .value("degenerate_faces", topo.num_degenerate_faces)
         .value("surface_area", area)
         .value("mean_edge_length", edge);
-    if (check) j.value("intersecting_face_pairs", crossing);
+    if (check)
+      j.value("intersecting_face_pairs", crossing)
+          .value("self_intersecting_elements", self_crossing);
+    if (links)
+      write_structure(j, structure, swatch ? &*swatch : nullptr,
+                      comparison ? &*comparison : nullptr);
     j.end_object();
     std::fputs(j.str().c_str(), stdout);
     return 0;
@@ -72,7 +124,12 @@ int run_info(int argc, char** argv, int first) {
   std::printf("degenerate faces:  %d\n", topo.num_degenerate_faces);
   std::printf("surface area:      %.6g\n", area);
   std::printf("mean edge length:  %.6g\n", edge);
-  if (check) std::printf("intersecting face pairs between elements: %lld\n", crossing);
+  if (check) {
+    std::printf("intersecting face pairs between elements: %lld\n", crossing);
+    std::printf("self-intersecting elements: %lld\n", self_crossing);
+  }
+  if (links)
+    print_structure(structure, swatch ? &*swatch : nullptr, comparison ? &*comparison : nullptr);
   return 0;
 }
 

@@ -3,9 +3,12 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_io.h"
+#include "core/mesh_topology.h"
 #include "core/render.h"
+#include "core/texture_structure.h"
 
 namespace mq::cli {
 
@@ -20,10 +23,16 @@ int run_render(int argc, char** argv, int first) {
   cl.option("azimuth", "DEG", "camera angle around the vertical axis", "35");
   cl.option("elevation", "DEG", "camera angle above the horizon", "30");
   cl.option("samples", "N", "samples per pixel (anti-aliasing)", "4");
-  cl.option("up", "auto|x|y|z", "the mesh's up axis; auto: the thickness axis of flat layers, else y",
-            "auto");
+  cl.option("up", "auto|x|y|z",
+            "the mesh's up axis; auto: the thickness axis of flat layers, else y", "auto");
   cl.flag("ground", "draw a ground plane that catches the shadow");
   cl.flag("single-color", "one colour for the whole mesh");
+  cl.option("color", "elements|links|single",
+            "colour per element, by its link count (0 red, 1 orange, 2 yellow, 3 cyan, 4 green, "
+            "more blue, not a ring grey), or one colour",
+            "elements");
+  cl.option("crop", "X Y Z R", "show only the elements whose centre lies within R of (X, Y, Z)", "",
+            4);
   cl.flag("quiet", "print nothing but errors");
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("output")) throw UsageError("-o PNG is required");
@@ -33,9 +42,49 @@ int run_render(int argc, char** argv, int first) {
   o.azimuth_deg = cl.get_double("azimuth", 0, -360, 360);
   o.elevation_deg = cl.get_double("elevation", 0, -89, 89);
   o.samples_per_pixel = static_cast<int>(cl.get_int("samples", 1, 64));
-  o.color_elements = !cl.has("single-color");
+  const std::string color = cl.has("single-color") ? std::string("single") : cl.get("color");
+  if (color != "elements" && color != "links" && color != "single")
+    throw UsageError("--color expects elements, links or single, got '" + color + "'");
+  o.color_elements = color != "single";
   o.ground_plane = cl.has("ground");
-  const TriMesh mesh = read_mesh(cl.positional_value("MESH"));
+  TriMesh mesh = read_mesh(cl.positional_value("MESH"));
+  std::vector<std::array<unsigned char, 3>> colors;
+  if (color == "links") {
+    const StructureReport r = measure_structure(mesh);
+    for (const ElementStructure& e : r.elements) {
+      static const std::array<unsigned char, 3> by_links[] = {
+          {{220, 40, 40}}, {{240, 140, 30}}, {{225, 205, 40}}, {{60, 200, 220}}, {{40, 170, 60}}};
+      if (!e.ring)
+        colors.push_back({{150, 150, 150}});
+      else if (e.links <= 4)
+        colors.push_back(by_links[e.links]);
+      else
+        colors.push_back({{50, 80, 220}});
+    }
+  }
+  if (cl.has("crop")) {
+    const Vector3d c(cl.get_double("crop", 0), cl.get_double("crop", 1), cl.get_double("crop", 2));
+    const double r = cl.get_double("crop", 3, 0, 1e300);
+    std::vector<int> fc;
+    const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
+    std::vector<Vector3d> sum(n, Vector3d::Zero());
+    std::vector<int> count(n, 0);
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        sum[fc[f]] += mesh.V.row(mesh.F(f, k)).transpose();
+        ++count[fc[f]];
+      }
+    std::vector<int> faces;
+    std::vector<std::array<unsigned char, 3>> kept;
+    for (int e = 0; e < n; ++e)
+      if ((sum[e] / count[e] - c).norm() <= r && !colors.empty()) kept.push_back(colors[e]);
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      if ((sum[fc[f]] / count[fc[f]] - c).norm() <= r) faces.push_back(f);
+    if (faces.empty()) throw InvalidInput("--crop: no element has its centre within the radius");
+    mesh = extract_faces(mesh, faces);
+    colors = kept;
+  }
+  o.element_colors = colors;
   const std::string up = cl.get("up");
   if (up == "x" || up == "y" || up == "z") {
     o.up_axis = up[0] - 'x';
@@ -50,7 +99,8 @@ int run_render(int argc, char** argv, int first) {
     throw UsageError("--up expects auto, x, y or z, got '" + up + "'");
   }
   write_png(cl.get("output"), render_mesh(mesh, o));
-  if (!cl.has("quiet")) std::printf("wrote %s (%dx%d)\n", cl.get("output").c_str(), o.width, o.height);
+  if (!cl.has("quiet"))
+    std::printf("wrote %s (%dx%d)\n", cl.get("output").c_str(), o.width, o.height);
   return 0;
 }
 

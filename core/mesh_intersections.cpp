@@ -131,9 +131,11 @@ bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
          segment_triangle_intersect(P(g, ga), P(g, gb), P(f, 0), P(f, 1), P(f, 2));
 }
 
-// Shared implementation: when label is given, only pairs with different labels are tested.
+// Shared implementation: when label is given, only pairs with different labels are tested, or
+// with same_label only pairs with the same label.
 std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i& F,
-                                            const std::vector<int>* label, bool stop_at_first) {
+                                            const std::vector<int>* label, bool stop_at_first,
+                                            bool same_label = false) {
   const int nf = static_cast<int>(F.rows());
   std::vector<std::pair<int, int>> result;
   if (nf == 0) return result;
@@ -214,7 +216,7 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
             for (int m = offsets[c]; m < offsets[c + 1]; ++m) {
               const int g = members[m];
               if (g <= f) continue;
-              if (label && (*label)[f] == (*label)[g]) continue;
+              if (label && ((*label)[f] == (*label)[g]) != same_label) continue;
               bool overlap = true, home = true;
               for (int a = 0; a < 3 && overlap; ++a) {
                 overlap = lo(f, a) <= hi(g, a) && lo(g, a) <= hi(f, a);
@@ -269,6 +271,19 @@ std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, con
   std::vector<int> component;
   connected_components(F, static_cast<int>(V.rows()), component);
   return find_pairs(V, F, &component, false);
+}
+
+std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+  std::vector<int> component;
+  connected_components(F, static_cast<int>(V.rows()), component);
+  std::vector<int> result;
+  for (const auto& [f, g] : find_pairs(V, F, &component, false, true))
+    result.push_back(component[f]);
+  std::sort(result.begin(), result.end());
+  result.erase(std::unique(result.begin(), result.end()), result.end());
+  return result;
 }
 
 bool meshes_intersect(const TriMesh& A, const TriMesh& B) {

@@ -32,6 +32,11 @@ struct IntersectionOptions {
 std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
                                                          const IntersectionOptions& options = {});
 
+// The vertex-connected components (elements, numbered as connected_components numbers them)
+// that intersect themselves: two of their faces overlap beyond a shared vertex or edge (a
+// fold, a tube pressed through itself). Ascending. Throws like intersecting_face_pairs.
+std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F);
+
 // Does any triangle of A intersect any triangle of B? Throws like intersecting_face_pairs.
 bool meshes_intersect(const TriMesh& A, const TriMesh& B);
 

@@ -233,7 +233,14 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
   const MatrixX3d NF = face_normals(P, F);
   const MatrixX3d CN = corner_normals(P, F, NF, face_component, smooth);
   std::vector<Vector3d> albedo(num_components);
-  for (int c = 0; c < num_components; ++c) albedo[c] = element_albedo(c, o.color_elements);
+  MQ_CHECK(o.element_colors.empty() || static_cast<int>(o.element_colors.size()) == num_components,
+           InvalidInput, "render: ", o.element_colors.size(), " element colours for ",
+           num_components, " elements");
+  for (int c = 0; c < num_components; ++c) {
+    albedo[c] = element_albedo(c, o.color_elements);
+    if (!o.element_colors.empty())
+      for (int k = 0; k < 3; ++k) albedo[c](k) = srgb_to_linear(o.element_colors[c][k] / 255.0);
+  }
 
   // Embree scene.
   DevicePtr device(rtcNewDevice("verbose=0"));
@@ -383,8 +390,8 @@ void write_png(const std::string& path, const Image& image) {
                                      nullptr);
   if (ok) {
     bytes.resize(size);
-    ok = png_image_write_to_memory(&png, bytes.data(), &size, 0, image.rgb.data(),
-                                   3 * image.width, nullptr);
+    ok = png_image_write_to_memory(&png, bytes.data(), &size, 0, image.rgb.data(), 3 * image.width,
+                                   nullptr);
     bytes.resize(size);
   }
   const std::string message = png.message;

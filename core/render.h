@@ -22,6 +22,9 @@ struct RenderOptions {
   // Each connected component (geometry element) gets its own hue from a fixed sequence indexed
   // by the component id; otherwise everything is a neutral clay colour.
   bool color_elements = true;
+  // When not empty: the colour (sRGB) of each connected component in order, overriding the
+  // hue sequence (e.g. elements coloured by a figure such as their link count).
+  std::vector<std::array<unsigned char, 3>> element_colors;
   std::array<unsigned char, 3> background{{245, 245, 245}};
   int samples_per_pixel = 4;  // fixed sub-pixel pattern, in [1, 64]
   bool shadows = true;        // hard shadows from the key light
@@ -42,7 +45,8 @@ struct Image {
 // are identical whatever the thread count.
 //   mesh  V #V by 3, F #F by 3 (N is ignored)
 // Throws InvalidInput for an empty mesh, a non-finite coordinate, an out-of-range index or an
-// option outside its documented range; InternalError if Embree cannot be initialised.
+// option outside its documented range or element_colors of the wrong size; InternalError if Embree
+// cannot be initialised.
 Image render_mesh(const TriMesh& mesh, const RenderOptions& options = {});
 
 // Writes an 8-bit RGB PNG atomically: to a temporary file beside path, then renamed over it.

@@ -1,0 +1,39 @@
+// Topological linking of closed loops, the figure that tells whether two chain mail rings are
+// interlinked (paper section 1: the quilt must keep "the integrity of each link"), and the centre
+// loop of a ring-shaped geometry element that carries it.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace mq {
+
+// A closed polygon: point k joins point k + 1, the last joins the first.
+using Loop = std::vector<Vector3d>;
+
+// The linking number of two disjoint closed polygons (each at least 3 points): the signed
+// number of times b passes through a surface spanned by a. Computed as the intersection number
+// of b with the cone from a's mean point over a (a singular disk whose boundary is a), which is
+// exact for any polygons that do not touch; when b grazes an edge of the cone exactly, the
+// Gauss integral below decides instead. O(#a #b).
+int linking_number(const Loop& a, const Loop& b);
+
+// The Gauss linking integral of two closed polygons, evaluated exactly segment pair by segment
+// pair (the signed solid-angle form of Klenin and Langowski, 2000); an integer up to rounding
+// when the polygons are disjoint. O(#a #b), slower than linking_number (four asin per pair).
+double gauss_linking_integral(const Loop& a, const Loop& b);
+
+// The centre loop of a ring-shaped element: a closed (every edge in two faces) genus-1 surface
+// whose vertices surround their mean point in the element's best-fit plane. The vertices are
+// binned by their angle about the plane's normal through the mean point, and each bin's mean
+// point is a loop point, so the loop runs inside the tube (the core of a torus).
+//   V  #V by 3, F  #F by 3 indices into V (one element)
+//   bins  loop points (>= 8); halved (down to 8) while some bin holds no vertex, so that a
+//         coarse ring of 16 cross sections gets a loop of 16 points
+// Returns nothing when the element is not closed, not of genus 1 (Euler characteristic 0),
+// or even 8 bins leave one empty (the element does not surround its mean point).
+std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int bins = 32);
+
+}  // namespace mq

@@ -1,0 +1,528 @@
+#include "core/texture_structure.h"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <queue>
+#include <unordered_map>
+
+#include "core/errors.h"
+#include "core/geometry_measures.h"
+#include "core/mesh_topology.h"
+#include "core/quilt_elements.h"
+
+namespace mq {
+
+namespace {
+
+double median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
+  return v[m];
+}
+
+// Uniform hash grid over points or boxes, keyed by integer cell coordinates.
+class HashGrid3 {
+ public:
+  explicit HashGrid3(double cell) : cell_(cell > 0 ? cell : 1) {}
+  void insert_box(int id, const Vector3d& lo, const Vector3d& hi) {
+    const auto a = cell_of(lo), b = cell_of(hi);
+    for (long long x = a[0]; x <= b[0]; ++x)
+      for (long long y = a[1]; y <= b[1]; ++y)
+        for (long long z = a[2]; z <= b[2]; ++z) cells_[key(x, y, z)].push_back(id);
+  }
+  // Ids in the cells meeting [lo, hi], sorted and unique.
+  std::vector<int> query_box(const Vector3d& lo, const Vector3d& hi) const {
+    std::vector<int> out;
+    const auto a = cell_of(lo), b = cell_of(hi);
+    for (long long x = a[0]; x <= b[0]; ++x)
+      for (long long y = a[1]; y <= b[1]; ++y)
+        for (long long z = a[2]; z <= b[2]; ++z) {
+          auto it = cells_.find(key(x, y, z));
+          if (it != cells_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+        }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+ private:
+  std::array<long long, 3> cell_of(const Vector3d& p) const {
+    return {static_cast<long long>(std::floor(p.x() / cell_)),
+            static_cast<long long>(std::floor(p.y() / cell_)),
+            static_cast<long long>(std::floor(p.z() / cell_))};
+  }
+  static unsigned long long key(long long x, long long y, long long z) {
+    return static_cast<unsigned long long>(x) * 73856093ULL ^
+           static_cast<unsigned long long>(y) * 19349663ULL ^
+           static_cast<unsigned long long>(z) * 83492791ULL;
+  }
+  double cell_;
+  std::unordered_map<unsigned long long, std::vector<int>> cells_;
+};
+
+double point_segment_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b) {
+  const Vector3d d = b - a;
+  const double len2 = d.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * d - p).norm();
+}
+
+// Vertex graph distances from `source` over the element's edges (Dijkstra).
+std::vector<double> graph_distances(const MatrixX3d& V, const Adjacency& adj, int source) {
+  std::vector<double> dist(V.rows(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
+  dist[source] = 0;
+  heap.emplace(0.0, source);
+  while (!heap.empty()) {
+    const auto [d, v] = heap.top();
+    heap.pop();
+    if (d > dist[v]) continue;
+    for (const int* w = adj.begin(v); w != adj.end(v); ++w) {
+      const double nd = d + (V.row(*w) - V.row(v)).norm();
+      if (nd < dist[*w]) {
+        dist[*w] = nd;
+        heap.emplace(nd, *w);
+      }
+    }
+  }
+  return dist;
+}
+
+int farthest(const std::vector<double>& dist) {
+  int best = 0;
+  for (size_t v = 0; v < dist.size(); ++v)
+    if (std::isfinite(dist[v]) && dist[v] > dist[best]) best = static_cast<int>(v);
+  return best;
+}
+
+// Per-element figures that need only the element itself.
+struct ElementShape {
+  ElementStructure s;
+  std::optional<Loop> loop;
+  Vector3d end[2] = {Vector3d::Zero(), Vector3d::Zero()};
+};
+
+ElementShape shape_of(const TriMesh& part, int loop_bins) {
+  ElementShape out;
+  const MatrixX3d& V = part.V;
+  out.s.centre = V.colwise().mean().transpose();
+  double r = 0;
+  for (Eigen::Index v = 0; v < V.rows(); ++v)
+    r = std::max(r, (V.row(v).transpose() - out.s.centre).norm());
+  out.s.size = 2 * r;
+  out.loop = ring_centre_loop(V, part.F, loop_bins);
+  out.s.ring = out.loop.has_value();
+  if (out.s.ring || V.rows() < 2) return out;
+  // Length: the double-sweep graph diameter (exact on a tube, a close lower bound elsewhere);
+  // width: the diameter a tube of that length and the element's area would have.
+  const Adjacency adj = vertex_adjacency(part.F, static_cast<int>(V.rows()));
+  const int a = farthest(graph_distances(V, adj, 0));
+  const std::vector<double> from_a = graph_distances(V, adj, a);
+  const int b = farthest(from_a);
+  const double length = from_a[b];
+  const double area = surface_area(V, part.F);
+  if (!(length > 0)) return out;
+  const double width = area / (M_PI * length);
+  out.s.length = length;
+  out.s.width = width;
+  out.s.long_element = length >= 4 * width;
+  out.end[0] = V.row(a).transpose();
+  out.end[1] = V.row(b).transpose();
+  return out;
+}
+
+// The plane of the element centres: origin, in-plane axes u, w and the spread off the plane.
+struct CentrePlane {
+  Vector3d origin = Vector3d::Zero(), u = Vector3d::UnitX(), w = Vector3d::UnitY();
+  double thickness = 0;
+  Vector2d lo = Vector2d::Zero(), hi = Vector2d::Zero();  // centres' box in (u, w)
+};
+
+CentrePlane centre_plane(const std::vector<Vector3d>& centres) {
+  CentrePlane p;
+  if (centres.empty()) return p;
+  for (const Vector3d& c : centres) p.origin += c;
+  p.origin /= static_cast<double>(centres.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vector3d& c : centres) cov += (c - p.origin) * (c - p.origin).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  // In-plane axes: the world axis most nearly in the plane, projected, and its normal in the
+  // plane, so a layer in the xy plane gets x and y (PCA axes of a square layer are arbitrary).
+  const Vector3d n = eig.eigenvectors().col(0);
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(n(k)) < std::abs(n(axis))) axis = k;
+  p.u = (Vector3d::Unit(axis) - n * n(axis)).normalized();
+  p.w = n.cross(p.u);
+  double nlo = std::numeric_limits<double>::infinity(), nhi = -nlo;
+  p.lo = Vector2d::Constant(nlo);
+  p.hi = Vector2d::Constant(-nlo);
+  for (const Vector3d& c : centres) {
+    const Vector3d d = c - p.origin;
+    const Vector2d q(d.dot(p.u), d.dot(p.w));
+    p.lo = p.lo.cwiseMin(q);
+    p.hi = p.hi.cwiseMax(q);
+    nlo = std::min(nlo, d.dot(n));
+    nhi = std::max(nhi, d.dot(n));
+  }
+  p.thickness = nhi - nlo;
+  return p;
+}
+
+// Polygon clipped to the half-plane {x : (x - m) . n <= 0}.
+std::vector<Vector2d> clip(const std::vector<Vector2d>& poly, const Vector2d& m,
+                           const Vector2d& n) {
+  std::vector<Vector2d> out;
+  const size_t k = poly.size();
+  for (size_t i = 0; i < k; ++i) {
+    const Vector2d& a = poly[i];
+    const Vector2d& b = poly[(i + 1) % k];
+    const double da = (a - m).dot(n), db = (b - m).dot(n);
+    if (da <= 0) out.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+double polygon_area(const std::vector<Vector2d>& poly) {
+  double a = 0;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Vector2d& p = poly[i];
+    const Vector2d& q = poly[(i + 1) % poly.size()];
+    a += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * std::abs(a);
+}
+
+// Area of the Voronoi cell of `centre` among `others` in the plane through centre normal to n,
+// started as the square of half-size radius: 0 when the cell does not close inside it (a
+// neighbour is missing on some side).
+double voronoi_cell_area(const Vector3d& centre, const std::vector<Vector3d>& others,
+                         const Vector3d& n, double radius) {
+  const Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+  std::vector<Vector2d> cell = {Vector2d(-radius, -radius), Vector2d(radius, -radius),
+                                Vector2d(radius, radius), Vector2d(-radius, radius)};
+  for (const Vector3d& o : others) {
+    const Vector3d d = o - centre;
+    const Vector2d q(d.dot(a), d.dot(b));
+    if (!(q.squaredNorm() > 0)) continue;
+    cell = clip(cell, 0.5 * q, q);
+    if (cell.size() < 3) return 0;
+  }
+  const double inside = radius * (1 - 1e-9);
+  for (const Vector2d& p : cell)
+    if (std::abs(p.x()) >= inside || std::abs(p.y()) >= inside) return 0;
+  return polygon_area(cell);
+}
+
+}  // namespace
+
+TextureBorder mesh_border(const MatrixX3d& V, const MatrixX3i& F) {
+  TextureBorder b;
+  const EdgeTopology topo = edge_topology(F, static_cast<int>(V.rows()));
+  for (int e = 0; e < topo.num_edges(); ++e)
+    if (topo.is_boundary(e))
+      b.segments.emplace_back(V.row(topo.E(e, 0)).transpose(), V.row(topo.E(e, 1)).transpose());
+  b.kind = b.segments.empty() ? TextureBorder::Kind::None : TextureBorder::Kind::Segments;
+  return b;
+}
+
+double StructureReport::share_with_links(int k) const {
+  if (interior_rings == 0 || k < 0 || k >= static_cast<int>(interior_link_histogram.size()))
+    return 0;
+  return static_cast<double>(interior_link_histogram[static_cast<size_t>(k)]) / interior_rings;
+}
+
+StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& options) {
+  MQ_CHECK(mesh.V.allFinite(), InvalidInput, "the mesh has non-finite vertex coordinates");
+  StructureReport report;
+  std::vector<int> fc;
+  const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
+  const std::vector<std::vector<int>> groups = component_faces(fc, n);
+  std::vector<ElementShape> shapes(static_cast<size_t>(n));
+  tbb::parallel_for(0, n, [&](int c) {
+    shapes[static_cast<size_t>(c)] = shape_of(extract_faces(mesh, groups[c]), options.loop_bins);
+  });
+  report.elements.resize(static_cast<size_t>(n));
+  std::vector<Vector3d> centres(static_cast<size_t>(n));
+  std::vector<double> sizes(static_cast<size_t>(n)), widths;
+  for (int c = 0; c < n; ++c) {
+    report.elements[c] = shapes[c].s;
+    centres[c] = shapes[c].s.centre;
+    sizes[c] = shapes[c].s.size;
+    if (shapes[c].s.long_element) widths.push_back(shapes[c].s.width);
+  }
+  report.median_size = median(sizes);
+  if (n == 0) return report;
+
+  // Nearest other centre, searched in the 27 cells of a grid of the median element size.
+  {
+    const double cell = report.median_size > 0 ? report.median_size : 1.0;
+    HashGrid3 grid(cell);
+    for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
+    std::vector<double> nearest(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+    const Vector3d r = Vector3d::Constant(cell);
+    tbb::parallel_for(0, n, [&](int c) {
+      for (const int d : grid.query_box(centres[c] - r, centres[c] + r))
+        if (d != c) nearest[c] = std::min(nearest[c], (centres[d] - centres[c]).norm());
+    });
+    report.median_spacing = median(nearest);
+  }
+
+  // The border and each element's distance to it.
+  TextureBorder border = options.border;
+  const CentrePlane plane = centre_plane(centres);
+  if (options.automatic_border)
+    border.kind = plane.thickness <= 0.5 * report.median_size ? TextureBorder::Kind::FlatBox
+                                                              : TextureBorder::Kind::None;
+  report.border = border.kind;
+  auto border_distance = [&](const Vector3d& p) {
+    switch (border.kind) {
+      case TextureBorder::Kind::None:
+        return std::numeric_limits<double>::infinity();
+      case TextureBorder::Kind::FlatBox: {
+        const Vector3d d = p - plane.origin;
+        const Vector2d q(d.dot(plane.u), d.dot(plane.w));
+        const double m = std::min({q.x() - plane.lo.x(), plane.hi.x() - q.x(), q.y() - plane.lo.y(),
+                                   plane.hi.y() - q.y()});
+        return std::max(0.0, m);
+      }
+      case TextureBorder::Kind::Segments: {
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& [a, b] : border.segments)
+          best = std::min(best, point_segment_distance(p, a, b));
+        return best;
+      }
+    }
+    return std::numeric_limits<double>::infinity();
+  };
+  // One element size and one spacing: on a base the outermost elements must lie wholly on it,
+  // so their centres can be a size and a spacing from its edge.
+  const double margin = options.interior_margin > 0 ? options.interior_margin
+                                                    : report.median_size + report.median_spacing;
+  const double end_margin = options.end_margin > 0 ? options.end_margin : 5 * median(widths);
+  tbb::parallel_for(0, n, [&](int c) {
+    ElementStructure& e = report.elements[c];
+    e.interior = border_distance(e.centre) > margin;
+    if (e.long_element)
+      for (const Vector3d& p : shapes[c].end)
+        if (border_distance(p) > end_margin) ++e.interior_ends;
+  });
+
+  // Interlinked rings: loops whose boxes overlap (b must cross the cone over a, which lies in
+  // a's convex hull) are tested exactly.
+  {
+    std::vector<int> rings;
+    std::vector<Vector3d> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n));
+    std::vector<double> ring_sizes;
+    for (int c = 0; c < n; ++c) {
+      if (!shapes[c].loop) continue;
+      rings.push_back(c);
+      lo[c] = hi[c] = shapes[c].loop->front();
+      for (const Vector3d& p : *shapes[c].loop) {
+        lo[c] = lo[c].cwiseMin(p);
+        hi[c] = hi[c].cwiseMax(p);
+      }
+      ring_sizes.push_back(shapes[c].s.size);
+    }
+    HashGrid3 grid(std::max(median(ring_sizes), 1e-12));
+    for (const int c : rings) grid.insert_box(c, lo[c], hi[c]);
+    std::vector<std::vector<int>> partners(static_cast<size_t>(n));
+    tbb::parallel_for(size_t(0), rings.size(), [&](size_t k) {
+      const int a = rings[k];
+      for (const int b : grid.query_box(lo[a], hi[a])) {
+        if (b <= a) continue;
+        if ((lo[a].array() > hi[b].array()).any() || (lo[b].array() > hi[a].array()).any())
+          continue;
+        if (linking_number(*shapes[a].loop, *shapes[b].loop) != 0) partners[a].push_back(b);
+      }
+    });
+    for (const int a : rings)
+      for (const int b : partners[a]) {
+        report.linked_pairs.emplace_back(a, b);
+        ++report.elements[a].links;
+        ++report.elements[b].links;
+      }
+  }
+
+  int max_links = 0;
+  for (const ElementStructure& e : report.elements)
+    if (e.ring) max_links = std::max(max_links, e.links);
+  report.link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
+  report.interior_link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
+  for (const ElementStructure& e : report.elements) {
+    if (e.long_element) {
+      ++report.long_elements;
+      report.ends += 2;
+      report.interior_ends += e.interior_ends;
+    }
+    if (!e.ring) continue;
+    ++report.rings;
+    ++report.link_histogram[e.links];
+    if (e.links == 0) ++report.isolated_rings;
+    if (e.interior) {
+      ++report.interior_rings;
+      ++report.interior_link_histogram[e.links];
+    }
+  }
+
+  // Density from the Voronoi cells of interior elements in their tangent planes.
+  {
+    const double radius =
+        4 * (report.median_spacing > 0 ? report.median_spacing : report.median_size);
+    HashGrid3 grid(radius > 0 ? radius : 1.0);
+    for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
+    std::vector<double> cell_area(static_cast<size_t>(n), 0);
+    tbb::parallel_for(0, n, [&](int c) {
+      if (!report.elements[c].interior || !(radius > 0)) return;
+      const Vector3d r = Vector3d::Constant(radius);
+      std::vector<Vector3d> others;
+      for (const int d : grid.query_box(centres[c] - r, centres[c] + r))
+        if (d != c && (centres[d] - centres[c]).norm() <= radius) others.push_back(centres[d]);
+      if (others.size() < 3) return;
+      Vector3d normal;
+      if (options.surface_normal) {
+        normal = options.surface_normal(centres[c]);
+      } else {
+        Vector3d mean = centres[c];
+        for (const Vector3d& o : others) mean += o;
+        mean /= static_cast<double>(others.size() + 1);
+        Eigen::Matrix3d cov = (centres[c] - mean) * (centres[c] - mean).transpose();
+        for (const Vector3d& o : others) cov += (o - mean) * (o - mean).transpose();
+        normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+      }
+      if (!(normal.norm() > 0) || !normal.allFinite()) return;
+      cell_area[c] = voronoi_cell_area(centres[c], others, normal.normalized(), radius);
+    });
+    double total = 0;
+    for (int c = 0; c < n; ++c)
+      if (cell_area[c] > 0) {
+        total += cell_area[c];
+        ++report.density_cells;
+      }
+    report.density = total > 0 ? report.density_cells / total : 0;
+  }
+
+  // Areas: given, or for a flat layer the centres' box grown by one spacing (a lattice of
+  // a x b cells then has exactly its area).
+  double area = options.area, end_area = options.area;
+  if (!(area > 0) && border.kind == TextureBorder::Kind::FlatBox) {
+    const Vector2d ext = plane.hi - plane.lo;
+    const double d = report.median_spacing;
+    area = (ext.x() + d) * (ext.y() + d);
+  }
+  if (area > 0) {
+    end_area = area;
+    if (border.kind == TextureBorder::Kind::FlatBox) {
+      const Vector2d ext = plane.hi - plane.lo;
+      end_area = std::max(0.0, ext.x() - 2 * end_margin) * std::max(0.0, ext.y() - 2 * end_margin);
+    } else if (border.kind == TextureBorder::Kind::Segments) {
+      double perimeter = 0;
+      for (const auto& [a, b] : border.segments) perimeter += (b - a).norm();
+      end_area = std::max(0.0, area - perimeter * end_margin);
+    }
+    report.area = area;
+    report.interior_ends_per_area = end_area > 0 ? report.interior_ends / end_area : 0;
+  }
+  return report;
+}
+
+SwatchStructure measure_swatch_structure(const TriMesh& swatch) {
+  SwatchStructure out;
+  const PreparedSwatch prepared = prepare_swatch(swatch);
+  out.report = measure_structure(prepared.mesh);
+  const StructureReport& r = out.report;
+  if (r.rings > 0) {
+    const int need = std::max(1, static_cast<int>(std::ceil(0.1 * r.rings)));
+    for (int k = static_cast<int>(r.link_histogram.size()) - 1; k >= 0; --k)
+      if (r.link_histogram[k] >= need) {
+        out.interior_links = k;
+        break;
+      }
+  }
+  // Density from Voronoi cells in the swatch plane (z is the thickness axis after prepare).
+  const int n = static_cast<int>(r.elements.size());
+  std::vector<Vector2d> c(static_cast<size_t>(n));
+  Vector2d lo = Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int i = 0; i < n; ++i) {
+    c[i] = r.elements[i].centre.head<2>();
+    lo = lo.cwiseMin(c[i]);
+    hi = hi.cwiseMax(c[i]);
+  }
+  const double tol = 1e-9 * std::max(1.0, (hi - lo).norm());
+  // Neighbours within four spacings bound every cell that closes at all in a sheet.
+  const double radius = 4 * (r.median_spacing > 0 ? r.median_spacing : r.median_size);
+  HashGrid3 grid(std::max(radius, 1e-12));
+  for (int i = 0; i < n; ++i)
+    grid.insert_box(i, Vector3d(c[i].x(), c[i].y(), 0), Vector3d(c[i].x(), c[i].y(), 0));
+  auto near = [&](int i) {
+    const Vector3d p(c[i].x(), c[i].y(), 0), d(radius, radius, 0);
+    std::vector<int> ids;
+    for (const int j : grid.query_box(p - d, p + d))
+      if (j != i && (c[j] - c[i]).norm() <= radius) ids.push_back(j);
+    return ids;
+  };
+  double closed_area = 0;
+  int closed = 0;
+  for (int i = 0; i < n && n > 1; ++i) {
+    std::vector<Vector2d> cell = {lo, Vector2d(hi.x(), lo.y()), hi, Vector2d(lo.x(), hi.y())};
+    for (const int j : near(i)) {
+      if (cell.empty()) break;
+      cell = clip(cell, 0.5 * (c[i] + c[j]), c[j] - c[i]);
+    }
+    bool inside = cell.size() >= 3;
+    for (const Vector2d& p : cell)
+      if (p.x() <= lo.x() + tol || p.y() <= lo.y() + tol || p.x() >= hi.x() - tol ||
+          p.y() >= hi.y() - tol)
+        inside = false;
+    if (!inside) continue;
+    closed_area += polygon_area(cell);
+    ++closed;
+  }
+  if (closed > 0 && closed_area > 0) {
+    out.density = closed / closed_area;
+    return out;
+  }
+  // No closed cell: the lattice cell of each centre's two nearest independent neighbours.
+  std::vector<double> cells;
+  for (int i = 0; i < n; ++i) {
+    std::vector<std::pair<double, int>> byd;
+    for (const int j : near(i)) byd.emplace_back((c[j] - c[i]).norm(), j);
+    std::sort(byd.begin(), byd.end());
+    if (byd.empty()) continue;
+    const Vector2d v1 = c[byd[0].second] - c[i];
+    for (size_t k = 1; k < byd.size(); ++k) {
+      const Vector2d v2 = c[byd[k].second] - c[i];
+      const double cross = std::abs(v1.x() * v2.y() - v1.y() * v2.x());
+      if (cross > 0.2 * v1.norm() * v2.norm()) {
+        cells.push_back(cross);
+        break;
+      }
+    }
+  }
+  const double m = median(cells);
+  out.density = m > 0 ? 1.0 / m : 0;
+  return out;
+}
+
+StructureComparison compare_structure(const StructureReport& output, const SwatchStructure& swatch,
+                                      double linear_scale) {
+  StructureComparison c;
+  c.interior_links = swatch.interior_links;
+  c.share_matching = output.share_with_links(swatch.interior_links);
+  c.linear_scale = linear_scale > 0                ? linear_scale
+                   : swatch.report.median_size > 0 ? output.median_size / swatch.report.median_size
+                                                   : 0;
+  if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0)
+    c.density_ratio = output.density / (swatch.density / (c.linear_scale * c.linear_scale));
+  return c;
+}
+
+}  // namespace mq
