@@ -13,22 +13,38 @@ namespace mq {
 
 void gather_subpatch(const std::vector<const Element*>& elements, const Vector2d& lo,
                      const Vector2d& hi, int max_points, MatrixX3d& P, MatrixX3d& NP) {
+  // Face centroids with face normals, not vertices with vertex normals: Eq. (1) compares n(v)
+  // with the swatch's face normals, and at the exact continuation of the output (the swatch
+  // placed where it repeats) a centroid lies on a swatch face of the same normal, cost 1,
+  // while a vertex normal averages faces 45 degrees apart on a coarse tube (4 sides): 1.77
+  // there, more than at some wrong offsets. Measured on 30 x 30 planes of 4-in-1 sheets,
+  // interior rings with the swatch's 4 links (partners chosen as in patch_quilting):
+  // --detail 16 3x3 / 6x6 100% / 100% (vertices: 26% / 31%), full detail 3x3 100% (79%).
+  auto centroid = [](const Element& e, int f) -> Vector3d {
+    return (e.V.row(e.F(f, 0)) + e.V.row(e.F(f, 1)) + e.V.row(e.F(f, 2))).transpose() / 3.0;
+  };
+  auto normal = [](const Element& e, int f) -> Vector3d {
+    return (e.V.row(e.F(f, 1)) - e.V.row(e.F(f, 0)))
+        .cross(e.V.row(e.F(f, 2)) - e.V.row(e.F(f, 0)))
+        .transpose();
+  };
   std::vector<std::pair<const Element*, int>> inside;
   for (const Element* e : elements)
-    for (int v = 0; v < e->V.rows(); ++v) {
-      const double x = e->V(v, 0), y = e->V(v, 1);
-      // Vertices without a finite normal (all their faces degenerate) cannot enter Eq. (1).
-      if (x >= lo.x() && x <= hi.x() && y >= lo.y() && y <= hi.y() && e->N.row(v).allFinite())
-        inside.emplace_back(e, v);
+    for (int f = 0; f < e->F.rows(); ++f) {
+      const Vector3d c = centroid(*e, f);
+      // A degenerate face has no normal and cannot enter Eq. (1).
+      if (c.x() >= lo.x() && c.x() <= hi.x() && c.y() >= lo.y() && c.y() <= hi.y() &&
+          normal(*e, f).norm() > 0)
+        inside.emplace_back(e, f);
     }
   const size_t n =
       max_points > 0 ? std::min(inside.size(), static_cast<size_t>(max_points)) : inside.size();
   P.resize(static_cast<Eigen::Index>(n), 3);
   NP.resize(static_cast<Eigen::Index>(n), 3);
   for (size_t i = 0; i < n; ++i) {
-    const auto [e, v] = inside[i * inside.size() / n];
-    P.row(static_cast<Eigen::Index>(i)) = e->V.row(v);
-    NP.row(static_cast<Eigen::Index>(i)) = e->N.row(v);
+    const auto [e, f] = inside[i * inside.size() / n];
+    P.row(static_cast<Eigen::Index>(i)) = centroid(*e, f).transpose();
+    NP.row(static_cast<Eigen::Index>(i)) = normal(*e, f).normalized().transpose();
   }
 }
 

@@ -58,9 +58,9 @@ struct OffsetChoice {
   long long point_offsets = 0;  // (point, offset) pairs evaluated
 };
 
-// The sub-patch points of Eq. (3): vertices (#P by 3, with their unit normals NP) of the given
-// elements lying in [lo, hi] (xy), at most max_points of them (an evenly strided subset, in
-// element then vertex order; 0 = all).
+// The sub-patch points of Eq. (3): face centroids (#P by 3, with their unit face normals NP) of
+// the given elements lying in [lo, hi] (xy), at most max_points of them (an evenly strided
+// subset, in element then face order; 0 = all). Degenerate faces are left out.
 void gather_subpatch(const std::vector<const Element*>& elements, const Vector2d& lo,
                      const Vector2d& hi, int max_points, MatrixX3d& P, MatrixX3d& NP);
 

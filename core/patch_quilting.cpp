@@ -92,9 +92,18 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
   std::vector<int> strongest(moved.size(), 0);
   for (const auto& [rel, n] : pair_count)
     strongest[rel.second] = std::max(strongest[rel.second], n);
+  // A partner must also pair with at least partner_share of the output element's vertices in
+  // the overlap region: the same element placed again, not a neighbour it touches (a linked
+  // ring, a crossing thread).
+  std::vector<int> region_vertices(frame.size(), 0);
+  for (size_t k = 0; k < frame.size(); ++k)
+    for (int v = 0; v < frame[k].V.rows(); ++v)
+      region_vertices[k] += region.contains(frame[k].V.row(v).transpose());
   std::vector<std::vector<int>> partners(moved.size());
   for (const auto& [k, i] : corr.relations)
-    if (4 * pair_count[{k, i}] >= strongest[i]) partners[i].push_back(k);
+    if (4 * pair_count[{k, i}] >= strongest[i] &&
+        pair_count[{k, i}] >= options.partner_share * region_vertices[k])
+      partners[i].push_back(k);
 
   // Only elements that step 5 may merge need deforming: a swatch element with a live partner that
   // is not inside the overlap (inside ones are dropped), and an output element that is the one

@@ -37,6 +37,7 @@ struct PlanarQuiltingStats {
   int iterations = 0;
   double cell_size = 0;
   int grid_nx = 0, grid_ny = 0;
+  int window_cells = 0;                 // side of the matched sub-patch, in cells
   long long matched_point_offsets = 0;  // (point, offset) evaluations of Eq. (2)
   PatchCounts counts;    // steps 3-5 over all patches; the first patch's elements count as added
   int removed_post = 0;  // removed in post-processing (outside the domain)
@@ -44,6 +45,10 @@ struct PlanarQuiltingStats {
   int faces = 0, vertices = 0, elements = 0;
   StageTimes times;
 };
+
+// The default grid cell of the matching (section 2.3's grid): half an element across, and at
+// least 8 cells along the swatch's shorter side.
+double matching_cell_size(const PreparedSwatch& swatch);
 
 // Runs planar mesh quilting. The swatch's smallest bounding-box side is its thickness; the
 // output lies in [0, L] x [0, W] x [0, thickness] (whole elements may cross the border unless

@@ -12,6 +12,8 @@
 #include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/planar_quilting.h"
+#include "core/swatch_generators.h"
+#include "core/texture_structure.h"
 #include "host/translation_cost_evaluator.h"
 #include "host/translation_cost_opencl.h"
 #include "tests/core/planar_checks.h"
@@ -41,6 +43,36 @@ TEST(PlanarQuilting, ChainMailSheet) {
   EXPECT_EQ(stats.elements, static_cast<int>(test::components(out).size()));
   // More rings than the swatch has: the layer really grew.
   EXPECT_GT(stats.elements, 25 * 3 / 2);
+}
+
+// The chain mail's structure: interior rings keep the swatch's 4 links and the ring density
+// stays the swatch's, for the sample sheets (small ones too) and for coarse rings, whose vertex
+// normals are 45 degrees off their faces'.
+TEST(PlanarQuilting, ChainMailKeepsItsLinksAndDensity) {
+  struct Case {
+    int rows, cols, ring_segments, wire_segments;
+  };
+  for (const Case c :
+       {Case{3, 3, 16, 4}, Case{6, 6, 16, 4}, Case{2, 4, 24, 6}, Case{3, 3, 48, 12}}) {
+    ChainMailOptions o;
+    o.rows = c.rows;
+    o.cols = c.cols;
+    o.ring_segments = c.ring_segments;
+    o.wire_segments = c.wire_segments;
+    const TriMesh swatch = chainmail_4in1(o);
+    const TriMesh out = quilt(swatch, 16, 16);
+    const SwatchStructure ref = measure_swatch_structure(swatch);
+    const StructureReport r = measure_structure(out);
+    const StructureComparison cmp = compare_structure(r, ref, 1.0);
+    SCOPED_TRACE(testing::Message() << c.rows << "x" << c.cols << " rings of " << c.ring_segments
+                                    << "x" << c.wire_segments);
+    ASSERT_EQ(ref.interior_links, 4);
+    ASSERT_GE(r.interior_rings, 30);
+    EXPECT_GE(cmp.share_matching, 0.98);
+    EXPECT_GE(cmp.density_ratio, 0.95);
+    EXPECT_LE(cmp.density_ratio, 1.05);
+    EXPECT_EQ(r.isolated_rings, 0);
+  }
 }
 
 TEST(PlanarQuilting, AppleLayer) {
