@@ -1,6 +1,5 @@
 // meshquilt info FILE: counts, bounding box and topology of a mesh.
 #include <cstdio>
-#include <memory>
 #include <optional>
 
 #include "cli/command_line.h"
@@ -8,7 +7,6 @@
 #include "cli/json_writer.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
-#include "core/closest_point_query.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
@@ -46,25 +44,23 @@ int run_info(int argc, char** argv, int first) {
   std::optional<SwatchStructure> swatch;
   StructureReport structure;
   std::optional<StructureComparison> comparison;
-  std::shared_ptr<ClosestPointQuery> base_query;
-  MatrixX3d base_normals;
   if (links) {
-    StructureOptions so;
-    if (cl.has("base")) {
-      const TriMesh base = read_mesh(cl.get("base"));
-      so.automatic_border = false;
-      so.border = mesh_border(base.V, base.F);
-      so.area = surface_area(base.V, base.F);
-      base_query = std::make_shared<ClosestPointQuery>(base.V, base.F);
-      base_normals = face_normals(base.V, base.F);
-      so.surface_normal = [&](const Vector3d& p) -> Vector3d {
-        return base_normals.row(base_query->closest(p).face).transpose();
-      };
-    }
-    structure = measure_structure(mesh, so);
+    std::optional<TriMesh> base;
+    if (cl.has("base")) base = read_mesh(cl.get("base"));
     if (cl.has("swatch")) {
-      swatch = measure_swatch_structure(read_mesh(cl.get("swatch")));
-      comparison = compare_structure(structure, *swatch, linear_scale);
+      const StructureSummary s = summarize_structure(mesh, read_mesh(cl.get("swatch")),
+                                                     base ? &*base : nullptr, linear_scale);
+      structure = s.output;
+      swatch = s.swatch;
+      comparison = s.comparison;
+    } else {
+      StructureOptions so;
+      if (base) {
+        so.automatic_border = false;
+        so.border = mesh_border(base->V, base->F);
+        so.area = surface_area(base->V, base->F);
+      }
+      structure = measure_structure(mesh, so);
     }
   }
   const TopologyReport topo = topology_report(mesh);

@@ -58,8 +58,7 @@ bool CommandLine::parse(int argc, char** argv, int first) {
         vals.push_back(inline_value);
       }
       while (static_cast<int>(vals.size()) < o->arity) {
-        if (i + 1 >= argc)
-          throw UsageError("option --" + name + " expects " + o->value_names);
+        if (i + 1 >= argc) throw UsageError("option --" + name + " expects " + o->value_names);
         vals.emplace_back(argv[++i]);
       }
       if (o->arity == 0) vals.emplace_back("1");

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
 #include "core/planar_quilting.h"
+#include "core/texture_structure.h"
 #include "host/translation_cost_evaluator.h"
 
 namespace mq::cli {
@@ -17,7 +18,8 @@ namespace mq::cli {
 namespace {
 
 void write_stats(const std::string& path, const PlanarQuiltingStats& s, const std::string& device,
-                 int threads, double wall, const std::string& swatch, double length, double width) {
+                 int threads, double wall, const std::string& swatch, double length, double width,
+                 const StructureSummary& structure) {
   JsonWriter j;
   j.begin_object()
       .value("command", "plane")
@@ -40,7 +42,9 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
   write_element_counts(j, s.counts);
   j.value("removed_post", s.removed_post).value("trimmed", s.trimmed).end_object();
   write_match_counts(j, s.counts);
-  j.value("matched_point_offsets", s.matched_point_offsets).begin_object("stage_seconds");
+  j.value("matched_point_offsets", s.matched_point_offsets);
+  write_structure(j, structure.output, &structure.swatch, &structure.comparison);
+  j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
   write_file_atomically(path, j.str());
@@ -98,9 +102,13 @@ int run_plane(int argc, char** argv, int first) {
   run.progress()->finish();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!run.stats_path().empty())
+  StructureSummary structure;
+  if (!run.stats_path().empty()) {
+    ScopedStageTimer timer(stats.times, "structure");
+    structure = summarize_structure(result, swatch, nullptr, 1.0);
     write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
-                options.length, options.width);
+                options.length, options.width, structure);
+  }
   if (!run.quiet()) {
     std::printf("wrote %s: %d faces, %d vertices, %d elements\n", out_path.c_str(), stats.faces,
                 stats.vertices, stats.elements);
@@ -109,6 +117,8 @@ int run_plane(int argc, char** argv, int first) {
         "%d added, %d matched, %d removed\n",
         stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.counts.stitched,
         stats.counts.replaced, stats.counts.added, stats.counts.matched, stats.removed_post);
+    if (!run.stats_path().empty())
+      print_structure(structure.output, &structure.swatch, &structure.comparison);
   }
   return 0;
 }

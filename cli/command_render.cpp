@@ -33,6 +33,7 @@ int run_render(int argc, char** argv, int first) {
             "elements");
   cl.option("crop", "X Y Z R", "show only the elements whose centre lies within R of (X, Y, Z)", "",
             4);
+  cl.option("base", "FILE", "also draw this base mesh, in a neutral colour, under the texture");
   cl.flag("quiet", "print nothing but errors");
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("output")) throw UsageError("-o PNG is required");
@@ -85,6 +86,30 @@ int run_render(int argc, char** argv, int first) {
     colors = kept;
   }
   o.element_colors = colors;
+  if (cl.has("base")) {
+    TriMesh base = read_mesh(cl.get("base"));
+    if (cl.has("crop")) {
+      const Vector3d c(cl.get_double("crop", 0), cl.get_double("crop", 1),
+                       cl.get_double("crop", 2));
+      const double r = cl.get_double("crop", 3, 0, 1e300);
+      std::vector<int> faces;
+      for (int f = 0; f < base.num_faces(); ++f) {
+        const Vector3d m =
+            (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
+                .transpose() /
+            3.0;
+        if ((m - c).norm() <= r) faces.push_back(f);
+      }
+      base = extract_faces(base, faces);
+    }
+    if (!base.empty()) {
+      std::vector<int> fc;
+      o.neutral_from = connected_components(mesh.F, mesh.num_vertices(), fc);
+      mesh.N.resize(0, 3);
+      base.N.resize(0, 3);
+      append_mesh(mesh, base);
+    }
+  }
   const std::string up = cl.get("up");
   if (up == "x" || up == "y" || up == "z") {
     o.up_axis = up[0] - 'x';

@@ -8,10 +8,12 @@
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/global_quilting.h"
 #include "core/mesh_io.h"
 #include "core/quilt_embedding.h"
 #include "core/surface_quilting.h"
 #include "core/tangent_field.h"
+#include "core/texture_structure.h"
 #include "host/tet_stretch_evaluator.h"
 #include "host/translation_cost_evaluator.h"
 
@@ -22,12 +24,14 @@ namespace {
 void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
                  const QuiltEmbeddingStats& em, const std::string& embedding,
                  const std::string& device, int threads, double wall, const std::string& base,
-                 const std::string& swatch) {
+                 const std::string& swatch, const std::string& method,
+                 const GlobalQuiltingStats* global, const StructureSummary& structure) {
   JsonWriter j;
   j.begin_object()
       .value("command", "surface")
       .value("base", base)
       .value("swatch", swatch)
+      .value("method", method)
       .value("device", device)
       .value("threads", threads)
       .value("wall_seconds", wall)
@@ -54,6 +58,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
   write_element_counts(j, s.counts);
   j.value("rejected_outside_patch", s.rejected_outside_patch)
       .value("removed_post", em.removed_intersecting)
+      .value("removed_self_intersecting", em.removed_self_intersecting)
       .value("unoptimized_map", em.unoptimized_elements)
       .end_object()
       .begin_object("element_area")
@@ -65,6 +70,23 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("coverage", em.coverage)
       .value("matched_point_offsets", s.matched_point_offsets);
   write_match_counts(j, s.counts);
+  if (global)
+    j.begin_object("global")
+        .value("periodic", global->periodic)
+        .value("seamless", global->seamless)
+        .value("tiled", global->tiled)
+        .value("orbits", global->orbits)
+        .value("singular_vertices", global->singular_vertices)
+        .value("pinned_cones", global->pinned_cones)
+        .value("cut_edges", global->cut_edges)
+        .value("cut_paths", global->cut_paths)
+        .value("worst_transition_error", global->worst_transition_error)
+        .value("scale_correction", global->scale_correction)
+        .value("parameter_area", global->parameter_area)
+        .value("placed", global->placed)
+        .value("off_surface", global->off_surface)
+        .end_object();
+  write_structure(j, structure.output, &structure.swatch, &structure.comparison);
   j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   for (const auto& [stage, seconds] : em.times.stages()) j.value(stage, seconds);
@@ -97,6 +119,11 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("embedding", "shell|normal",
             "place the texture through the shell map or by plain normal displacement", "shell");
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
+  cl.option("method", "auto|global|patches",
+            "global: one field-aligned parameterisation, seamless for a periodic swatch (keeps "
+            "chain mail linked); patches: local conformal patches (the paper's); auto: global "
+            "for a lattice of compact elements",
+            "auto");
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("base")) throw UsageError("--base FILE is required");
@@ -121,6 +148,9 @@ int run_surface(int argc, char** argv, int first) {
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
   const Device device = parse_device(cl.get("device"));
+  const std::string method = cl.get("method");
+  if (method != "auto" && method != "global" && method != "patches")
+    throw UsageError("--method expects auto, global or patches, got '" + method + "'");
 
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
@@ -140,8 +170,12 @@ int run_surface(int argc, char** argv, int first) {
   }
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   SurfaceQuiltingStats stats;
+  GlobalQuiltingStats gstats;
+  const bool global = method == "global" || (method == "auto" && lattice_swatch(swatch));
   const SurfaceQuilt quilt =
-      quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+      global
+          ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
+          : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);
@@ -152,9 +186,16 @@ int run_surface(int argc, char** argv, int first) {
   run.progress()->finish();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!run.stats_path().empty())
+  // The structure figures (issue 13) are measured for --stats: a second or so on a million
+  // faces, not worth it on every run.
+  StructureSummary structure;
+  if (!run.stats_path().empty()) {
+    ScopedStageTimer timer(stats.times, "structure");
+    structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
-                run.threads(), wall, cl.get("base"), cl.get("swatch"));
+                run.threads(), wall, cl.get("base"), cl.get("swatch"),
+                global ? "global" : "patches", global ? &gstats : nullptr, structure);
+  }
   if (!run.quiet()) {
     std::printf(
         "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
@@ -168,12 +209,21 @@ int run_surface(int argc, char** argv, int first) {
       std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n",
                   embedding_stats.stretch_before, embedding_stats.stretch_after,
                   embedding_stats.atlas_charts);
+    if (global)
+      std::printf(
+          "global parameterisation: %d cones, %d cut edges%s; %s plane texture, %d elements "
+          "placed (%d off the surface)\n",
+          gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
+          gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
     std::printf(
-        "%d patches in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-        "%d added, %d matched, %d removed\n",
-        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.counts.stitched,
-        stats.counts.replaced, stats.counts.added, stats.counts.matched,
-        embedding_stats.removed_intersecting);
+        "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+        "%d added, %d matched, %d removed (%d folded)\n",
+        stats.iterations, global ? "plane iterations" : "patches", wall, evaluator->name().c_str(),
+        run.threads(), stats.counts.stitched, stats.counts.replaced, stats.counts.added,
+        stats.counts.matched, embedding_stats.removed_intersecting,
+        embedding_stats.removed_self_intersecting);
+    if (!run.stats_path().empty())
+      print_structure(structure.output, &structure.swatch, &structure.comparison);
   }
   return 0;
 }

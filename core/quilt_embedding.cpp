@@ -1,5 +1,6 @@
 #include "core/quilt_embedding.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -12,6 +13,32 @@
 #include "core/surface_coverage.h"
 
 namespace mq {
+
+namespace {
+
+// The similarity (scale, rotation, translation) taking `from` nearest to `to` in the least
+// squares sense, applied to `from` (Umeyama 1991). Both #V by 3, corresponding rows.
+MatrixX3d similarity_fit(const MatrixX3d& from, const MatrixX3d& to) {
+  const Vector3d cf = from.colwise().mean().transpose(), ct = to.colwise().mean().transpose();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  double var = 0;
+  for (Eigen::Index i = 0; i < from.rows(); ++i) {
+    const Vector3d a = from.row(i).transpose() - cf, b = to.row(i).transpose() - ct;
+    cov += b * a.transpose();
+    var += a.squaredNorm();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) S(2, 2) = -1;
+  const Eigen::Matrix3d R = svd.matrixU() * S * svd.matrixV().transpose();
+  const double scale = var > 0 ? (svd.singularValues().asDiagonal() * S).trace() / var : 1.0;
+  MatrixX3d out(from.rows(), 3);
+  for (Eigen::Index i = 0; i < from.rows(); ++i)
+    out.row(i) = (ct + scale * R * (from.row(i).transpose() - cf)).transpose();
+  return out;
+}
+
+}  // namespace
 
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
                     TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats_out) {
@@ -87,7 +114,11 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     ScopedStageTimer timer(stats.times, "embedding");
     all.V = ShellEmbedding(*map).embed(points);
     if (options.optimize_stretch) {
-      const auto pairs = intersecting_face_pairs(all.V, all.F);
+      // Pairs of faces that intersect, within an element (it folds through itself) or between
+      // two: both kinds keep the unoptimised map.
+      IntersectionOptions all_pairs;
+      all_pairs.between_components_only = false;
+      const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
       // Nothing to revert: post-processing would find the same nothing.
       known_disjoint = pairs.empty();
       std::vector<char> revert(quilt.elements.size(), 0);
@@ -108,13 +139,57 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     all.V = normal_displacement(quilt.input_base.V, quilt.input_base.F, points);
   }
 
-  // Post-processing: of two intersecting elements the later one goes.
-  std::vector<char> drop(quilt.elements.size(), 0);
+  // Repair (issue 13): an element the map folds through itself (over a sharp crease or next
+  // to a cone of the parameterisation the map bends it too sharply) is replaced by its flat
+  // shape moved by the similarity that best fits where the map put it (Umeyama): whole and
+  // unfolded by construction, in its place and at its size.
+  if (options.remove_intersecting) {
+    ScopedStageTimer timer(stats.times, "post-processing");
+    std::vector<int> component_first(quilt.elements.size(), 0);
+    IntersectionOptions all_pairs;
+    all_pairs.between_components_only = false;
+    std::vector<char> folded_now(quilt.elements.size(), 0);
+    for (const int c : self_intersecting_components(all.V, all.F)) {
+      // Components of `all` are the elements, in order.
+      if (c >= 0 && c < static_cast<int>(folded_now.size())) folded_now[c] = 1;
+    }
+    Eigen::Index v0 = 0;
+    for (size_t k = 0; k < quilt.elements.size(); ++k) {
+      const SurfaceElement& e = quilt.elements[k];
+      const Eigen::Index ev = static_cast<Eigen::Index>(e.face.size());
+      if (folded_now[k] && e.flat.rows() == ev) {
+        // As little rigidity as removes the fold: the mapped shape blended towards the fitted
+        // flat one, the first blend without a self-intersection (the flat shape has none).
+        const MatrixX3d placed = all.V.middleRows(v0, ev);
+        const MatrixX3d rigid = similarity_fit(e.flat, placed);
+        MatrixX3d best = rigid;
+        for (const double keep : {0.75, 0.5, 0.25}) {
+          const MatrixX3d blend = keep * placed + (1 - keep) * rigid;
+          if (self_intersecting_components(blend, e.F).empty()) {
+            best = blend;
+            break;
+          }
+        }
+        all.V.middleRows(v0, ev) = best;
+        ++stats.rigid_repairs;
+      }
+      v0 += ev;
+    }
+  }
+
+  // Post-processing (issue 13: no folded element reaches the output): an element that
+  // intersects itself goes; of two intersecting elements the later one goes.
+  std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "post-processing");
-    for (const auto& [f, g] : intersecting_face_pairs(all.V, all.F)) {
+    IntersectionOptions all_pairs;
+    all_pairs.between_components_only = false;
+    const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+    for (const auto& [f, g] : pairs)
+      if (element_of[f] == element_of[g]) folded[element_of[f]] = drop[element_of[f]] = 1;
+    for (const auto& [f, g] : pairs) {
       const int a = element_of[f], b = element_of[g];
-      if (!drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
+      if (a != b && !drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
     }
   }
   TriMesh out;
@@ -138,7 +213,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       const SurfaceElement& e = quilt.elements[k];
       const Eigen::Index ev = static_cast<Eigen::Index>(e.face.size()), ef = e.F.rows();
       if (drop[k]) {
-        ++stats.removed_intersecting;
+        ++(folded[k] ? stats.removed_self_intersecting : stats.removed_intersecting);
       } else {
         out.V.middleRows(kv, ev) = all.V.middleRows(v0, ev);
         out.F.middleRows(kf, ef) = e.F.array() + static_cast<int>(kv);

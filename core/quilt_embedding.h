@@ -1,7 +1,7 @@
 // The final embedding of a surface quilt (paper section 3.2): output vertices, stored in local
 // coordinates over the base, are placed in 3D through the stretch-minimised shell map (default)
 // or by plain normal displacement; elements that cannot be embedded whole without intersecting
-// their neighbours are then removed (post-processing).
+// themselves or their neighbours are then removed (post-processing).
 #pragma once
 
 #include <string>
@@ -23,7 +23,9 @@ struct QuiltEmbeddingStats {
   int optimization_sweeps = 0;
   int atlas_charts = 0;
   int fold_repaired_vertices = 0;
-  int removed_intersecting = 0;
+  int removed_intersecting = 0;       // intersecting another element
+  int removed_self_intersecting = 0;  // folded through itself, and no repair possible
+  int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
   // Elements mapped through the shell map as it was before stretch optimisation, because the
   // optimised map made them intersect another element.
   int unoptimized_elements = 0;

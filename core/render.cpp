@@ -233,13 +233,16 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
   const MatrixX3d NF = face_normals(P, F);
   const MatrixX3d CN = corner_normals(P, F, NF, face_component, smooth);
   std::vector<Vector3d> albedo(num_components);
-  MQ_CHECK(o.element_colors.empty() || static_cast<int>(o.element_colors.size()) == num_components,
+  MQ_CHECK(o.element_colors.empty() ||
+               static_cast<int>(o.element_colors.size()) == num_components ||
+               (o.neutral_from >= 0 && static_cast<int>(o.element_colors.size()) == o.neutral_from),
            InvalidInput, "render: ", o.element_colors.size(), " element colours for ",
            num_components, " elements");
   for (int c = 0; c < num_components; ++c) {
     albedo[c] = element_albedo(c, o.color_elements);
-    if (!o.element_colors.empty())
+    if (!o.element_colors.empty() && c < static_cast<int>(o.element_colors.size()))
       for (int k = 0; k < 3; ++k) albedo[c](k) = srgb_to_linear(o.element_colors[c][k] / 255.0);
+    if (o.neutral_from >= 0 && c >= o.neutral_from) albedo[c] = element_albedo(c, false);
   }
 
   // Embree scene.

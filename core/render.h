@@ -25,6 +25,9 @@ struct RenderOptions {
   // When not empty: the colour (sRGB) of each connected component in order, overriding the
   // hue sequence (e.g. elements coloured by a figure such as their link count).
   std::vector<std::array<unsigned char, 3>> element_colors;
+  // Components from this index on (in connected_components order) are drawn in the neutral clay
+  // colour whatever the colouring: a base surface appended after the texture (-1: none).
+  int neutral_from = -1;
   std::array<unsigned char, 3> background{{245, 245, 245}};
   int samples_per_pixel = 4;  // fixed sub-pixel pattern, in [1, 64]
   bool shadows = true;        // hard shadows from the key light

@@ -13,6 +13,7 @@
 #include "core/local_patch.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
+#include "core/planar_quilting.h"
 #include "core/quilt_elements.h"
 #include "core/tangent_field.h"
 #include "core/weld_vertices.h"
@@ -334,12 +335,8 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
   return out;
 }
 
-SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
-                           const SurfaceQuiltingOptions& options,
-                           TranslationCostEvaluator& evaluator, SurfaceQuiltingStats* stats_out,
-                           ProgressSink* progress) {
-  SurfaceQuiltingStats stats;
-  StageTimes& times = stats.times;
+SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                               const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
   validate_base(base_in);
   MQ_CHECK(std::isfinite(options.base_edge_fraction) && options.base_edge_fraction > 0,
            InvalidInput, "base_edge_fraction must be positive and finite, got ",
@@ -349,58 +346,68 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
            "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
            " base faces");
+  ScopedStageTimer timer(stats.times, "prepare");
+  SurfaceJob job;
+  // Exporters split vertices along hard edges; welded, a box's sides form one surface and
+  // patches (and elements) can wrap around its edges.
+  job.cleaned = weld_vertices(base_in, &stats.welded_vertices);
   // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
   // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
   // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
-  TriMesh cleaned, base;
-  Refinement refinement;
-  MatrixX3d input_field;
-  {
-    ScopedStageTimer timer(times, "prepare");
-    // Exporters split vertices along hard edges; welded, a box's sides form one surface and
-    // patches (and elements) can wrap around its edges.
-    cleaned = weld_vertices(base_in, &stats.welded_vertices);
-    const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-    base = bisect_longest_edges(cleaned, options.scale * diagonal * options.base_edge_fraction,
-                                2'000'000, &refinement);
-    // The field is per input face.
-    if (options.field.rows()) {
-      input_field.resize(base.num_faces(), 3);
-      for (int f = 0; f < base.num_faces(); ++f)
-        input_field.row(f) = options.field.row(refinement.parent[static_cast<size_t>(f)]);
-    }
+  const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
+  job.base =
+      bisect_longest_edges(job.cleaned, options.scale * diagonal * options.base_edge_fraction,
+                           2'000'000, &job.refinement);
+  stats.base_faces = job.base.num_faces();
+  // The field is per input face.
+  if (options.field.rows()) {
+    job.field.resize(job.base.num_faces(), 3);
+    for (int f = 0; f < job.base.num_faces(); ++f)
+      job.field.row(f) = options.field.row(job.refinement.parent[static_cast<size_t>(f)]);
+  } else {
+    job.field = smooth_tangent_field(job.base.V, job.base.F);
   }
-  const int nf = base.num_faces();
-  stats.base_faces = nf;
-
+  job.topo = edge_topology(job.base.F, job.base.num_vertices());
+  job.TT = face_adjacency(job.topo);
   // The swatch at its size on the surface (section 3.1's relative size s).
+  const double refined_diagonal = bounding_box(job.base.V, job.base.F).extent().norm();
+  const PreparedSwatch unit = prepare_swatch(swatch_mesh);
+  job.swatch_scale = options.scale * refined_diagonal / std::max(unit.size.x(), unit.size.y());
+  job.swatch = swatch_mesh;
+  job.swatch.V *= job.swatch_scale;
+  stats.swatch_scale = job.swatch_scale;
+  return job;
+}
+
+SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                           const SurfaceQuiltingOptions& options,
+                           TranslationCostEvaluator& evaluator, SurfaceQuiltingStats* stats_out,
+                           ProgressSink* progress) {
+  SurfaceQuiltingStats stats;
+  StageTimes& times = stats.times;
+  SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
+  TriMesh& cleaned = job.cleaned;
+  const TriMesh& base = job.base;
+  Refinement& refinement = job.refinement;
+  const MatrixX3d& field = job.field;
+  const EdgeTopology& topo = job.topo;
+  const MatrixX3i& TT = job.TT;
+  const int nf = base.num_faces();
+
   PreparedSwatch swatch;
-  MatrixX3d field;
   std::unique_ptr<SwatchFaceTree> swatch_tree;
   const EmbreeDevice embree;  // one device for every BVH of the run
   LaplacianTopologyCache laplacians;
-  EdgeTopology topo;
-  MatrixX3i TT;
   {
     ScopedStageTimer timer(times, "prepare");
-    const double diagonal = bounding_box(base.V, base.F).extent().norm();
-    PreparedSwatch unit = prepare_swatch(swatch_mesh);
-    const double factor = options.scale * diagonal / std::max(unit.size.x(), unit.size.y());
-    TriMesh scaled = swatch_mesh;
-    scaled.V *= factor;
-    swatch = prepare_swatch(scaled);
-    stats.swatch_scale = factor;
+    swatch = prepare_swatch(job.swatch);
     swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
     laplacians = swatch_topologies(swatch);
-    field = input_field.rows() ? input_field : smooth_tangent_field(base.V, base.F);
-    topo = edge_topology(base.F, base.num_vertices());
-    TT = face_adjacency(topo);
   }
   const SwatchQueries queries{*swatch_tree, embree, laplacians};
   const double H = swatch.size.z();
   stats.shell_height = H;
-  const double cell = std::min(0.5 * swatch.mean_element_diameter,
-                               std::min(swatch.size.x(), swatch.size.y()) / 8.0);
+  const double cell = matching_cell_size(swatch);
   stats.cell_size = cell;
   const int swatch_cells =
       static_cast<int>(std::floor(std::min(swatch.size.x(), swatch.size.y()) / cell + 1e-9));

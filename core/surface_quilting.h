@@ -9,6 +9,7 @@
 
 #include "core/geometry_matching.h"
 #include "core/longest_edge_bisection.h"
+#include "core/mesh_topology.h"
 #include "core/patch_quilting.h"
 #include "core/progress.h"
 #include "core/stage_timer.h"
@@ -23,6 +24,10 @@ struct SurfaceElement {
   std::vector<int> face;   // #V base faces
   MatrixX3d barycentric;   // #V by 3
   Eigen::VectorXd height;  // #V
+  // Optional (#V by 3, or empty): the element as it was placed, in the flat frame of its
+  // placement (a rigid copy of its swatch element). The embedding falls back to it, moved
+  // rigidly, where the map folds the element through itself.
+  MatrixX3d flat;
 };
 
 struct SurfaceQuilt {
@@ -62,6 +67,20 @@ struct SurfaceQuiltingOptions {
   }();
   PatchQuiltingOptions patch;
   uint64_t seed = 1;
+  // The global-parameterisation method (core/global_quilting).
+  struct Global {
+    // Weight of the guidance field against the line field's smoothness: small lets the
+    // field's poles split into the mild half-turn cones a lattice can close around.
+    double guidance_weight = 1e-3;
+    // Weight of the one implicit Laplacian step that smooths the copy of the base the field and
+    // the parameterisation are computed on (0: the base itself).
+    double smoothing = 1.0;
+    // Pin the cones and fix the transitions at the texture's symmetries (periodic swatches).
+    bool seamless = true;
+    // A periodic swatch of compact elements is tiled over the parameter plane (the planar
+    // quilt it would give); else the plane is quilted.
+    bool tile = true;
+  } global;
 };
 
 struct SurfaceQuiltingStats {
@@ -78,6 +97,25 @@ struct SurfaceQuiltingStats {
   int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
   StageTimes times;
 };
+
+// The base and the swatch as both surface methods work on them: the base with coincident
+// vertices welded and refined, the guidance field on the refined faces (the smooth default when
+// none is given), the swatch scaled to its size on the surface.
+struct SurfaceJob {
+  TriMesh cleaned;        // the base as given, coincident vertices welded
+  TriMesh base;           // cleaned, refined by longest-edge bisection
+  Refinement refinement;  // base faces in cleaned faces
+  MatrixX3d field;        // #F(base) by 3 unit tangents
+  EdgeTopology topo;
+  MatrixX3i TT;
+  double swatch_scale = 0;  // factor applied to the swatch
+  TriMesh swatch;           // the swatch scaled by it
+};
+
+// Validates the inputs (the same throws as quilt_surface) and prepares a SurfaceJob; times go
+// to the stage "prepare", welded vertices and base faces to stats.
+SurfaceJob prepare_surface_job(const TriMesh& base, const TriMesh& swatch,
+                               const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats);
 
 // Runs mesh quilting over `base`. Local coordinates in the result refer to the base (coincident
 // vertices welded) refined by bisect_longest_edges(base, scale * diagonal * base_edge_fraction,

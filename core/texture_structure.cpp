@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <queue>
 #include <unordered_map>
 
+#include "core/closest_point_query.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
@@ -117,6 +119,7 @@ ElementShape shape_of(const TriMesh& part, int loop_bins) {
   for (Eigen::Index v = 0; v < V.rows(); ++v)
     r = std::max(r, (V.row(v).transpose() - out.s.centre).norm());
   out.s.size = 2 * r;
+  out.s.area = surface_area(V, part.F);
   out.loop = ring_centre_loop(V, part.F, loop_bins);
   out.s.ring = out.loop.has_value();
   if (out.s.ring || V.rows() < 2) return out;
@@ -252,14 +255,16 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
   });
   report.elements.resize(static_cast<size_t>(n));
   std::vector<Vector3d> centres(static_cast<size_t>(n));
-  std::vector<double> sizes(static_cast<size_t>(n)), widths;
+  std::vector<double> sizes(static_cast<size_t>(n)), areas(static_cast<size_t>(n)), widths;
   for (int c = 0; c < n; ++c) {
     report.elements[c] = shapes[c].s;
     centres[c] = shapes[c].s.centre;
     sizes[c] = shapes[c].s.size;
+    areas[c] = shapes[c].s.area;
     if (shapes[c].s.long_element) widths.push_back(shapes[c].s.width);
   }
   report.median_size = median(sizes);
+  report.median_area = median(areas);
   if (n == 0) return report;
 
   // Nearest other centre, searched in the 27 cells of a grid of the median element size.
@@ -384,12 +389,17 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
       if (!report.elements[c].interior || !(radius > 0)) return;
       const Vector3d r = Vector3d::Constant(radius);
       std::vector<Vector3d> others;
-      for (const int d : grid.query_box(centres[c] - r, centres[c] + r))
-        if (d != c && (centres[d] - centres[c]).norm() <= radius) others.push_back(centres[d]);
+      const Vector3d own =
+          options.surface_normal ? options.surface_normal(centres[c]) : Vector3d::Zero();
+      for (const int d : grid.query_box(centres[c] - r, centres[c] + r)) {
+        if (d == c || (centres[d] - centres[c]).norm() > radius) continue;
+        if (options.surface_normal && options.surface_normal(centres[d]).dot(own) < 0.5) continue;
+        others.push_back(centres[d]);
+      }
       if (others.size() < 3) return;
       Vector3d normal;
       if (options.surface_normal) {
-        normal = options.surface_normal(centres[c]);
+        normal = own;
       } else {
         Vector3d mean = centres[c];
         for (const Vector3d& o : others) mean += o;
@@ -517,12 +527,35 @@ StructureComparison compare_structure(const StructureReport& output, const Swatc
   StructureComparison c;
   c.interior_links = swatch.interior_links;
   c.share_matching = output.share_with_links(swatch.interior_links);
-  c.linear_scale = linear_scale > 0                ? linear_scale
-                   : swatch.report.median_size > 0 ? output.median_size / swatch.report.median_size
-                                                   : 0;
+  c.linear_scale = linear_scale > 0 ? linear_scale
+                   : swatch.report.median_area > 0
+                       ? std::sqrt(output.median_area / swatch.report.median_area)
+                       : 0;
   if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0)
     c.density_ratio = output.density / (swatch.density / (c.linear_scale * c.linear_scale));
   return c;
+}
+
+StructureSummary summarize_structure(const TriMesh& output, const TriMesh& swatch,
+                                     const TriMesh* base, double linear_scale) {
+  StructureSummary out;
+  StructureOptions so;
+  std::unique_ptr<ClosestPointQuery> query;
+  MatrixX3d normals;
+  if (base) {
+    so.automatic_border = false;
+    so.border = mesh_border(base->V, base->F);
+    so.area = surface_area(base->V, base->F);
+    query = std::make_unique<ClosestPointQuery>(base->V, base->F);
+    normals = face_normals(base->V, base->F);
+    so.surface_normal = [&](const Vector3d& p) -> Vector3d {
+      return normals.row(query->closest(p).face).transpose();
+    };
+  }
+  out.output = measure_structure(output, so);
+  out.swatch = measure_swatch_structure(swatch);
+  out.comparison = compare_structure(out.output, out.swatch, linear_scale);
+  return out;
 }
 
 }  // namespace mq

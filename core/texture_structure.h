@@ -46,7 +46,9 @@ struct StructureOptions {
   // centres' box grown by the median nearest-centre distance), unknown otherwise.
   double area = 0;
   // Unit normal of the surface under a point, for the tangent planes of the density measure;
-  // empty: the normal of the plane best fitting the element's neighbour centres.
+  // empty: the normal of the plane best fitting the element's neighbour centres. When given,
+  // neighbours whose surface faces another way (the other side of a cup's wall, of an ear)
+  // are no neighbours.
   std::function<Vector3d(const Vector3d&)> surface_normal;
   int loop_bins = 32;  // points per ring centre loop
 };
@@ -55,6 +57,7 @@ struct StructureOptions {
 struct ElementStructure {
   Vector3d centre = Vector3d::Zero();  // mean vertex
   double size = 0;                     // twice the largest distance from the centre to a vertex
+  double area = 0;                     // surface area of the element
   bool ring = false;                   // closed genus-1 and surrounds its centre (has a loop)
   int links = 0;                       // rings it is interlinked with (|linking number| >= 1)
   bool interior = true;                // farther than interior_margin from the border
@@ -68,6 +71,7 @@ struct StructureReport {
   std::vector<std::pair<int, int>> linked_pairs;  // (i, j), i < j, ascending
   TextureBorder::Kind border = TextureBorder::Kind::None;
   double median_size = 0;
+  double median_area = 0;     // of the elements' surface areas
   double median_spacing = 0;  // median distance from an element centre to the nearest other
   int rings = 0, interior_rings = 0, isolated_rings = 0;  // isolated: no link at all
   // [k]: interior rings interlinked with exactly k others.
@@ -115,9 +119,21 @@ struct StructureComparison {
   double linear_scale = 0;    // output length units per swatch unit
 };
 
-// linear_scale: output length per swatch length; 0 estimates it as the ratio of the median
-// element sizes (rings bend and stretch a little on curved bases, so give it when known).
+// linear_scale: output length per swatch length; 0 estimates it from the median element
+// surface areas (their square root; a size along one direction would follow the stretch of
+// curved bases), so give it when known.
 StructureComparison compare_structure(const StructureReport& output, const SwatchStructure& swatch,
                                       double linear_scale = 0);
+
+// The figures of an output against its swatch in one call: measured with the base's boundary,
+// area and normals when a base is given (a surface result), else as a flat layer; compared at
+// linear_scale (0: estimated).
+struct StructureSummary {
+  StructureReport output;
+  SwatchStructure swatch;
+  StructureComparison comparison;
+};
+StructureSummary summarize_structure(const TriMesh& output, const TriMesh& swatch,
+                                     const TriMesh* base = nullptr, double linear_scale = 0);
 
 }  // namespace mq

@@ -70,6 +70,26 @@ TriMesh plane_grid(double w, double h, int nx, int ny) {
   return g;
 }
 
+TriMesh open_cylinder(double r, double h, int n, int m) {
+  TriMesh c;
+  c.V.resize(n * (m + 1), 3);
+  c.F.resize(2 * n * m, 3);
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * i / n;
+      c.V.row(j * n + i) << r * std::cos(a), r * std::sin(a), h * j / m;
+    }
+  int f = 0;
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * n + i, b = j * n + (i + 1) % n, cc = (j + 1) * n + (i + 1) % n,
+                d = (j + 1) * n + i;
+      c.F.row(f++) << a, b, cc;
+      c.F.row(f++) << a, cc, d;
+    }
+  return c;
+}
+
 void expect_same_points_on_coarse(const TriMesh& fine, const TriMesh& coarse, int stride,
                                   const std::function<void(int&, Vector3d&)>& to_coarse) {
   for (int f = 0; f < fine.num_faces(); f += stride) {

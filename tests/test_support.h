@@ -23,6 +23,10 @@ TriMesh torus(double R, double r, int n, int m);
 // Open regular grid in the z = 0 plane over [0,w]x[0,h], nx by ny quads split in two.
 TriMesh plane_grid(double w, double h, int nx, int ny);
 
+// Open cylinder of radius r around the z axis over [0, h], n segments around, m along, faces
+// counter-clockwise seen from outside.
+TriMesh open_cylinder(double r, double h, int n, int m);
+
 // Expects every stride-th face of `fine`, a refinement of `coarse`, to map through
 // to_coarse(face, barycentric) onto the same 3D point of `coarse` (within 1e-12), with
 // barycentric coordinates that sum to 1 and are not negative.

@@ -1,0 +1,49 @@
+// Mesh quilting over a curved surface through one field-aligned global parameterisation: the
+// planar algorithm of section 2 grows the swatch over the parameter plane, and every element is
+// carried onto the base through the charts (core/global_parameterization).
+//
+// Why, beyond the paper's section 3.1: there, each patch is flattened on its own and the
+// texture the earlier patches placed is seen through a slightly different map; on a curved base
+// the misfit between neighbouring patches (a few percent of scale and turn) is more than chain
+// mail's clearance, and rings come out disjoint or missing along every seam (measured: 60% of
+// interior rings with their 4 links on a sphere, 36% on Spot). Through one parameterisation the
+// planar quilt keeps its structure everywhere the charts agree: inside each chart exactly, and
+// across the cut graph up to the rigid transition between charts.
+#pragma once
+
+#include "core/surface_quilting.h"
+
+namespace mq {
+
+struct GlobalQuiltingStats {
+  bool periodic = false;      // the swatch's lattice was found (core/swatch_symmetry)
+  bool seamless = false;      // cones pinned and transitions fixed at the texture's symmetries
+  bool tiled = false;         // the plane texture is the lattice tiling (else a planar quilt)
+  int orbits = 0;             // elements per lattice cell, when tiled
+  int singular_vertices = 0;  // of the line field
+  int pinned_cones = 0;
+  int cut_edges = 0, cut_paths = 0;
+  // Largest distance of a transition from the texture's nearest symmetry, in lattice periods
+  // (the constraints are soft; a ring's clearance in the 4-in-1 sheet is about 0.2).
+  double worst_transition_error = 0;
+  double scale_correction = 1;  // the parameterisation's scale, made 1 at the median face
+  double parameter_area = 0;    // of the parameter plane textured
+  int placed = 0;               // elements carried onto the base
+  int off_surface = 0;          // left out: a vertex beyond a boundary or around a singular vertex
+};
+
+// Whether a swatch is a lattice of compact elements (periodic, core/swatch_symmetry), the
+// textures for which the global method keeps the structure the patch method loses: what the
+// command's --method auto goes by. Throws InvalidInput for a swatch prepare_swatch rejects.
+bool lattice_swatch(const TriMesh& swatch);
+
+// Like quilt_surface (same options, same result), through a global parameterisation.
+// Throws like quilt_surface.
+SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
+                                  const SurfaceQuiltingOptions& options,
+                                  TranslationCostEvaluator& evaluator,
+                                  SurfaceQuiltingStats* stats = nullptr,
+                                  GlobalQuiltingStats* global_stats = nullptr,
+                                  ProgressSink* progress = nullptr);
+
+}  // namespace mq

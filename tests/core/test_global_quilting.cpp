@@ -1,0 +1,113 @@
+// Surface quilting through the global parameterisation on generated bases (a flat square, an
+// open cylinder, a sphere): chain mail keeps its structure, every element is whole, and the run
+// is deterministic. The shipped meshes are in tests/slow/test_surface_structure.cpp.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "core/global_quilting.h"
+#include "core/mesh_intersections.h"
+#include "core/quilt_embedding.h"
+#include "core/tangent_field.h"
+#include "core/texture_structure.h"
+#include "tests/core/planar_checks.h"
+#include "tests/core/shell_fixtures.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+struct GlobalRun {
+  SurfaceQuiltingStats stats;
+  GlobalQuiltingStats global;
+  QuiltEmbeddingStats embedding;
+  TriMesh output;
+  StructureSummary structure;
+};
+
+// The tiny 3 x 3 sheet (rings of 2.24 swatch units across) at `ring` base units across.
+GlobalRun run(const TriMesh& base, double ring, const MatrixX3d& field = MatrixX3d()) {
+  GlobalRun r;
+  const TriMesh swatch = test::tiny_chainmail();
+  const double diagonal = bounding_box(base.V, base.F).extent().norm();
+  SurfaceQuiltingOptions o;
+  o.scale = ring / 2.24 * bounding_box(swatch.V).extent().head<2>().maxCoeff() / diagonal;
+  o.field = field;
+  TranslationCostCpu cost;
+  const SurfaceQuilt quilt = quilt_surface_global(base, swatch, o, cost, &r.stats, &r.global);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;  // the texture decides the links; the shell map is tested on its own
+  TetStretchCpu stretch;
+  r.output = embed_quilt(quilt, e, stretch, &r.embedding);
+  r.structure = summarize_structure(r.output, swatch, &base, r.stats.swatch_scale);
+  return r;
+}
+
+void expect_mail(const GlobalRun& r, double share, const char* what) {
+  SCOPED_TRACE(what);
+  const StructureComparison& c = r.structure.comparison;
+  const StructureReport& s = r.structure.output;
+  std::printf(
+      "[ measure  ] %s: %d rings (%d interior), %.2f%% with 4 links, %d isolated, "
+      "density %.1f%%, %d cones, %d off the surface, %d folded, %d intersecting\n",
+      what, s.rings, s.interior_rings, 100 * c.share_matching, s.isolated_rings,
+      100 * c.density_ratio, r.global.singular_vertices, r.global.off_surface,
+      r.embedding.removed_self_intersecting, r.embedding.removed_intersecting);
+  EXPECT_TRUE(r.global.periodic);
+  EXPECT_TRUE(r.global.tiled);
+  ASSERT_EQ(c.interior_links, 4);
+  ASSERT_GT(s.interior_rings, 100);
+  EXPECT_GE(c.share_matching, share);
+  EXPECT_LE(s.isolated_rings, 0.01 * s.rings);
+  EXPECT_GE(c.density_ratio, 0.9);
+  // Nothing reaches the output intersecting itself or another element.
+  EXPECT_TRUE(intersecting_face_pairs(r.output.V, r.output.F).empty());
+  EXPECT_TRUE(self_intersecting_components(r.output.V, r.output.F).empty());
+  EXPECT_GE(r.embedding.coverage, 0.95);
+}
+
+TEST(GlobalQuilting, FlatSquareIsThePlane) {
+  const TriMesh base = test::plane_grid(12, 12, 24, 24);
+  const GlobalRun r =
+      run(base, 1.0, tangent_field_from_direction(base.V, base.F, Vector3d::UnitX()));
+  expect_mail(r, 0.98, "flat square");
+  EXPECT_EQ(r.global.singular_vertices, 0);
+  EXPECT_EQ(r.global.cut_edges, 0);
+  EXPECT_NEAR(r.structure.comparison.density_ratio, 1.0, 0.02);
+}
+
+TEST(GlobalQuilting, CylinderAlongItsAxis) {
+  const TriMesh base = test::open_cylinder(2.0, 3.0, 48, 12);
+  const GlobalRun r =
+      run(base, 0.2, tangent_field_from_direction(base.V, base.F, Vector3d::UnitZ()));
+  expect_mail(r, 0.95, "cylinder, rings a tenth of the radius");
+  EXPECT_EQ(r.global.singular_vertices, 0);
+  EXPECT_TRUE(r.global.seamless);
+  EXPECT_LT(r.global.worst_transition_error, 0.05);
+}
+
+TEST(GlobalQuilting, SphereWithItsFourCones) {
+  TriMesh base = test::icosphere(4);
+  base.V *= 3.0;
+  const GlobalRun r = run(base, 0.6);
+  expect_mail(r, 0.95, "sphere, rings a fifth of the radius");
+  EXPECT_EQ(r.global.singular_vertices, 4);
+  EXPECT_EQ(r.global.pinned_cones, 4);
+  EXPECT_TRUE(r.global.seamless);
+  EXPECT_LT(r.global.worst_transition_error, 0.2);
+}
+
+TEST(GlobalQuilting, SameInputSameBytesWhateverTheThreadCount) {
+  TriMesh base = test::icosphere(3);
+  base.V *= 2.0;
+  std::vector<TriMesh> outs;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    outs.push_back(run(base, 0.6).output);
+  }
+  ASSERT_GT(outs[0].num_faces(), 0);
+  EXPECT_EQ(outs[0].V, outs[1].V);
+  EXPECT_EQ(outs[0].F, outs[1].F);
+}
+
+}  // namespace
+}  // namespace mq
