@@ -11,6 +11,7 @@
 #include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
+#include "core/surface_quilting.h"
 #include "core/texture_structure.h"
 
 namespace mq::cli {
@@ -33,13 +34,19 @@ int run_info(int argc, char** argv, int first) {
   cl.option("base", "FILE",
             "with --links: the base mesh of a surface result (its area and boundary)");
   cl.option("scale", "S",
-            "with --swatch: output units per swatch unit (default: from the element sizes)");
+            "with --swatch and --base: the scale the result was quilted at, as surface --scale "
+            "(default: estimated from the element sizes)");
+  cl.option("elements", "CSV",
+            "with --links: write one line per element (centre, size, area, ring, links, interior, "
+            "length, interior ends) to this CSV file");
   if (!cl.parse(argc, argv, first)) return 0;
   const std::string path = cl.positional_value("FILE");
   const bool links = cl.has("links");
-  if (!links && (cl.has("swatch") || cl.has("base") || cl.has("scale")))
-    throw UsageError("--swatch, --base and --scale need --links");
-  const double linear_scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
+  if (!links && (cl.has("swatch") || cl.has("base") || cl.has("scale") || cl.has("elements")))
+    throw UsageError("--swatch, --base, --scale and --elements need --links");
+  if (cl.has("scale") && !(cl.has("swatch") && cl.has("base")))
+    throw UsageError("--scale needs --swatch and --base (it is relative to the base's size)");
+  const double scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
   const TriMesh mesh = read_mesh(path);
   std::optional<SwatchStructure> swatch;
   StructureReport structure;
@@ -48,8 +55,11 @@ int run_info(int argc, char** argv, int first) {
     std::optional<TriMesh> base;
     if (cl.has("base")) base = read_mesh(cl.get("base"));
     if (cl.has("swatch")) {
-      const StructureSummary s = summarize_structure(mesh, read_mesh(cl.get("swatch")),
-                                                     base ? &*base : nullptr, linear_scale);
+      const TriMesh swatch_mesh = read_mesh(cl.get("swatch"));
+      // Output units per swatch unit, as the surface command computed it.
+      const double linear_scale = scale > 0 ? swatch_scale_for(*base, swatch_mesh, scale) : 0;
+      const StructureSummary s =
+          summarize_structure(mesh, swatch_mesh, base ? &*base : nullptr, linear_scale);
       structure = s.output;
       swatch = s.swatch;
       comparison = s.comparison;
@@ -62,6 +72,18 @@ int run_info(int argc, char** argv, int first) {
       }
       structure = measure_structure(mesh, so);
     }
+  }
+  if (links && cl.has("elements")) {
+    std::string csv = "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends\n";
+    char line[256];
+    for (size_t k = 0; k < structure.elements.size(); ++k) {
+      const ElementStructure& e = structure.elements[k];
+      std::snprintf(line, sizeof line, "%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.9g,%d\n", k,
+                    e.centre.x(), e.centre.y(), e.centre.z(), e.size, e.area, e.ring ? 1 : 0,
+                    e.links, e.interior ? 1 : 0, e.long_element ? 1 : 0, e.length, e.interior_ends);
+      csv += line;
+    }
+    write_file_atomically(cl.get("elements"), csv);
   }
   const TopologyReport topo = topology_report(mesh);
   const BoundingBox box = bounding_box(mesh.V, mesh.F);

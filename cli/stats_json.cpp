@@ -122,7 +122,7 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
       std::printf("structure kept:    %.2f%% of interior rings link %d others, as in the swatch\n",
                   100 * comparison->share_matching, comparison->interior_links);
     if (comparison->density_ratio > 0)
-      std::printf("density ratio:     %.2f%% of the swatch's (scale %.6g)\n",
+      std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",
                   100 * comparison->density_ratio, comparison->linear_scale);
   }
 }

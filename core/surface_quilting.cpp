@@ -335,6 +335,16 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
   return out;
 }
 
+double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale) {
+  MQ_CHECK(std::isfinite(scale) && scale > 0, InvalidInput,
+           "the swatch scale must be positive and finite, got ", scale);
+  MQ_CHECK(base.num_faces() > 0 && swatch.num_faces() > 0, InvalidInput,
+           "the swatch scale needs a non-empty base and swatch");
+  const double diagonal = bounding_box(base.V, base.F).extent().norm();
+  const PreparedSwatch unit = prepare_swatch(swatch);
+  return scale * diagonal / std::max(unit.size.x(), unit.size.y());
+}
+
 SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mesh,
                                const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
   validate_base(base_in);
@@ -370,9 +380,7 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   job.topo = edge_topology(job.base.F, job.base.num_vertices());
   job.TT = face_adjacency(job.topo);
   // The swatch at its size on the surface (section 3.1's relative size s).
-  const double refined_diagonal = bounding_box(job.base.V, job.base.F).extent().norm();
-  const PreparedSwatch unit = prepare_swatch(swatch_mesh);
-  job.swatch_scale = options.scale * refined_diagonal / std::max(unit.size.x(), unit.size.y());
+  job.swatch_scale = swatch_scale_for(job.base, swatch_mesh, options.scale);
   job.swatch = swatch_mesh;
   job.swatch.V *= job.swatch_scale;
   stats.swatch_scale = job.swatch_scale;

@@ -112,6 +112,12 @@ struct SurfaceJob {
   TriMesh swatch;           // the swatch scaled by it
 };
 
+// The factor taking swatch units to base units for SurfaceQuiltingOptions::scale = `scale`: the
+// swatch's longer side (of its prepared footprint) becomes `scale` times the base's bounding-box
+// diagonal (section 3.1's relative size s). Throws InvalidInput for scale <= 0 or not finite, an
+// empty base or swatch.
+double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale);
+
 // Validates the inputs (the same throws as quilt_surface) and prepares a SurfaceJob; times go
 // to the stage "prepare", welded vertices and base faces to stats.
 SurfaceJob prepare_surface_job(const TriMesh& base, const TriMesh& swatch,

@@ -306,6 +306,80 @@ TEST(Cli, RenderWritesAPng) {
   EXPECT_EQ(be32(20), 48u);
 }
 
+// Issue 13's structure measure as a user runs it: on a quilted plane of the default job's coarse
+// sheet, interior rings keep the swatch's 4 links, nothing folds, and the figures are in --json.
+TEST(Cli, InfoLinksMeasuresAQuiltedPlane) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(
+      meshquilt(dir, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw.obj --quiet").status, 0);
+  ASSERT_EQ(meshquilt(dir, "plane --swatch sw.obj --size 12 12 -o p.obj --quiet").status, 0);
+  const CliRun t = meshquilt(dir, "info p.obj --links --swatch sw.obj --intersections");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("structure kept:    100.00% of interior rings link 4 others"),
+            std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("self-intersecting elements: 0"), std::string::npos) << t.out;
+  const CliRun j = meshquilt(dir, "info p.obj --links --swatch sw.obj --json");
+  ASSERT_EQ(j.status, 0) << j.err;
+  EXPECT_EQ(json_value(j.out, "interior_links"), "4");
+  EXPECT_GE(std::stod(json_value(j.out, "share_with_swatch_links")), 0.98);
+  EXPECT_GE(std::stod(json_value(j.out, "density_ratio")), 0.95);
+  EXPECT_EQ(json_value(j.out, "isolated_rings"), "0");
+  // --swatch without --links is a usage error.
+  EXPECT_EQ(meshquilt(dir, "info p.obj --swatch sw.obj").status, 2);
+}
+
+// The surface command's methods on a generated flat base: auto takes the global method for the
+// chain mail sheet and reproduces the plane's structure; patches runs too; a bad name is a
+// usage error. The base drawn under the texture renders.
+TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(
+      meshquilt(dir, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw.obj --quiet").status, 0);
+  const TriMesh grid = test::plane_grid(10, 10, 20, 20);
+  std::ostringstream obj;
+  for (int v = 0; v < grid.num_vertices(); ++v)
+    obj << "v " << grid.V(v, 0) << " " << grid.V(v, 1) << " " << grid.V(v, 2) << "\n";
+  for (int f = 0; f < grid.num_faces(); ++f)
+    obj << "f " << grid.F(f, 0) + 1 << " " << grid.F(f, 1) + 1 << " " << grid.F(f, 2) + 1 << "\n";
+  spit(dir + "/grid.obj", obj.str());
+  const std::string job = "surface --base grid.obj --swatch sw.obj --scale 0.07 --field 1 0 0";
+  const CliRun a = meshquilt(dir, job + " -o a.obj --stats a.json --quiet");
+  ASSERT_EQ(a.status, 0) << a.err;
+  const std::string stats = slurp(dir + "/a.json");
+  EXPECT_NE(stats.find("\"method\": \"global\""), std::string::npos);
+  EXPECT_GE(std::stod(json_value(stats, "share_with_swatch_links")), 0.98);
+  EXPECT_EQ(json_value(stats, "removed_self_intersecting"), "0");
+  // info --scale takes surface's --scale (relative to the base) and agrees with its stats.
+  const CliRun i =
+      meshquilt(dir,
+                "info a.obj --links --swatch sw.obj --base grid.obj --scale 0.07 --json "
+                "--elements e.csv");
+  ASSERT_EQ(i.status, 0) << i.err;
+  EXPECT_NEAR(std::stod(json_value(i.out, "density_ratio")),
+              std::stod(json_value(stats, "density_ratio")), 1e-6);
+  EXPECT_NEAR(std::stod(json_value(i.out, "density_ratio")), 1.0, 0.08);
+  const std::string csv = slurp(dir + "/e.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends");
+  EXPECT_EQ(static_cast<int>(std::count(csv.begin(), csv.end(), '\n')) - 1,
+            std::stoi(json_value(i.out, "rings")));
+  EXPECT_EQ(meshquilt(dir, "info a.obj --links --swatch sw.obj --scale 0.07").status, 2);
+  const CliRun p = meshquilt(dir, job + " --method patches -o p.obj --stats p.json --quiet");
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_NE(slurp(dir + "/p.json").find("\"method\": \"patches\""), std::string::npos);
+  EXPECT_EQ(meshquilt(dir, job + " --method bogus -o b.obj").status, 2);
+  EXPECT_FALSE(fs::exists(dir + "/b.obj"));
+  const CliRun r = meshquilt(
+      dir, "render a.obj --base grid.obj --color links -o pic.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir + "/pic.png").substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const CliRun c = meshquilt(dir, "render a.obj --crop 100 100 100 1 -o none.png");
+  EXPECT_EQ(c.status, 1);
+  EXPECT_EQ(c.err_lines().size(), 1u);
+  EXPECT_FALSE(fs::exists(dir + "/none.png"));
+}
+
 TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
   const std::string dir = test::temp_dir();
   const std::string sw = small_swatch(dir);
