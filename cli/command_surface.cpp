@@ -59,6 +59,8 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
   j.value("rejected_outside_patch", s.rejected_outside_patch)
       .value("removed_post", em.removed_intersecting)
       .value("removed_self_intersecting", em.removed_self_intersecting)
+      .value("rigid_repairs", em.rigid_repairs)
+      .value("shrunk_to_fit", em.shrunk_to_fit)
       .value("unoptimized_map", em.unoptimized_elements)
       .end_object()
       .begin_object("element_area")
@@ -215,13 +217,19 @@ int run_surface(int argc, char** argv, int first) {
           "placed (%d off the surface)\n",
           gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
           gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
-    std::printf(
-        "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-        "%d added, %d matched, %d removed (%d folded)\n",
-        stats.iterations, global ? "plane iterations" : "patches", wall, evaluator->name().c_str(),
-        run.threads(), stats.counts.stitched, stats.counts.replaced, stats.counts.added,
-        stats.counts.matched, embedding_stats.removed_intersecting,
-        embedding_stats.removed_self_intersecting);
+    if (global && gstats.tiled)
+      std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", wall,
+                  evaluator->name().c_str(), run.threads(), embedding_stats.rigid_repairs,
+                  embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting);
+    else
+      std::printf(
+          "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+          "%d added, %d matched, %d removed (%d folded)\n",
+          stats.iterations, global ? "plane iterations" : "patches", wall,
+          evaluator->name().c_str(), run.threads(), stats.counts.stitched, stats.counts.replaced,
+          stats.counts.added, stats.counts.matched,
+          embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+          embedding_stats.removed_self_intersecting);
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);
   }

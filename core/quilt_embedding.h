@@ -15,6 +15,8 @@ struct QuiltEmbeddingOptions {
   bool shell_map = true;            // false: plain normal displacement
   bool optimize_stretch = true;     // random line search on the shell map (section 3.2)
   bool remove_intersecting = true;  // post-processing
+  // Before removing an element that touches a neighbour, try it at 95%, 90%, 85% of its size.
+  bool shrink_to_fit = true;
   std::uint64_t seed = 1;
 };
 
@@ -26,6 +28,7 @@ struct QuiltEmbeddingStats {
   int removed_intersecting = 0;       // intersecting another element
   int removed_self_intersecting = 0;  // folded through itself, and no repair possible
   int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
+  int shrunk_to_fit = 0;              // elements kept at 85-95% of their size instead of removed
   // Elements mapped through the shell map as it was before stretch optimisation, because the
   // optimised map made them intersect another element.
   int unoptimized_elements = 0;
