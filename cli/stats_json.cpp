@@ -113,9 +113,13 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
     std::printf("density:           %.6g elements per unit area (%d closed Voronoi cells)\n",
                 r.density, r.density_cells);
   if (swatch) {
-    std::printf("swatch:            %d rings, links %s, interior link count %d, density %.6g\n",
-                swatch->report.rings, histogram_text(swatch->report.link_histogram).c_str(),
-                swatch->interior_links, swatch->density);
+    if (swatch->report.rings > 0)
+      std::printf("swatch:            %d rings, links %s, interior link count %d, density %.6g\n",
+                  swatch->report.rings, histogram_text(swatch->report.link_histogram).c_str(),
+                  swatch->interior_links, swatch->density);
+    else
+      std::printf("swatch:            no rings, %d long elements of %zu\n",
+                  swatch->report.long_elements, swatch->report.elements.size());
   }
   if (comparison) {
     if (comparison->interior_links >= 0)

@@ -531,7 +531,9 @@ StructureComparison compare_structure(const StructureReport& output, const Swatc
                    : swatch.report.median_area > 0
                        ? std::sqrt(output.median_area / swatch.report.median_area)
                        : 0;
-  if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0)
+  const bool long_swatch =
+      2 * swatch.report.long_elements > static_cast<int>(swatch.report.elements.size());
+  if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0 && !long_swatch)
     c.density_ratio = output.density / (swatch.density / (c.linear_scale * c.linear_scale));
   return c;
 }

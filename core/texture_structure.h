@@ -115,7 +115,9 @@ SwatchStructure measure_swatch_structure(const TriMesh& swatch);
 struct StructureComparison {
   int interior_links = -1;    // the swatch's
   double share_matching = 0;  // interior output rings with exactly that many links
-  double density_ratio = 0;   // output density / swatch density at the output's scale
+  // Output density / swatch density at the output's scale; 0 when most swatch elements are long
+  // (threads join across seams, so their count per area says nothing; see interior ends).
+  double density_ratio = 0;
   double linear_scale = 0;    // output length units per swatch unit
 };
 

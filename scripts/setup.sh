@@ -12,12 +12,16 @@ $mq swatch chainmail -o out/chainmail_swatch.obj
 $mq info out/chainmail_swatch.obj
 $mq plane --swatch out/chainmail_swatch.obj --size 30 30 -o out/chainmail_plane.obj \
   --stats out/chainmail_plane.json
-$mq info out/chainmail_plane.obj
+# The structure measure: links per ring against the swatch's, density (issue 13).
+$mq info out/chainmail_plane.obj --links --swatch out/chainmail_swatch.obj
 $mq render out/chainmail_plane.obj -o out/chainmail_plane.png
 # ... and over a shipped base mesh (Keenan Crane's Spot, CC0), through the shell map.
 $mq swatch chainmail --rows 3 --cols 3 --detail 16 -o out/chainmail_small.obj
 $mq surface --base data/spot_6k.obj --swatch out/chainmail_small.obj --scale 0.08 \
   -o out/spot_chainmail.obj --stats out/spot_chainmail.json
-$mq info out/spot_chainmail.obj
+$mq info out/spot_chainmail.obj --links --swatch out/chainmail_small.obj --base data/spot_6k.obj \
+  --scale 0.08
 $mq render out/spot_chainmail.obj -o out/spot_chainmail.png
-echo "setup: done; results in out/ (chainmail_plane.*, spot_chainmail.*)"
+# Each ring coloured by its link count (green: 4, as in the swatch), the cow drawn under it.
+$mq render out/spot_chainmail.obj --color links --base data/spot_6k.obj -o out/spot_links.png
+echo "setup: done; results in out/ (chainmail_plane.*, spot_chainmail.*, spot_links.png)"

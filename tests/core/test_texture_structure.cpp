@@ -153,6 +153,8 @@ TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
   const StructureReport rc = measure_structure(cut);
   EXPECT_EQ(rc.long_elements, 17);
   EXPECT_EQ(rc.interior_ends, 2);
+  // Threads are not counted per area (they join across seams): no density ratio.
+  EXPECT_EQ(compare_structure(rc, measure_swatch_structure(weave), 1.0).density_ratio, 0.0);
   // Apples are not long.
   const StructureReport apples = measure_structure(apple_layer({}));
   EXPECT_EQ(apples.long_elements, 0);
