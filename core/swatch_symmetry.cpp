@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+#include <vector>
 
 #include "core/mesh_intersections.h"
 
@@ -238,6 +240,71 @@ Vector2d axis_periods(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
     }
   }
   return out;
+}
+
+bool repeating_elements(const PreparedSwatch& swatch) {
+  const int n = static_cast<int>(swatch.elements.size());
+  if (n < 4) return false;
+  std::vector<Vector2d> c(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const Element& e = swatch.elements[i];
+    if (((e.hi - e.lo).array() > 0.6 * swatch.size.head<2>().array()).any()) return false;
+    c[i] = 0.5 * (e.lo + e.hi);
+  }
+  // The median nearest-centre distance (all pairs: swatches hold tens to hundreds of elements).
+  std::vector<double> nearest(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      const double d = (c[i] - c[j]).norm();
+      nearest[i] = std::min(nearest[i], d);
+      nearest[j] = std::min(nearest[j], d);
+    }
+  std::nth_element(nearest.begin(), nearest.begin() + n / 2, nearest.end());
+  const double tol = 0.25 * nearest[n / 2];
+  if (!(tol > 0)) return false;
+  // Centres in a hash grid of cell `tol`: a lookup checks the 3 x 3 cells around a point.
+  std::unordered_map<long long, std::vector<int>> grid;
+  auto key = [&](long long x, long long y) { return x * 1000003LL + y; };
+  auto cell = [&](double v) { return static_cast<long long>(std::floor(v / tol)); };
+  for (int i = 0; i < n; ++i) grid[key(cell(c[i].x()), cell(c[i].y()))].push_back(i);
+  auto has_centre_near = [&](const Vector2d& p) {
+    const long long cx = cell(p.x()), cy = cell(p.y());
+    for (long long x = cx - 1; x <= cx + 1; ++x)
+      for (long long y = cy - 1; y <= cy + 1; ++y)
+        if (const auto it = grid.find(key(x, y)); it != grid.end())
+          for (const int j : it->second)
+            if ((c[j] - p).norm() <= tol) return true;
+    return false;
+  };
+  // Shifts from the element nearest the footprint's centre to every other element.
+  const Vector2d middle = 0.5 * swatch.size.head<2>();
+  int k = 0;
+  for (int i = 1; i < n; ++i)
+    if ((c[i] - middle).squaredNorm() < (c[k] - middle).squaredNorm()) k = i;
+  // The shortest periods are shifts to near elements: the 24 nearest are tried.
+  std::vector<int> order;
+  for (int j = 0; j < n; ++j)
+    if (j != k) order.push_back(j);
+  const auto closer = [&](int a, int b) {
+    const double da = (c[a] - c[k]).squaredNorm(), db = (c[b] - c[k]).squaredNorm();
+    return da < db || (da == db && a < b);
+  };
+  const size_t tries = std::min<size_t>(24, order.size());
+  std::partial_sort(order.begin(), order.begin() + tries, order.end(), closer);
+  order.resize(tries);
+  const Vector2d lo = Vector2d::Constant(tol), hi = swatch.size.head<2>() - lo;
+  for (const int j : order) {
+    const Vector2d t = c[j] - c[k];
+    int inside = 0, matched = 0;
+    for (int i = 0; i < n; ++i) {
+      const Vector2d p = c[i] + t;
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+      ++inside;
+      matched += has_centre_near(p);
+    }
+    if (inside >= 2 && matched >= 0.9 * inside) return true;
+  }
+  return false;
 }
 
 bool tileable(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry) {

@@ -34,6 +34,13 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
 Vector2d axis_periods(const PreparedSwatch& swatch, const SwatchFaceTree& faces, double cell,
                       double tolerance = 0.02);
 
+// A quick necessary condition for tileable(), a few microseconds per element: at least 4
+// elements, none wider than 60% of the swatch along x or y (a thread runs its whole length), and
+// some shift between two element centres that takes at least 90% of the centres it keeps inside the
+// footprint (and at least 2) onto other centres, within a quarter of the median nearest-centre
+// distance. A scattered layer (apples) or a sheet of threads fails it without the self-matching.
+bool repeating_elements(const PreparedSwatch& swatch);
+
 // Whether the swatch is a lattice of compact elements: periodic, and one element per lattice
 // orbit repeated over the swatch's footprint intersects nothing (rings, apples on a grid).
 // Threads that run the whole swatch are not: their copies a period apart overlap.

@@ -88,6 +88,41 @@ TEST(SwatchSymmetry, WeaveIsPeriodicButNotTileableApplesAndIvyAreNeither) {
   EXPECT_FALSE(ivy.symmetry.periodic);
 }
 
+// The quick pre-check agrees with the full test on every sample swatch: true for the chain
+// mail sheets (tileable), false for the weave, apples and ivy (not tileable), and false for
+// a sheet whose rings were moved off the lattice.
+TEST(SwatchSymmetry, RepeatingElementsComesBeforeTileable) {
+  for (const auto& [rows, cols] : {std::pair{2, 4}, std::pair{3, 3}, std::pair{5, 6}}) {
+    ChainMailOptions o;
+    o.rows = rows;
+    o.cols = cols;
+    o.ring_segments = 16;
+    o.wire_segments = 4;
+    const Detected d = detect(chainmail_4in1(o));
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    EXPECT_TRUE(repeating_elements(d.swatch));
+    EXPECT_TRUE(tileable(d.swatch, d.symmetry));
+  }
+  WeaveOptions w;
+  w.threads_x = w.threads_y = 4;
+  EXPECT_FALSE(repeating_elements(prepare_swatch(plain_weave(w))));
+  AppleOptions a;
+  a.count = 12;
+  EXPECT_FALSE(repeating_elements(prepare_swatch(apple_layer(a))));
+  EXPECT_FALSE(repeating_elements(prepare_swatch(ivy_section({}))));
+  // Each ring of a 3 x 3 sheet moved by its own amount: no shift repeats the centres.
+  ChainMailOptions o;
+  o.rows = o.cols = 3;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  PreparedSwatch moved = prepare_swatch(chainmail_4in1(o));
+  for (size_t k = 0; k < moved.elements.size(); ++k) {
+    const double s = 0.4 * std::sin(2.7 * static_cast<double>(k) + 1.0);
+    moved.elements[k].translate(Vector3d(s, 0.7 * s * s, 0));
+  }
+  EXPECT_FALSE(repeating_elements(moved));
+}
+
 TEST(SwatchSymmetry, TilingALatticeGivesThePerfectSheet) {
   ChainMailOptions o;
   o.rows = o.cols = 3;
