@@ -104,8 +104,10 @@ int run_plane(int argc, char** argv, int first) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   StructureSummary structure;
   if (!run.stats_path().empty()) {
-    ScopedStageTimer timer(stats.times, "structure");
-    structure = summarize_structure(result, swatch, nullptr, 1.0);
+    {
+      ScopedStageTimer timer(stats.times, "structure");
+      structure = summarize_structure(result, swatch, nullptr, 1.0);
+    }
     write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
                 options.length, options.width, structure);
   }

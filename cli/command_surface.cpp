@@ -173,11 +173,18 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats gstats;
-  const bool global = method == "global" || (method == "auto" && lattice_swatch(swatch));
+  bool global = method == "global";
+  double choice_seconds = 0;
+  if (method == "auto") {
+    const auto t0 = std::chrono::steady_clock::now();
+    global = lattice_swatch(swatch);
+    choice_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   const SurfaceQuilt quilt =
       global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
           : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+  if (method == "auto") stats.times.add("method choice", choice_seconds);
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);
@@ -192,8 +199,10 @@ int run_surface(int argc, char** argv, int first) {
   // faces, not worth it on every run.
   StructureSummary structure;
   if (!run.stats_path().empty()) {
-    ScopedStageTimer timer(stats.times, "structure");
-    structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
+    {
+      ScopedStageTimer timer(stats.times, "structure");
+      structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
+    }
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"),
                 global ? "global" : "patches", global ? &gstats : nullptr, structure);

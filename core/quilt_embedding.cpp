@@ -234,7 +234,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // shape moved by the similarity that best fits where the map put it (Umeyama): whole and
   // unfolded by construction, in its place and at its size.
   if (options.remove_intersecting) {
-    ScopedStageTimer timer(stats.times, "post-processing");
+    ScopedStageTimer timer(stats.times, "fold repair");
     std::vector<int> component_first(quilt.elements.size(), 0);
     IntersectionOptions all_pairs;
     all_pairs.between_components_only = false;
@@ -273,7 +273,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // on 80.4% of interior rings where dropping the later of each pair kept 78.0%.
   std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
-    ScopedStageTimer timer(stats.times, "post-processing");
+    ScopedStageTimer timer(stats.times, "element removal");
     IntersectionOptions all_pairs;
     all_pairs.between_components_only = false;
     const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
