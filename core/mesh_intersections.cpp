@@ -84,8 +84,17 @@ bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vect
                                 const Vector3d& b, const Vector3d& c) {
   const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
   if (op * oq > 0) return false;
-  if (op == 0 && oq == 0) {  // segment in the triangle's plane
-    const int k = dominant_axis((b - a).cross(c - a));
+  // The predicates are not exact: a segment in a tilted plane with the triangle (the fan that
+  // caps a thread's end) gets signs from rounding, and the line test below then reports
+  // sectors of the fan on opposite sides of its centre as overlapping. Within a relative 1e-9
+  // of the plane the segment is taken to lie in it.
+  const Vector3d n = (b - a).cross(c - a);
+  const double tolerance =
+      1e-9 * n.norm() * std::max({(q - p).norm(), (b - a).norm(), (c - a).norm(), (c - b).norm()});
+  const bool in_plane = (op == 0 && oq == 0) || (std::abs(n.dot(p - a)) <= tolerance &&
+                                                 std::abs(n.dot(q - a)) <= tolerance);
+  if (in_plane) {  // segment in the triangle's plane
+    const int k = dominant_axis(n);
     const Vector2d p2 = project(p, k), q2 = project(q, k);
     const Vector2d a2 = project(a, k), b2 = project(b, k), c2 = project(c, k);
     return point_in_triangle_2d(p2, a2, b2, c2) || segments_intersect_2d(p2, q2, a2, b2) ||
@@ -118,7 +127,11 @@ bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
     // their opposite vertices lie on the same side of the edge (a fold-over).
     const int u = shared_f[0], v = shared_f[1];
     const int a = 3 - u - v, b = 3 - shared_g[0] - shared_g[1];
-    if (orient3d(P(f, u), P(f, v), P(f, a), P(g, b)) != 0) return false;
+    // Coplanar within the same relative 1e-9 as segment_triangle_intersect's.
+    const Vector3d n = (P(f, v) - P(f, u)).cross(P(f, a) - P(f, u));
+    const double scale = std::max(
+        {(P(f, v) - P(f, u)).norm(), (P(f, a) - P(f, u)).norm(), (P(g, b) - P(f, u)).norm()});
+    if (std::abs(n.dot(P(g, b) - P(f, u))) > 1e-9 * n.norm() * scale) return false;
     const int k = dominant_axis((P(f, 1) - P(f, 0)).cross(P(f, 2) - P(f, 0)));
     const Vector2d u2 = project(P(f, u), k), v2 = project(P(f, v), k);
     return orient2d(u2, v2, project(P(f, a), k)) * orient2d(u2, v2, project(P(g, b), k)) > 0;

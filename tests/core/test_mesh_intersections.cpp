@@ -7,6 +7,7 @@
 #include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
+#include "core/swatch_generators.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -130,6 +131,38 @@ TEST(MeshIntersections, SharedVertexPiercingReported) {
   V.row(3) << -1, -1, -1;  // now the second face meets the first only at vertex 0
   V.row(4) << -1, -1, 1;
   EXPECT_TRUE(intersecting_face_pairs(V, F, all).empty());
+}
+
+// The fan that caps a thread's end lies in a tilted plane, so its corners are coplanar only up
+// to rounding; sectors on opposite sides of the centre touch at the centre alone (the weave
+// swatch's 12 threads were all reported as folded). A sector folded over its neighbour in the
+// same plane is still a fold.
+TEST(MeshIntersections, TiltedCapFanIsNotFolded) {
+  const int n = 12;
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()) *
+                             Eigen::AngleAxisd(0.3, Vector3d::UnitX()))
+                                .toRotationMatrix();
+  MatrixX3d V(n + 1, 3);
+  V.row(n) = Vector3d(6.070221, 0.570221, 0.322658).transpose();
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n;
+    V.row(i) = (V.row(n).transpose() + R * Vector3d(0.15 * std::cos(t), 0.15 * std::sin(t), 0))
+                   .transpose();
+  }
+  MatrixX3i F(n, 3);
+  for (int i = 0; i < n; ++i) F.row(i) << n, i, (i + 1) % n;
+  EXPECT_TRUE(self_intersecting_components(V, F).empty());
+  IntersectionOptions all;
+  all.between_components_only = false;
+  EXPECT_TRUE(intersecting_face_pairs(V, F, all).empty());
+  // Sector 3 swung round to cover sectors 0-1: same plane, overlapping beyond the centre.
+  F.row(3) << n, 0, 2;
+  EXPECT_FALSE(intersecting_face_pairs(V, F, all).empty());
+}
+
+TEST(MeshIntersections, RealWeaveSwatchThreadsAreNotFolded) {
+  const TriMesh weave = plain_weave();
+  EXPECT_TRUE(self_intersecting_components(weave.V, weave.F).empty());
 }
 
 TEST(MeshIntersections, BadInputThrows) {
