@@ -174,17 +174,12 @@ int run_surface(int argc, char** argv, int first) {
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats gstats;
   bool global = method == "global";
-  double choice_seconds = 0;
-  if (method == "auto") {
-    const auto t0 = std::chrono::steady_clock::now();
-    global = lattice_swatch(swatch);
-    choice_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
   const SurfaceQuilt quilt =
-      global
+      method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
+                                            run.progress(), &global)
+      : global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
           : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
-  if (method == "auto") stats.times.add("method choice", choice_seconds);
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);

@@ -210,24 +210,19 @@ bool lattice_swatch(const TriMesh& swatch_mesh) {
   return tileable(swatch, detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch)));
 }
 
-SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_mesh,
-                                  const SurfaceQuiltingOptions& options,
-                                  TranslationCostEvaluator& evaluator,
-                                  SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
-                                  ProgressSink* progress) {
-  SurfaceQuiltingStats stats;
+namespace {
+
+// The global method from a prepared job and the swatch's symmetry (found on job.swatch).
+SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch,
+                                   const SwatchSymmetry& symmetry,
+                                   const SurfaceQuiltingOptions& options,
+                                   TranslationCostEvaluator& evaluator, SurfaceQuiltingStats stats,
+                                   SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
+                                   ProgressSink* progress) {
   GlobalQuiltingStats gstats;
   StageTimes& times = stats.times;
-  SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const TriMesh& base = job.base;
-  const PreparedSwatch swatch = prepare_swatch(job.swatch);
   stats.shell_height = swatch.size.z();
-  SwatchSymmetry symmetry;
-  {
-    ScopedStageTimer timer(times, "symmetry");
-    const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
-    symmetry = detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch));
-  }
   gstats.periodic = symmetry.periodic;
 
   // The line field and the parameterisation, on a smoothed copy of the base (same
@@ -377,6 +372,58 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_
   report_progress(progress, "quilting", 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (global_out) *global_out = gstats;
+  return quilt;
+}
+
+SwatchSymmetry timed_symmetry(const PreparedSwatch& swatch, StageTimes& times) {
+  ScopedStageTimer timer(times, "symmetry");
+  const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
+  return detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch));
+}
+
+}  // namespace
+
+SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                                  const SurfaceQuiltingOptions& options,
+                                  TranslationCostEvaluator& evaluator,
+                                  SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
+                                  ProgressSink* progress) {
+  SurfaceQuiltingStats stats;
+  SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
+  const PreparedSwatch swatch = prepare_swatch(job.swatch);
+  const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
+  return quilt_prepared_global(job, swatch, symmetry, options, evaluator, std::move(stats),
+                               stats_out, global_out, progress);
+}
+
+SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                                const SurfaceQuiltingOptions& options,
+                                TranslationCostEvaluator& evaluator,
+                                SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
+                                ProgressSink* progress, bool* used_global) {
+  SurfaceQuiltingStats stats;
+  SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
+  const PreparedSwatch swatch = prepare_swatch(job.swatch);
+  bool repeating = false;
+  {
+    ScopedStageTimer timer(stats.times, "method choice");
+    repeating = repeating_elements(swatch);
+  }
+  if (repeating) {
+    // The symmetry decides and, for a lattice, is the one the layout uses: found once.
+    const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
+    if (tileable(swatch, symmetry)) {
+      if (used_global) *used_global = true;
+      return quilt_prepared_global(job, swatch, symmetry, options, evaluator, std::move(stats),
+                                   stats_out, global_out, progress);
+    }
+  }
+  if (used_global) *used_global = false;
+  const StageTimes choice = stats.times;
+  SurfaceQuilt quilt = quilt_surface(base_in, swatch_mesh, options, evaluator, stats_out, progress);
+  if (stats_out)
+    for (const auto& [stage, seconds] : choice.stages())
+      if (stage != "prepare") stats_out->times.add(stage, seconds);
   return quilt;
 }
 

@@ -46,4 +46,14 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
                                   GlobalQuiltingStats* global_stats = nullptr,
                                   ProgressSink* progress = nullptr);
 
+// --method auto: quilt_surface_global for a lattice swatch (lattice_swatch, decided on the
+// swatch at the job's scale), quilt_surface otherwise; the swatch's symmetry is found once.
+// *used_global (optional) says which ran. Throws like quilt_surface.
+SurfaceQuilt quilt_surface_auto(const TriMesh& base, const TriMesh& swatch,
+                                const SurfaceQuiltingOptions& options,
+                                TranslationCostEvaluator& evaluator,
+                                SurfaceQuiltingStats* stats = nullptr,
+                                GlobalQuiltingStats* global_stats = nullptr,
+                                ProgressSink* progress = nullptr, bool* used_global = nullptr);
+
 }  // namespace mq

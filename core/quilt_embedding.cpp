@@ -41,55 +41,133 @@ MatrixX3d similarity_fit(const MatrixX3d& from, const MatrixX3d& to) {
   return out;
 }
 
+// Element boxes in a uniform grid (cell: the median element size; a box larger than a few
+// cells is rare), to find the elements near a box in about constant time.
+class ElementGrid {
+ public:
+  // first: #elements+1 offsets of each element's rows in V; elements with skip[k] set (or
+  // no vertices) are left out until insert()ed.
+  ElementGrid(const MatrixX3d& V, const std::vector<Eigen::Index>& first,
+              const std::vector<char>& skip) {
+    const size_t ne = first.size() - 1;
+    box.resize(ne);
+    std::vector<double> sizes;
+    for (size_t k = 0; k < ne; ++k) {
+      for (Eigen::Index v = first[k]; v < first[k + 1]; ++v) box[k].extend(V.row(v).transpose());
+      if (first[k + 1] > first[k]) sizes.push_back(box[k].extent().maxCoeff());
+    }
+    if (sizes.empty()) return;
+    std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+    cell_ = std::max(sizes[sizes.size() / 2], 1e-12);
+    origin_ = bounding_box(V).min;
+    for (size_t k = 0; k < ne; ++k)
+      if (!skip[k] && first[k + 1] > first[k]) insert(static_cast<int>(k), box[k]);
+  }
+  void insert(int k, const BoundingBox& b) {
+    box[static_cast<size_t>(k)] = b;
+    for_cells(b, [&](unsigned long long c) { grid_[c].push_back(k); });
+  }
+  // The inserted elements whose box meets b, ascending.
+  std::vector<int> near(const BoundingBox& b) const {
+    std::vector<int> found;
+    for_cells(b, [&](unsigned long long c) {
+      if (const auto it = grid_.find(c); it != grid_.end())
+        for (const int j : it->second)
+          if (overlap(b, box[static_cast<size_t>(j)])) found.push_back(j);
+    });
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    return found;
+  }
+  static bool overlap(const BoundingBox& a, const BoundingBox& b) {
+    return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+  }
+  std::vector<BoundingBox> box;
+
+ private:
+  template <class Visit>
+  void for_cells(const BoundingBox& b, Visit&& visit) const {
+    if (grid_.empty() && cell_ == 0) return;
+    const auto cell_of = [&](const Vector3d& p) {
+      return ((p - origin_) / cell_).array().floor().cast<long long>().eval();
+    };
+    const auto lo = cell_of(b.min), hi = cell_of(b.max);
+    for (long long x = lo(0); x <= hi(0); ++x)
+      for (long long y = lo(1); y <= hi(1); ++y)
+        for (long long z = lo(2); z <= hi(2); ++z)
+          visit(static_cast<unsigned long long>(x) * 0x9E3779B97F4A7C15ull ^
+                static_cast<unsigned long long>(y) * 0xC2B2AE3D27D4EB4Full ^
+                static_cast<unsigned long long>(z) * 0x165667B19E3779F9ull);
+  }
+  double cell_ = 0;
+  Vector3d origin_ = Vector3d::Zero();
+  std::unordered_map<unsigned long long, std::vector<int>> grid_;
+};
+
+std::vector<Eigen::Index> vertex_offsets(const SurfaceQuilt& quilt) {
+  std::vector<Eigen::Index> first(quilt.elements.size() + 1, 0);
+  for (size_t k = 0; k < quilt.elements.size(); ++k)
+    first[k + 1] = first[k] + static_cast<Eigen::Index>(quilt.elements[k].face.size());
+  return first;
+}
+
+// The intersecting face pairs of (V, F) (all pairs, as intersecting_face_pairs with
+// between_components_only false) after the elements marked `changed` moved, from the pairs
+// found before they did: the pairs of unchanged elements stay, those of changed elements are
+// found again among the faces of the elements whose boxes meet theirs. The same sorted pairs
+// as a full pass, for the cost of the changed elements' neighbourhoods (the fold repair moves
+// 274 of the armor's 1,944 rings; a full pass over its 2.2M faces took ~1 s).
+std::vector<std::pair<int, int>> updated_pairs(const SurfaceQuilt& quilt, const MatrixX3d& V,
+                                               const MatrixX3i& F,
+                                               const std::vector<int>& element_of,
+                                               std::vector<std::pair<int, int>> pairs,
+                                               const std::vector<char>& changed) {
+  if (std::find(changed.begin(), changed.end(), 1) == changed.end()) return pairs;
+  const auto is_changed = [&](int f) { return changed[static_cast<size_t>(element_of[f])] != 0; };
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [&](const std::pair<int, int>& p) {
+                               return is_changed(p.first) || is_changed(p.second);
+                             }),
+              pairs.end());
+  const std::vector<Eigen::Index> first = vertex_offsets(quilt);
+  const ElementGrid grid(V, first, std::vector<char>(quilt.elements.size(), 0));
+  std::vector<char> take(quilt.elements.size(), 0);
+  for (size_t k = 0; k < quilt.elements.size(); ++k)
+    if (changed[k]) {
+      take[k] = 1;
+      for (const int j : grid.near(grid.box[k])) take[static_cast<size_t>(j)] = 1;
+    }
+  std::vector<int> faces;  // global face indices of the subset, ascending
+  for (int f = 0; f < F.rows(); ++f)
+    if (take[static_cast<size_t>(element_of[f])]) faces.push_back(f);
+  MatrixX3i sub(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i) sub.row(static_cast<Eigen::Index>(i)) = F.row(faces[i]);
+  IntersectionOptions all_pairs;
+  all_pairs.between_components_only = false;
+  for (const auto& [a, b] : intersecting_face_pairs(V, sub, all_pairs)) {
+    const int f = faces[static_cast<size_t>(a)], g = faces[static_cast<size_t>(b)];
+    if (is_changed(f) || is_changed(g)) pairs.emplace_back(f, g);
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 // Elements dropped for touching a neighbour are tried again a little smaller about their
 // centres (chain mail has clearance between linked rings: a ring pushed into its neighbour over
 // a crease usually clears it at 90% of its size and still threads it). `V` holds every
 // element's vertices in order; a kept shrunken element overwrites its rows and its `drop` flag.
-// Neighbours are found through a uniform grid of element boxes, so this is linear in the number
-// of elements. Returns how many elements came back.
+// Neighbours are found through the element grid, so this is linear in the number of elements.
+// Returns how many elements came back.
 int shrink_to_fit(const SurfaceQuilt& quilt, const std::vector<char>& folded, MatrixX3d& V,
                   std::vector<char>& drop) {
   const size_t ne = quilt.elements.size();
-  std::vector<Eigen::Index> first(ne + 1, 0);
-  for (size_t k = 0; k < ne; ++k)
-    first[k + 1] = first[k] + static_cast<Eigen::Index>(quilt.elements[k].face.size());
-  std::vector<BoundingBox> box(ne);
-  std::vector<double> sizes;
-  for (size_t k = 0; k < ne; ++k) {
-    for (Eigen::Index v = first[k]; v < first[k + 1]; ++v) box[k].extend(V.row(v).transpose());
-    if (first[k + 1] > first[k]) sizes.push_back(box[k].extent().maxCoeff());
-  }
-  if (sizes.empty()) return 0;
-  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
-  const double cell = std::max(sizes[sizes.size() / 2], 1e-12);
-  const Vector3d origin = bounding_box(V).min;
-  auto cell_of = [&](const Vector3d& p) {
-    return ((p - origin) / cell).array().floor().cast<long long>().eval();
-  };
-  auto key = [](long long x, long long y, long long z) {
-    return static_cast<unsigned long long>(x) * 0x9E3779B97F4A7C15ull ^
-           static_cast<unsigned long long>(y) * 0xC2B2AE3D27D4EB4Full ^
-           static_cast<unsigned long long>(z) * 0x165667B19E3779F9ull;
-  };
-  // Every kept element, in each cell its box touches (a box larger than a few cells is rare).
-  std::unordered_map<unsigned long long, std::vector<int>> grid;
-  auto for_cells = [&](const BoundingBox& b, auto&& visit) {
-    const auto lo = cell_of(b.min), hi = cell_of(b.max);
-    for (long long x = lo(0); x <= hi(0); ++x)
-      for (long long y = lo(1); y <= hi(1); ++y)
-        for (long long z = lo(2); z <= hi(2); ++z) visit(key(x, y, z));
-  };
-  for (size_t k = 0; k < ne; ++k)
-    if (!drop[k] && first[k + 1] > first[k])
-      for_cells(box[k], [&](unsigned long long c) { grid[c].push_back(static_cast<int>(k)); });
+  const std::vector<Eigen::Index> first = vertex_offsets(quilt);
+  ElementGrid grid(V, first, drop);
   auto element_mesh = [&](size_t k) {
     TriMesh m;
     m.V = V.middleRows(first[k], first[k + 1] - first[k]);
     m.F = quilt.elements[k].F;
     return m;
-  };
-  auto overlap = [](const BoundingBox& a, const BoundingBox& b) {
-    return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
   };
   int restored = 0;
   for (size_t k = 0; k < ne; ++k) {
@@ -102,25 +180,16 @@ int shrink_to_fit(const SurfaceQuilt& quilt, const std::vector<char>& folded, Ma
         m.V.row(v) = (c + factor * (m.V.row(v).transpose() - c)).transpose();
       BoundingBox b;
       for (Eigen::Index v = 0; v < m.V.rows(); ++v) b.extend(m.V.row(v).transpose());
-      std::vector<int> near;
-      for_cells(b, [&](unsigned long long cc) {
-        if (const auto it = grid.find(cc); it != grid.end())
-          near.insert(near.end(), it->second.begin(), it->second.end());
-      });
-      std::sort(near.begin(), near.end());
-      near.erase(std::unique(near.begin(), near.end()), near.end());
       bool clear = true;
-      for (const int j : near)
-        if (static_cast<size_t>(j) != k && !drop[j] && overlap(b, box[j]) &&
-            meshes_intersect(m, element_mesh(j))) {
+      for (const int j : grid.near(b))
+        if (static_cast<size_t>(j) != k && !drop[j] && meshes_intersect(m, element_mesh(j))) {
           clear = false;
           break;
         }
       if (!clear) continue;
       V.middleRows(first[k], m.V.rows()) = m.V;
-      box[k] = b;
       drop[k] = 0;
-      for_cells(b, [&](unsigned long long cc) { grid[cc].push_back(static_cast<int>(k)); });
+      grid.insert(static_cast<int>(k), b);
       ++restored;
       break;
     }
@@ -179,6 +248,10 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     }
   }
   bool known_disjoint = false;  // no two elements of all.V intersect (already checked)
+  // The intersecting face pairs of all.V (within an element and between two), once found kept
+  // up to date as elements move (updated_pairs): one full pass instead of three.
+  std::vector<std::pair<int, int>> pairs;
+  bool have_pairs = false;
   if (map) {
     // The unoptimised map creates no intersections where the base is concave (the shell is
     // valid and elements lie in it apart); the optimised one bends its tetrahedra a little, and
@@ -208,7 +281,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       // two: both kinds keep the unoptimised map.
       IntersectionOptions all_pairs;
       all_pairs.between_components_only = false;
-      const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
       // Nothing to revert: post-processing would find the same nothing.
       known_disjoint = pairs.empty();
       std::vector<char> revert(quilt.elements.size(), 0);
@@ -223,6 +296,8 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
         }
         v0 += ev;
       }
+      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), revert);
+      have_pairs = true;
     }
   } else {
     ScopedStageTimer timer(stats.times, "embedding");
@@ -235,14 +310,15 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // unfolded by construction, in its place and at its size.
   if (options.remove_intersecting) {
     ScopedStageTimer timer(stats.times, "fold repair");
-    std::vector<int> component_first(quilt.elements.size(), 0);
-    IntersectionOptions all_pairs;
-    all_pairs.between_components_only = false;
-    std::vector<char> folded_now(quilt.elements.size(), 0);
-    for (const int c : self_intersecting_components(all.V, all.F)) {
-      // Components of `all` are the elements, in order.
-      if (c >= 0 && c < static_cast<int>(folded_now.size())) folded_now[c] = 1;
+    if (!have_pairs && !known_disjoint) {
+      IntersectionOptions all_pairs;
+      all_pairs.between_components_only = false;
+      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+      have_pairs = true;
     }
+    std::vector<char> folded_now(quilt.elements.size(), 0);
+    for (const auto& [f, g] : pairs)
+      if (element_of[f] == element_of[g]) folded_now[static_cast<size_t>(element_of[f])] = 1;
     Eigen::Index v0 = 0;
     for (size_t k = 0; k < quilt.elements.size(); ++k) {
       const SurfaceElement& e = quilt.elements[k];
@@ -262,9 +338,13 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
         }
         all.V.middleRows(v0, ev) = best;
         ++stats.rigid_repairs;
+      } else {
+        folded_now[k] = 0;  // left as it is
       }
       v0 += ev;
     }
+    if (have_pairs)
+      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), folded_now);
   }
 
   // Post-processing (issue 13: no folded element reaches the output): an element that
@@ -274,9 +354,11 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "element removal");
-    IntersectionOptions all_pairs;
-    all_pairs.between_components_only = false;
-    const auto pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+    if (!have_pairs) {
+      IntersectionOptions all_pairs;
+      all_pairs.between_components_only = false;
+      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+    }
     for (const auto& [f, g] : pairs)
       if (element_of[f] == element_of[g]) folded[element_of[f]] = drop[element_of[f]] = 1;
     std::vector<std::pair<int, int>> touching;

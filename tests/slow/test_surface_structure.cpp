@@ -36,9 +36,8 @@ Result quilt(const TriMesh& base, const TriMesh& swatch, double scale) {
   SurfaceQuiltingOptions o;
   o.scale = scale;
   TranslationCostCpu cost;
-  r.global = lattice_swatch(swatch);
-  const SurfaceQuilt q = r.global ? quilt_surface_global(base, swatch, o, cost, &r.stats)
-                                  : quilt_surface(base, swatch, o, cost, &r.stats);
+  const SurfaceQuilt q = quilt_surface_auto(base, swatch, o, cost, &r.stats, nullptr, nullptr,
+                                            &r.global);
   TetStretchCpu stretch;
   r.output = embed_quilt(q, {}, stretch, &r.embedding);
   r.structure = summarize_structure(r.output, swatch, &base, r.stats.swatch_scale);
