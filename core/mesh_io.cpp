@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
+#include "core/input_file.h"
 
 namespace mq {
 namespace {
@@ -26,23 +27,7 @@ namespace {
 // Whole-file input and a line-aware text cursor.
 
 std::string read_whole_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    MQ_THROW(InvalidInput, path, ": cannot read mesh: is a directory");
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) MQ_THROW(InvalidInput, path, ": cannot open mesh file: ", std::strerror(errno));
-  std::string data;
-  char chunk[1 << 16];
-  if (std::fseek(f, 0, SEEK_END) == 0) {
-    const long size = std::ftell(f);
-    if (size > 0) data.reserve(static_cast<size_t>(size));
-    std::fseek(f, 0, SEEK_SET);
-  }
-  size_t n = 0;
-  while ((n = std::fread(chunk, 1, sizeof(chunk), f)) > 0) data.append(chunk, n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) MQ_THROW(InvalidInput, path, ": cannot read mesh file");
+  std::string data = read_input_file(path, "mesh file");
   if (data.empty()) MQ_THROW(InvalidInput, path, ":1: empty file");
   return data;
 }
@@ -68,6 +53,7 @@ class TextCursor {
   void advance(int k) { p_ += k; }
   int line() const { return line_; }
   const char* pos() const { return p_; }
+  long long remaining() const { return static_cast<long long>(end_ - p_); }
 
   void skip_blanks() {
     while (p_ < end_ && is_blank(*p_)) ++p_;
@@ -290,6 +276,13 @@ TriMesh read_off(const std::string& path, const std::string& data) {
   if (!c.at_eol()) c.read_int("edge count");  // the edge count is informative only
   c.skip_line();
   if (nf == 0) c.fail("no faces");
+  // Large counts are checked against the bytes left before anything is allocated: a vertex takes at
+  // least 3 numbers (6 bytes with their separators), a face 4 (8 bytes).
+  // Small counts go on to the parse, whose messages say where the data end.
+  if (nv + nf > (1 << 16) && 6 * nv + 8 * nf > c.remaining() + 1)
+    c.fail("counts " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+           " faces need more data than the file's " + std::to_string(c.remaining()) +
+           " remaining bytes");
 
   std::vector<double> V(static_cast<size_t>(3 * nv)), N;
   if (has_normals) N.resize(static_cast<size_t>(3 * nv));
@@ -635,6 +628,27 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
   }
   if (index_prop < 0) c.fail("PLY face element lacks a vertex_indices list");
 
+  // Declared counts are checked against the bytes left before anything is allocated: every
+  // item takes at least its scalars' and list counts' sizes in binary, 2 bytes (a digit and a
+  // separator) per value in ASCII. An element with no properties takes no bytes at all: it is
+  // not iterated (its count is meaningless).
+  long long needed = 0;
+  for (const PlyElement& e : elements) {
+    long long per_item = 0;
+    for (const PlyProperty& p : e.properties)
+      per_item += encoding == PlyEncoding::Ascii ? 2 : ply_size(p.is_list ? p.count_type : p.type);
+    if (&e == face_el && per_item > 0)  // at least 3 indices per face
+      per_item += 3 * (encoding == PlyEncoding::Ascii
+                           ? 2
+                           : ply_size(face_el->properties[static_cast<size_t>(index_prop)].type));
+    needed += per_item * e.count;  // <= 2^31 * (8 + 24) * #properties: no overflow
+    // Small counts go on to the parse, whose messages say where the data end.
+    if (e.count > (1 << 16) && needed > c.remaining() + 1)
+      c.fail("element '" + e.name + "' count " + std::to_string(e.count) +
+             " needs more data than the file's " + std::to_string(c.remaining()) +
+             " remaining bytes");
+  }
+
   const long long nv = vertex_el->count;
   std::vector<double> V(static_cast<size_t>(3 * nv)), N;
   if (has_normals) N.resize(static_cast<size_t>(3 * nv));
@@ -648,6 +662,7 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
   for (const PlyElement& e : elements) {
     PlyValueSource src(&c, encoding == PlyEncoding::Ascii ? nullptr : &binary, &e.name);
     const bool is_vertex = &e == vertex_el, is_face = &e == face_el;
+    if (e.properties.empty()) continue;  // no bytes to read
     for (long long i = 0; i < e.count; ++i) {
       src.begin_item(i);
       for (size_t pi = 0; pi < e.properties.size(); ++pi) {
@@ -829,7 +844,11 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 
 TriMesh read_mesh(const std::string& path) {
   const MeshFormat format = mesh_format_from_path(path);
-  const std::string data = read_whole_file(path);
+  return read_mesh_data(read_whole_file(path), format, path);
+}
+
+TriMesh read_mesh_data(const std::string& data, MeshFormat format, const std::string& path) {
+  if (data.empty()) MQ_THROW(InvalidInput, path, ":1: empty file");
   switch (format) {
     case MeshFormat::Obj:
       return read_obj(path, data);

@@ -35,6 +35,11 @@ MeshFormat mesh_format_from_path(const std::string& path);
 // malformed number, or unsupported PLY content.
 TriMesh read_mesh(const std::string& path);
 
+// Parses the bytes of a mesh file in the given format, as read_mesh does once it has read
+// them; `path` only names the data in messages. Throws like read_mesh. (The fuzz targets in
+// fuzz/ call it directly.)
+TriMesh read_mesh_data(const std::string& data, MeshFormat format, const std::string& path);
+
 struct WriteOptions {
   // PLY only: binary little-endian (true) or ASCII (false).
   bool binary = true;

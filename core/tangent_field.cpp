@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "core/geometry_measures.h"
+#include "core/input_file.h"
 #include "core/mesh_topology.h"
 
 namespace mq {
@@ -141,16 +142,19 @@ bool parse_int(const std::string& s, long& value) {
 // Calls on_line(tokens, line_number) for each non-empty data line of path.
 template <typename OnLine>
 void for_each_data_line(const std::string& path, const char* what, OnLine on_line) {
-  std::ifstream in(path);
-  MQ_CHECK(in, InvalidInput, "cannot open ", what, " file ", path);
-  std::string line;
+  const std::string file = std::string(what) + " file";
+  // A regular file of bounded size (core/input_file): a FIFO or /dev/zero is refused.
+  const std::string data = read_input_file(path, file.c_str(), std::size_t{1} << 30);
   int number = 0;
-  while (std::getline(in, line)) {
+  std::size_t at = 0;
+  while (at < data.size()) {
+    std::size_t end = data.find('\n', at);
+    if (end == std::string::npos) end = data.size();
     ++number;
-    const std::vector<std::string> tokens = tokens_of(line);
+    const std::vector<std::string> tokens = tokens_of(data.substr(at, end - at));
     if (!tokens.empty()) on_line(tokens, number);
+    at = end + 1;
   }
-  MQ_CHECK(!in.bad(), InvalidInput, "error reading ", what, " file ", path);
 }
 
 // Sparse cotangent Laplacian (positive semi-definite form: L(i,i) = sum of weights, L(i,j) =
@@ -309,6 +313,10 @@ MatrixX3d tangent_field_from_vertex_vectors(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(vertex_vectors.rows() == V.rows(), InvalidInput,
            "tangent field: ", vertex_vectors.rows(), " vertex vectors for ", V.rows(), " vertices");
   MQ_CHECK(vertex_vectors.allFinite(), InvalidInput, "tangent field: non-finite vertex vector");
+  // An all-zero field gives no direction anywhere; silently replacing it by the smooth default
+  // would hide a broken export (issue 14).
+  MQ_CHECK(vertex_vectors.size() == 0 || vertex_vectors.cwiseAbs().maxCoeff() > 0, InvalidInput,
+           "the guidance field's vectors are all zero: no direction to follow");
   return face_field_from_raw_vertex(V, F, vertex_vectors);
 }
 

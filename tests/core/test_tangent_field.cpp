@@ -117,9 +117,9 @@ TEST(TangentField, VertexVectorsFromFile) {
             std::string::npos);
   EXPECT_THROW(read_vertex_vector_field(test::temp_dir() + "/missing.txt", 9), InvalidInput);
   EXPECT_THROW(tangent_field_from_vertex_vectors(grid.V, grid.F, X.topRows(4)), InvalidInput);
-  // All-zero vectors: no information, the fallback axis fills every face.
-  expect_unit_tangent(grid,
-                      tangent_field_from_vertex_vectors(grid.V, grid.F, MatrixX3d::Zero(9, 3)));
+  // All-zero vectors give no direction anywhere: an error, not a silent default (issue 14).
+  EXPECT_THROW(tangent_field_from_vertex_vectors(grid.V, grid.F, MatrixX3d::Zero(9, 3)),
+               InvalidInput);
 }
 
 TEST(TangentField, KeyVectorReaderRejectsMalformedLines) {
