@@ -7,6 +7,7 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 
 namespace {
@@ -31,10 +32,8 @@ struct Command {
 };
 
 constexpr Command kCommands[] = {
-    {"info", mq::cli::run_info},
-    {"swatch", mq::cli::run_swatch},
-    {"render", mq::cli::run_render},
-    {"plane", mq::cli::run_plane},
+    {"info", mq::cli::run_info},       {"swatch", mq::cli::run_swatch},
+    {"render", mq::cli::run_render},   {"plane", mq::cli::run_plane},
     {"surface", mq::cli::run_surface},
 };
 
@@ -50,6 +49,7 @@ int main(int argc, char** argv) {
     std::puts("meshquilt 0.1.0");
     return 0;
   }
+  mq::install_temporary_file_cleanup();  // no .NAME.tmp-* left behind on SIGINT or SIGTERM
   for (const Command& c : kCommands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
     try {

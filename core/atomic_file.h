@@ -41,7 +41,14 @@ class AtomicOutputFile {
   std::vector<char> buffer_;
   size_t used_ = 0;
   bool committed_ = false;
+  int slot_ = -1;  // in the signal handler's list of temporaries
 };
+
+// Removes the temporary files of AtomicOutputFiles still open when SIGINT or SIGTERM arrives,
+// then lets the signal end the process as it would have (default action). Call once, early in
+// main(). A SIGKILL cannot be caught: its temporary file (".NAME.tmp-PID-XXXXXX", PID the
+// writer's) is removed by the next AtomicOutputFile for the same NAME once no process PID runs.
+void install_temporary_file_cleanup();
 
 // Writes `bytes` to `path` atomically (an AtomicOutputFile written at once).
 void write_file_atomically(const std::string& path, std::string_view bytes);
