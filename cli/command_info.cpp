@@ -5,6 +5,7 @@
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/json_writer.h"
+#include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
 #include "core/geometry_measures.h"
@@ -47,6 +48,7 @@ int run_info(int argc, char** argv, int first) {
   if (cl.has("scale") && !(cl.has("swatch") && cl.has("base")))
     throw UsageError("--scale needs --swatch and --base (it is relative to the base's size)");
   const double scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
+  check_paths({cl.get("elements")}, {path, cl.get("swatch"), cl.get("base")});
   const TriMesh mesh = read_mesh(path);
   std::optional<SwatchStructure> swatch;
   StructureReport structure;

@@ -8,6 +8,7 @@
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/planar_quilting.h"
 #include "core/texture_structure.h"
@@ -76,7 +77,7 @@ int run_plane(int argc, char** argv, int first) {
   if (!cl.has("output")) throw UsageError("-o OUT is required");
   const std::string out_path = cl.get("output");
   mesh_format_from_path(out_path);  // fail on an unknown extension before any work
-  check_output_directory(out_path);
+  check_paths({out_path, cl.get("stats")}, {cl.get("swatch")});
 
   PlanarQuiltingOptions options;
   options.length = cl.get_double("size", 0, 1e-300, 1e300);
@@ -87,6 +88,7 @@ int run_plane(int argc, char** argv, int first) {
   options.subpatch_fraction = cl.get_double("subpatch", 0, 0.01, 1.0);
   options.deform = !cl.has("no-deform");
   options.trim_border = cl.has("trim");
+  options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
 
   RunContext run(cl);
@@ -95,6 +97,10 @@ int run_plane(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   PlanarQuiltingStats stats;
   const TriMesh result = quilt_plane(swatch, options, *evaluator, &stats, run.progress());
+  // A run that makes no geometry is an error, not an empty file (issue 14).
+  MQ_CHECK(result.num_faces() > 0, InvalidInput,
+           "the layer is empty: no element of the swatch fits the ", options.length, " x ",
+           options.width, " domain; nothing written");
   {
     ScopedStageTimer timer(stats.times, "write");
     write_mesh(out_path, result);

@@ -3,6 +3,7 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "cli/run_context.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_io.h"
@@ -48,6 +49,7 @@ int run_render(int argc, char** argv, int first) {
     throw UsageError("--color expects elements, links or single, got '" + color + "'");
   o.color_elements = color != "single";
   o.ground_plane = cl.has("ground");
+  check_paths({cl.get("output")}, {cl.positional_value("MESH"), cl.get("base")});
   TriMesh mesh = read_mesh(cl.positional_value("MESH"));
   std::vector<std::array<unsigned char, 3>> colors;
   if (color == "links") {

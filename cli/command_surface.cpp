@@ -8,6 +8,7 @@
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
 #include "core/global_quilting.h"
 #include "core/mesh_io.h"
 #include "core/quilt_embedding.h"
@@ -37,6 +38,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("wall_seconds", wall)
       .value("base_faces", s.base_faces)
       .value("welded_vertices", s.welded_vertices)
+      .value("duplicate_faces", s.duplicate_faces)
       .value("swatch_scale", s.swatch_scale)
       .value("shell_height", s.shell_height)
       .value("cell_size", s.cell_size)
@@ -135,6 +137,8 @@ int run_surface(int argc, char** argv, int first) {
     throw UsageError("give at most one of --field, --field-file and --keys");
   const std::string out_path = cl.get("output");
   mesh_format_from_path(out_path);
+  check_paths({out_path, cl.get("stats")},
+              {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
 
   SurfaceQuiltingOptions options;
   options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
@@ -149,6 +153,7 @@ int run_surface(int argc, char** argv, int first) {
   embedding.optimize_stretch = !cl.has("no-stretch-opt");
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
+  options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
   const std::string method = cl.get("method");
   if (method != "auto" && method != "global" && method != "patches")
@@ -183,6 +188,16 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);
+  // A run that makes no geometry is an error, not an empty file (issue 14).
+  MQ_CHECK(!quilt.elements.empty(), InvalidInput,
+           "no element of the swatch could be placed on "
+           "the base at --scale ",
+           options.scale,
+           " (is the swatch larger than the base?); "
+           "nothing written");
+  MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
+           " elements placed intersect others or themselves after embedding and were removed "
+           "(try a smaller --scale, or --keep-intersecting); nothing written");
   {
     ScopedStageTimer timer(stats.times, "write");
     write_mesh(out_path, result);

@@ -3,6 +3,8 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "cli/run_context.h"
+#include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 #include "core/swatch_generators.h"
@@ -26,14 +28,27 @@ int run_swatch(int argc, char** argv, int first) {
   cl.option("detail", "N", "segments around a ring/tube or apple resolution", "0");
   cl.option("seed", "N", "random seed (apples, ivy)", "1");
   cl.flag("quiet", "print nothing but errors");
+  cl.option("max-faces", "N",
+            "refuse a swatch estimated to have more faces (also bounded by the machine's memory)",
+            "2e7");
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("output")) throw UsageError("-o FILE is required");
   const std::string kind = cl.positional_value("KIND");
   const std::string out = cl.get("output");
   mesh_format_from_path(out);
+  check_paths({out}, {});
   const double scale = cl.get_double("scale", 0, 1e-6, 1e6);
   const int detail = static_cast<int>(cl.get_int("detail", 0, 256));
   const auto seed = static_cast<uint64_t>(cl.get_int("seed", 0, 1LL << 62));
+  const double limit = face_limit(cl);
+  // The size is estimated from a small swatch of the same kind and detail before the real one
+  // is made (issue 14: 200 x 200 rings at --detail 256 would need ~54 GB).
+  const auto check_size = [&](double faces) {
+    MQ_CHECK(faces <= limit, InvalidInput, "this ", kind, " swatch would have about ", faces,
+             " faces, more than the limit of ", limit,
+             " (--max-faces); use fewer elements or a "
+             "lower --detail");
+  };
   TriMesh mesh;
   if (kind == "chainmail") {
     ChainMailOptions o;
@@ -42,6 +57,9 @@ int run_swatch(int argc, char** argv, int first) {
     o.ring_radius *= scale;
     o.wire_radius *= scale;
     if (detail) o.ring_segments = std::max(8, detail), o.wire_segments = std::max(4, detail / 4);
+    ChainMailOptions one = o;
+    one.rows = one.cols = 1;
+    check_size(static_cast<double>(chainmail_4in1(one).num_faces()) * o.rows * o.cols);
     mesh = chainmail_4in1(o);
   } else if (kind == "weave") {
     WeaveOptions o;
@@ -50,6 +68,10 @@ int run_swatch(int argc, char** argv, int first) {
     o.spacing *= scale;
     o.thread_radius *= scale;
     if (detail) o.tube_segments = std::max(4, detail);
+    WeaveOptions small = o;
+    small.threads_x = small.threads_y = 2;
+    check_size(static_cast<double>(plain_weave(small).num_faces()) * o.threads_x * o.threads_y /
+               4.0);
     mesh = plain_weave(o);
   } else if (kind == "apples") {
     AppleOptions o;
@@ -57,6 +79,9 @@ int run_swatch(int argc, char** argv, int first) {
     o.mean_radius *= scale;
     o.seed = seed;
     if (detail) o.resolution = std::max(6, detail);
+    AppleOptions one = o;
+    one.count = 1;
+    check_size(static_cast<double>(apple_layer(one).num_faces()) * o.count);
     mesh = apple_layer(o);
   } else if (kind == "ivy") {
     IvyOptions o;
@@ -64,6 +89,14 @@ int run_swatch(int argc, char** argv, int first) {
     o.length = cl.get_double("length", 0, 1e-3, 1e6) * scale;
     o.leaf_size *= scale;
     o.seed = seed;
+    IvyOptions bare = o;  // the vine per unit length, then one leaf
+    bare.leaves = 0;
+    bare.length = std::min(o.length, 10 * scale);
+    const double vine = ivy_section(bare).num_faces();
+    IvyOptions leafy = bare;
+    leafy.leaves = 1;
+    const double leaf = std::max(0, ivy_section(leafy).num_faces() - static_cast<int>(vine));
+    check_size(vine * o.length / bare.length + leaf * o.leaves);
     mesh = ivy_section(o);
   } else {
     throw UsageError("unknown swatch kind '" + kind + "' (chainmail, weave, apples or ivy)");

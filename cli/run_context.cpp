@@ -1,7 +1,9 @@
 #include "cli/run_context.h"
 
 #include <tbb/info.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "core/errors.h"
@@ -19,6 +21,23 @@ void add_run_options(CommandLine& cl) {
   cl.flag("quiet", "print nothing but errors (no progress, no summary)");
   cl.option("stats", "FILE.json", "write counts and per-stage timings as JSON");
   cl.option("threads", "N", "worker threads (0 = all cores)", "0");
+  cl.option("max-faces", "N",
+            "refuse a job estimated to output more faces (also bounded by the machine's memory)",
+            "2e7");
+}
+
+double face_limit(const CommandLine& cl) {
+  const double asked = cl.get_double("max-faces", 0, 1, 1e12);
+  // About 350 bytes of peak memory per output face (the armor job: 710 MiB for 2.2M faces);
+  // 400 with a margin, against 80% of the physical memory.
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return asked;
+  const double memory = static_cast<double>(pages) * static_cast<double>(page);
+  const double fits = 0.8 * memory / 400.0;
+  MQ_CHECK(asked <= fits || !cl.has("max-faces"), InvalidInput, "--max-faces ", asked,
+           " needs about ", asked * 400 / (1 << 30), " GiB of memory; this machine has ",
+           memory / (1 << 30), " GiB");
+  return std::min(asked, fits);
 }
 
 void check_output_directory(const std::string& path) {
@@ -26,6 +45,41 @@ void check_output_directory(const std::string& path) {
   std::error_code ec;
   MQ_CHECK(dir.empty() || std::filesystem::is_directory(dir, ec), InvalidInput, path,
            ": the directory '", dir.string(), "' does not exist");
+}
+
+namespace {
+
+// Whether a and b name the same file: the same inode when both exist, else the same normalised
+// absolute path.
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return ca == cb;
+}
+
+}  // namespace
+
+void check_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const std::string& out = outputs[i];
+    if (out.empty()) continue;
+    check_output_directory(out);
+    std::error_code ec;
+    MQ_CHECK(!fs::is_directory(out, ec), InvalidInput, out, ": is a directory");
+    const fs::path dir = fs::path(out).parent_path();
+    MQ_CHECK(::access(dir.empty() ? "." : dir.c_str(), W_OK | X_OK) == 0, InvalidInput, out,
+             ": cannot write in the directory '", dir.empty() ? "." : dir.string(), "'");
+    for (size_t j = 0; j < i; ++j)
+      MQ_CHECK(outputs[j].empty() || !same_file(out, outputs[j]), InvalidInput, out,
+               ": named as two outputs (e.g. -o and --stats)");
+    for (const std::string& in : inputs)
+      MQ_CHECK(in.empty() || !same_file(out, in), InvalidInput, out,
+               ": is also an input file; it would be overwritten");
+  }
 }
 
 RunContext::RunContext(const CommandLine& cl)

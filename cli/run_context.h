@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
@@ -21,6 +22,16 @@ void add_run_options(CommandLine& cl);
 // Throws InvalidInput naming `path` when the directory it would be written to does not exist,
 // so that a run fails before its work rather than after it (leaving nothing half done).
 void check_output_directory(const std::string& path);
+
+// The --max-faces limit, lowered to what the machine's memory holds. Throws InvalidInput when
+// an explicit --max-faces cannot fit in memory.
+double face_limit(const CommandLine& cl);
+
+// Every output path checked before any work (issue 14): its directory exists and is writable,
+// it is not a directory, and it names neither another output nor an input file (`--stats
+// out.obj -o out.obj` would replace the mesh with the JSON; `--stats` naming the swatch would
+// overwrite an input). Empty paths are skipped. Throws InvalidInput naming the path.
+void check_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
 
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {

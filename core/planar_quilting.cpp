@@ -97,15 +97,20 @@ void validate(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
   MQ_CHECK(smallest <= std::max(o.length, o.width), InvalidInput,
            "every element of the swatch is larger than the requested ", o.length, " x ", o.width,
            " domain (smallest element spans ", smallest, ")");
-  // Output size estimate from the swatch's face density, to refuse jobs that cannot fit.
-  const double faces =
-      static_cast<double>(s.mesh.F.rows()) * o.length * o.width / (s.size.x() * s.size.y());
-  MQ_CHECK(faces < 2e8, InvalidInput, "a ", o.length, " x ", o.width,
-           " layer of this swatch would have about ", faces,
-           " faces, more than this tool can hold; choose a smaller size");
+  // Output size estimate, to refuse jobs that cannot fit before any work.
+  const double faces = estimated_plane_faces(s, o.length, o.width);
+  MQ_CHECK(faces <= o.max_faces, InvalidInput, "a ", o.length, " x ", o.width,
+           " layer of this swatch would have about ", faces, " faces, more than the limit of ",
+           o.max_faces, " (--max-faces); choose a smaller size");
 }
 
 }  // namespace
+
+double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width) {
+  const double sx = swatch.size.x(), sy = swatch.size.y();
+  return static_cast<double>(swatch.mesh.F.rows()) * std::max(length, sx) * std::max(width, sy) /
+         (sx * sy);
+}
 
 double matching_cell_size(const PreparedSwatch& s) {
   // Half an element across, but at least 8 cells along the swatch's shorter side so the
@@ -128,9 +133,17 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   const double cell = options.cell_size > 0 ? options.cell_size : matching_cell_size(swatch);
   MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ", cell,
            " is larger than the swatch's footprint");
+  // The grid and the swatch in cells bound the memory of the grid and the offsets each match
+  // searches (every swatch cell is a candidate offset): the default cell gives at most a few
+  // hundred thousand and a few hundred.
   const double cells_estimate = std::ceil(options.length / cell) * std::ceil(options.width / cell);
-  MQ_CHECK(cells_estimate <= double(1 << 26), InvalidInput, "the grid would have ", cells_estimate,
-           " cells; use a larger --cell");
+  MQ_CHECK(cells_estimate <= double(1 << 24), InvalidInput, "the grid would have ", cells_estimate,
+           " cells of size ", cell, " (at most ", 1 << 24, "); use a larger --cell");
+  const double swatch_cells =
+      std::floor(swatch.size.x() / cell) * std::floor(swatch.size.y() / cell);
+  MQ_CHECK(swatch_cells <= double(1 << 16), InvalidInput, "a cell of ", cell,
+           " divides the swatch into ", swatch_cells, " cells (at most ", 1 << 16,
+           "), too many offsets to match; use a larger --cell");
   SynthesisGrid grid(Vector2d::Zero(), cell, static_cast<int>(std::ceil(options.length / cell)),
                      static_cast<int>(std::ceil(options.width / cell)));
   stats.cell_size = cell;

@@ -31,7 +31,14 @@ struct PlanarQuiltingOptions {
   bool deform = true;        // section 2.6 element deformation
   bool trim_border = false;  // cut elements crossing the domain border open instead of whole
   uint64_t seed = 1;         // for the epsilon-random offset choice
+  // Refuse a job whose output is estimated above this many faces (issue 14: a size that would
+  // run for hours or exhaust memory fails at once; about 350 bytes of memory per face).
+  double max_faces = 2e7;
 };
+
+// Estimated faces of a length x width layer of the swatch: whole swatch copies, so a strip
+// thinner than the swatch still costs a swatch's width.
+double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width);
 
 struct PlanarQuiltingStats {
   int iterations = 0;

@@ -1,6 +1,7 @@
 #include "core/surface_quilting.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -292,6 +293,49 @@ void validate_base(const TriMesh& base) {
     for (int k = 0; k < 3; ++k)
       MQ_CHECK(base.F(f, k) >= 0 && base.F(f, k) < base.V.rows(), InvalidInput, "base face ", f,
                " references missing vertex ", base.F(f, k));
+  // Checked here, in the user's terms, rather than by the step that would trip over it later
+  // (issue 14: a zero-size base failed in the refinement, a degenerate face in the shell's
+  // tetrahedra after 12 s of work, a base listed twice gave an empty result).
+  const Vector3d extent = bounding_box(base.V, base.F).extent();
+  MQ_CHECK(extent.allFinite(), InvalidInput,
+           "the base mesh's coordinates are too large (its size overflows)");
+  MQ_CHECK(extent.norm() > 0, InvalidInput,
+           "the base mesh has zero size (all its vertices at one "
+           "point)");
+  for (int f = 0; f < base.F.rows(); ++f) {
+    const int a = base.F(f, 0), b = base.F(f, 1), c = base.F(f, 2);
+    MQ_CHECK(a != b && b != c && a != c, InvalidInput, "base face ", f,
+             " repeats a vertex (a degenerate face); remove it from the base mesh");
+  }
+}
+
+// The mesh without faces that repeat an earlier one (the same three vertices, in any order);
+// input_face[f] is the face of `mesh` that face f of the result is. Real models carry them
+// (the wicker chair: 2 of 17k) and a base listed twice over gave an empty result (issue 14):
+// the first of each is kept.
+TriMesh without_duplicate_faces(const TriMesh& mesh, std::vector<int>& input_face, int* removed) {
+  std::vector<std::array<int, 4>> sorted(static_cast<size_t>(mesh.F.rows()));
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    std::array<int, 4> t{mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2), f};
+    std::sort(t.begin(), t.begin() + 3);
+    sorted[static_cast<size_t>(f)] = t;
+  }
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<char> keep(static_cast<size_t>(mesh.F.rows()), 1);
+  for (size_t i = 1; i < sorted.size(); ++i)
+    if (std::equal(sorted[i].begin(), sorted[i].begin() + 3, sorted[i - 1].begin()))
+      keep[static_cast<size_t>(sorted[i][3])] = 0;  // sorted by index too: the later one goes
+  input_face.clear();
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    if (keep[static_cast<size_t>(f)]) input_face.push_back(f);
+  *removed = mesh.F.rows() - static_cast<int>(input_face.size());
+  if (*removed == 0) return mesh;
+  TriMesh out;
+  out.V = mesh.V;
+  out.F.resize(static_cast<Eigen::Index>(input_face.size()), 3);
+  for (size_t i = 0; i < input_face.size(); ++i)
+    out.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(input_face[i]);
+  return out;
 }
 
 }  // namespace
@@ -361,6 +405,24 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   // Exporters split vertices along hard edges; welded, a box's sides form one surface and
   // patches (and elements) can wrap around its edges.
   job.cleaned = weld_vertices(base_in, &stats.welded_vertices);
+  std::vector<int> input_face;  // job.cleaned's faces -> base_in's
+  job.cleaned = without_duplicate_faces(job.cleaned, input_face, &stats.duplicate_faces);
+  // The output estimated before any work: the swatch's faces per unit of footprint area at its
+  // scale on the surface, over the base's area (issue 14: --scale 1e-6 ran out of memory).
+  {
+    const BoundingBox sb = bounding_box(swatch_mesh.V, swatch_mesh.F);
+    Vector3d e = sb.extent();
+    std::sort(e.data(), e.data() + 3);
+    // The refined base below has the same bounding box, so this is the scale used throughout.
+    job.swatch_scale = swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
+    const double k = job.swatch_scale;
+    const double footprint = std::max(e(1) * e(2), 1e-300) * k * k;
+    const double faces = static_cast<double>(swatch_mesh.num_faces()) *
+                         face_areas(base_in.V, base_in.F).sum() / footprint;
+    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
+             " the texture would have about ", faces, " faces, more than the limit of ",
+             options.max_faces, " (--max-faces); use a larger --scale");
+  }
   // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
   // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
   // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
@@ -373,14 +435,14 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   if (options.field.rows()) {
     job.field.resize(job.base.num_faces(), 3);
     for (int f = 0; f < job.base.num_faces(); ++f)
-      job.field.row(f) = options.field.row(job.refinement.parent[static_cast<size_t>(f)]);
+      job.field.row(f) = options.field.row(
+          input_face[static_cast<size_t>(job.refinement.parent[static_cast<size_t>(f)])]);
   } else {
     job.field = smooth_tangent_field(job.base.V, job.base.F);
   }
   job.topo = edge_topology(job.base.F, job.base.num_vertices());
   job.TT = face_adjacency(job.topo);
   // The swatch at its size on the surface (section 3.1's relative size s).
-  job.swatch_scale = swatch_scale_for(job.base, swatch_mesh, options.scale);
   job.swatch = swatch_mesh;
   job.swatch.V *= job.swatch_scale;
   stats.swatch_scale = job.swatch_scale;

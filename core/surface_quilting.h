@@ -67,6 +67,9 @@ struct SurfaceQuiltingOptions {
   }();
   PatchQuiltingOptions patch;
   uint64_t seed = 1;
+  // Refuse a job whose output is estimated above this many faces (the swatch's faces per unit
+  // of footprint area times the base's area): issue 14.
+  double max_faces = 2e7;
   // The global-parameterisation method (core/global_quilting).
   struct Global {
     // Weight of the guidance field against the line field's smoothness: small lets the
@@ -87,6 +90,7 @@ struct SurfaceQuiltingStats {
   int iterations = 0;
   int base_faces = 0;       // after refinement
   int welded_vertices = 0;  // base vertices merged with another at the same position
+  int duplicate_faces = 0;  // base faces that repeated another, removed
   int patches_shrunk = 0;
   double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;

@@ -1,0 +1,186 @@
+// Issue 14's cases, run as a user would: every bad input, impossible size or clashing path
+// ends in under the timeout with exit 1 or 2, one line naming the problem, and nothing written;
+// or, where the input is valid, a correct result.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tests/cli/cli_support.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+// A 2 x 2 grid of squares as an OFF base (9 vertices, 8 faces), with extra face lines.
+std::string grid_off(const std::string& extra_faces = "", int extra = 0) {
+  std::string s = "OFF\n9 " + std::to_string(8 + extra) + " 0\n";
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) s += std::to_string(i) + " " + std::to_string(j) + " 0\n";
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int a = 3 * j + i, b = a + 1, c = a + 4, d = a + 3;
+      s += "3 " + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(c) + "\n";
+      s += "3 " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(d) + "\n";
+    }
+  return s + extra_faces;
+}
+
+std::string binary_ply_header(const std::string& elements_before, long long vertices) {
+  return "ply\nformat binary_little_endian 1.0\n" + elements_before + "element vertex " +
+         std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+         "property list uchar int vertex_indices\nend_header\n";
+}
+
+std::string one_triangle_binary() {
+  std::string body;
+  const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  body.append(reinterpret_cast<const char*>(v), sizeof v);
+  body.push_back(3);
+  const int32_t f[3] = {0, 1, 2};
+  body.append(reinterpret_cast<const char*>(f), sizeof f);
+  return body;
+}
+
+class Reliability : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::temp_dir();
+    const CliRun r =
+        meshquilt(dir_, "swatch chainmail --rows 2 --cols 2 --detail 16 -o sw.obj --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    spit(dir_ + "/grid.off", grid_off());
+  }
+  // Runs args with a generous timeout (the target is 5 s; a hang or an hour-long job fails)
+  // and expects exit 1 or 2, one line containing `message`, and the directory unchanged.
+  void expect_refused(const std::string& args, const std::string& message) {
+    SCOPED_TRACE(args);
+    const std::vector<std::string> before = listing(dir_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const CliRun r = meshquilt(dir_, args, 60);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_FALSE(r.signaled) << "killed (status " << r.status << ")";
+    EXPECT_TRUE(r.status == 1 || r.status == 2) << r.status << ": " << r.err;
+    const auto lines = r.err_lines();
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_NE(lines[0].find(message), std::string::npos) << lines[0];
+    EXPECT_LT(seconds, 20.0);
+    EXPECT_EQ(listing(dir_), before);
+  }
+  std::string dir_;
+};
+
+TEST_F(Reliability, DeclaredCountsAreBoundedByTheData) {
+  spit(dir_ + "/big.off", "OFF\n268435456 1 0\n0 0 0\n");  // the issue's 24-byte file
+  expect_refused("info big.off", "need more data than the file's");
+  spit(dir_ + "/huge.off", "OFF\n2147483647 2147483647 0\n0 0 0\n3 0 0 0\n");
+  expect_refused("info huge.off", "need more data than the file's");
+  spit(dir_ + "/big.ply", binary_ply_header("", 2000000000) + std::string(40, '\0'));
+  expect_refused("info big.ply", "element 'vertex' count 2000000000 needs more data");
+  spit(dir_ + "/big_ascii.ply",
+       "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\n"
+       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+       "0 0 0\n");
+  expect_refused("plane --swatch big_ascii.ply --size 5 5 -o o.obj", "needs more data");
+}
+
+TEST_F(Reliability, ElementsWithoutPropertiesAreSkipped) {
+  std::string empty_elements;
+  for (int i = 0; i < 100; ++i)
+    empty_elements += "element junk" + std::to_string(i) + " 2147483647\n";
+  spit(dir_ + "/junk.ply", binary_ply_header(empty_elements, 3) + one_triangle_binary());
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun r = meshquilt(dir_, "info junk.ply");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("faces:             1\n"), std::string::npos) << r.out;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+}
+
+TEST_F(Reliability, NonRegularFilesAreRefused) {
+  ASSERT_EQ(::mkfifo((dir_ + "/pipe.off").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo((dir_ + "/keys.txt").c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", dir_ + "/zero.obj");
+  fs::create_symlink("/dev/urandom", dir_ + "/random.ply");
+  fs::create_symlink("/dev/zero", dir_ + "/zero_keys.txt");
+  expect_refused("info pipe.off", "is a pipe (FIFO), not a regular file");
+  expect_refused("info zero.obj", "is a device, not a regular file");
+  expect_refused("info random.ply", "is a device, not a regular file");
+  expect_refused("surface --base grid.off --swatch sw.obj --keys keys.txt -o o.obj",
+                 "is a pipe (FIFO)");
+  expect_refused("surface --base grid.off --swatch sw.obj --keys zero_keys.txt -o o.obj",
+                 "is a device");
+  expect_refused("surface --base grid.off --swatch sw.obj --field-file pipe.off -o o.obj",
+                 "is a pipe (FIFO)");
+}
+
+TEST_F(Reliability, NoGeometryIsAnErrorNotAnEmptyFile) {
+  // Every face listed twice, or one duplicated face: the duplicates are dropped (and counted),
+  // and the result is the same as for the grid itself.
+  std::string twice = grid_off();
+  const size_t faces_at = twice.find("\n3 ");
+  twice = "OFF\n9 16 0\n" + twice.substr(twice.find('\n', 4) + 1) + twice.substr(faces_at + 1);
+  spit(dir_ + "/twice.off", twice);
+  spit(dir_ + "/dup.off", grid_off("3 4 5 8\n", 1));
+  const CliRun ref = meshquilt(dir_, "surface --base grid.off --swatch sw.obj -o ref.obj --quiet");
+  ASSERT_EQ(ref.status, 0) << ref.err;
+  for (const char* base : {"twice.off", "dup.off"}) {
+    const CliRun r = meshquilt(dir_, std::string("surface --base ") + base +
+                                         " --swatch sw.obj -o o.obj --stats s.json --quiet");
+    ASSERT_EQ(r.status, 0) << base << ": " << r.err;
+    EXPECT_TRUE(slurp(dir_ + "/o.obj") == slurp(dir_ + "/ref.obj")) << base;
+    EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "duplicate_faces"),
+              std::string(base) == "dup.off" ? "1" : "8");
+    fs::remove(dir_ + "/o.obj");
+    fs::remove(dir_ + "/s.json");
+  }
+  fs::remove(dir_ + "/ref.obj");
+  spit(dir_ + "/degenerate.off", grid_off("3 4 4 8\n", 1));
+  expect_refused("surface --base degenerate.off --swatch sw.obj -o o.obj", "repeats a vertex");
+  spit(dir_ + "/point.off", "OFF\n3 1 0\n1 1 1\n1 1 1\n1 1 1\n3 0 1 2\n");
+  expect_refused("surface --base point.off --swatch sw.obj -o o.obj", "zero size");
+  expect_refused("surface --base grid.off --swatch sw.obj --scale 10 -o o.obj --quiet",
+                 "nothing written");
+}
+
+TEST_F(Reliability, SizesThatCannotFitAreRefusedBeforeWork) {
+  expect_refused("plane --swatch sw.obj --size 1e6 0.5 -o o.obj", "--max-faces");
+  expect_refused("plane --swatch sw.obj --size 8 8 --cell 1e-3 -o o.obj", "use a larger --cell");
+  expect_refused("plane --swatch sw.obj --size 8 8 --cell 0.01 -o o.obj", "use a larger --cell");
+  expect_refused("surface --base grid.off --swatch sw.obj --scale 1e-6 -o o.obj",
+                 "use a larger --scale");
+  expect_refused("swatch chainmail --rows 200 --cols 200 --detail 256 -o o.obj", "--max-faces");
+  expect_refused("swatch weave --rows 200 --cols 200 --detail 256 -o o.obj", "--max-faces");
+  expect_refused("plane --swatch sw.obj --size 5 5 --max-faces 10 -o o.obj", "limit of 10");
+  // The override lets a job through that the default would also allow.
+  const CliRun ok = meshquilt(dir_, "plane --swatch sw.obj --size 5 5 --max-faces 1e6 -o o.obj");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
+  expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats o.obj", "two outputs");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats ./o.obj", "two outputs");
+  const std::string swatch_before = slurp(dir_ + "/sw.obj");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats sw.obj", "is also an input");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o sw.obj", "is also an input");
+  EXPECT_TRUE(slurp(dir_ + "/sw.obj") == swatch_before);
+  expect_refused("surface --base grid.off --swatch sw.obj -o grid.off", "is also an input");
+  expect_refused("info sw.obj --links --elements sw.obj", "is also an input");
+  fs::create_directory(dir_ + "/sub.obj");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o sub.obj", "is a directory");
+  if (::geteuid() != 0) {  // root writes into read-only directories
+    fs::create_directory(dir_ + "/ro");
+    fs::permissions(dir_ + "/ro", fs::perms::owner_read | fs::perms::owner_exec);
+    expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats ro/s.json",
+                   "cannot write in the directory");
+    fs::permissions(dir_ + "/ro", fs::perms::owner_all);
+  }
+}
+
+}  // namespace
+}  // namespace mq
