@@ -15,3 +15,7 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE slow
 fi
+# The readers under libFuzzer with ASan + UBSan, 12 s per target (issue 14).
+if [ "${MESHQUILT_SKIP_FUZZ:-0}" != 1 ]; then
+  bash scripts/fuzz.sh 12
+fi
