@@ -8,6 +8,7 @@
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
@@ -50,6 +51,11 @@ int run_info(int argc, char** argv, int first) {
   const double scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
   check_paths({cl.get("elements")}, {path, cl.get("swatch"), cl.get("base")});
   const TriMesh mesh = read_mesh(path);
+  // Finite coordinates whose differences overflow would print inf and nan sizes and areas.
+  MQ_CHECK(mesh.V.rows() == 0 || (bounding_box(mesh.V).extent().allFinite() &&
+                                  (mesh.V.cwiseAbs().maxCoeff() < 1e150)),
+           InvalidInput, path, ": coordinates too large to measure (up to ",
+           mesh.V.cwiseAbs().maxCoeff(), "; sizes and areas would overflow)");
   std::optional<SwatchStructure> swatch;
   StructureReport structure;
   std::optional<StructureComparison> comparison;

@@ -1,5 +1,6 @@
 #include "cli/command_line.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -58,7 +59,15 @@ bool CommandLine::parse(int argc, char** argv, int first) {
         vals.push_back(inline_value);
       }
       while (static_cast<int>(vals.size()) < o->arity) {
-        if (i + 1 >= argc) throw UsageError("option --" + name + " expects " + o->value_names);
+        // An option where a value belongs ("--size 8 -o x"): too few values, said as such
+        // rather than as an unexpected argument further on. "-3" is a value.
+        const bool next_is_option =
+            i + 1 < argc && argv[i + 1][0] == '-' &&
+            !(std::isdigit(static_cast<unsigned char>(argv[i + 1][1])) || argv[i + 1][1] == '.');
+        if (i + 1 >= argc || next_is_option)
+          throw UsageError("option --" + name + " expects " + o->value_names + " (" +
+                           std::to_string(o->arity) + " value" + (o->arity > 1 ? "s" : "") +
+                           "), got " + std::to_string(vals.size()));
         vals.emplace_back(argv[++i]);
       }
       if (o->arity == 0) vals.emplace_back("1");

@@ -44,10 +44,10 @@ void ConsoleProgress::update(const std::string& stage, double done, double total
     const int filled = static_cast<int>(std::lround(fraction * width));
     std::string bar(filled, '#');
     bar.resize(width, '-');
-    std::fprintf(stderr, "\r%-22.22s [%s] %3d%%  %s", stage.c_str(), bar.c_str(),
-                 static_cast<int>(fraction * 100),
-                 can_estimate ? ("ETA " + format_duration(remaining) + "   ").c_str()
-                              : "            ");
+    std::fprintf(
+        stderr, "\r%-22.22s [%s] %3d%%  %s", stage.c_str(), bar.c_str(),
+        static_cast<int>(fraction * 100),
+        can_estimate ? ("ETA " + format_duration(remaining) + "   ").c_str() : "            ");
     std::fflush(stderr);
     line_open_ = true;
   } else {

@@ -309,16 +309,20 @@ void validate_base(const TriMesh& base) {
   }
 }
 
-// The mesh without faces that repeat an earlier one (the same three vertices, in any order);
-// input_face[f] is the face of `mesh` that face f of the result is. Real models carry them
-// (the wicker chair: 2 of 17k) and a base listed twice over gave an empty result (issue 14):
-// the first of each is kept.
+// The mesh without faces that repeat an earlier one (the same three vertices in the same
+// orientation); input_face[f] is the face of `mesh` that face f of the result is. A base listed
+// twice over gave an empty result (issue 14): the first of each is kept. The same triangle
+// facing the other way is kept: it is the back of a two-sided sheet (the wicker chair has 35
+// such pairs, and without their backs its patches meet non-manifold borders).
 TriMesh without_duplicate_faces(const TriMesh& mesh, std::vector<int>& input_face, int* removed) {
+  // Key: the face rotated to start at its smallest index (orientation kept), then the face.
   std::vector<std::array<int, 4>> sorted(static_cast<size_t>(mesh.F.rows()));
   for (int f = 0; f < mesh.F.rows(); ++f) {
-    std::array<int, 4> t{mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2), f};
-    std::sort(t.begin(), t.begin() + 3);
-    sorted[static_cast<size_t>(f)] = t;
+    int r = 0;
+    for (int k = 1; k < 3; ++k)
+      if (mesh.F(f, k) < mesh.F(f, r)) r = k;
+    sorted[static_cast<size_t>(f)] = {mesh.F(f, r), mesh.F(f, (r + 1) % 3), mesh.F(f, (r + 2) % 3),
+                                      f};
   }
   std::sort(sorted.begin(), sorted.end());
   std::vector<char> keep(static_cast<size_t>(mesh.F.rows()), 1);

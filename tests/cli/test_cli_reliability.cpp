@@ -162,6 +162,17 @@ TEST_F(Reliability, SizesThatCannotFitAreRefusedBeforeWork) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+TEST_F(Reliability, MessagesInTheUsersTerms) {
+  spit(dir_ + "/far.off", "OFF\n3 1 0\n-1e308 0 0\n1e308 0 0\n0 1e308 0\n3 0 1 2\n");
+  expect_refused("info far.off", "coordinates too large");
+  expect_refused("plane --swatch sw.obj --size 8 -o o.obj", "expects L W (2 values), got 1");
+  spit(dir_ + "/zero.txt", std::string(9 * 2, ' ') +
+                               "\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n"
+                               "0 0 0\n0 0 0\n0 0 0\n0 0 0\n");
+  expect_refused("surface --base grid.off --swatch sw.obj --field-file zero.txt -o o.obj",
+                 "all zero");
+}
+
 TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
   expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats o.obj", "two outputs");
   expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats ./o.obj", "two outputs");
