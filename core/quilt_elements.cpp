@@ -1,5 +1,7 @@
 #include "core/quilt_elements.h"
 
+#include <algorithm>
+
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
@@ -87,6 +89,12 @@ PreparedSwatch prepare_swatch(const TriMesh& swatch) {
   s.size = box.extent();
   MQ_CHECK(s.size.x() > 0 && s.size.y() > 0, InvalidInput,
            "the swatch's footprint has zero area (all vertices on a line)");
+  // Sizes whose squares (areas, distances) underflow or overflow a double: a denormal swatch
+  // was reported as non-finite further on (issue 14). Any real unit, micrometres to
+  // kilometres, is far inside.
+  MQ_CHECK(std::min(s.size.x(), s.size.y()) > 1e-100 && s.size.maxCoeff() < 1e100, InvalidInput,
+           "the swatch's size (", s.size.x(), " x ", s.size.y(), " x ", s.size.z(),
+           ") is too small or too large to compute with; rescale it");
   s.elements = split_elements(m);
   s.mean_edge_length = mean_edge_length(m.V, m.F);
   double diameter = 0;

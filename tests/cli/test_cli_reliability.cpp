@@ -166,6 +166,10 @@ TEST_F(Reliability, MessagesInTheUsersTerms) {
   spit(dir_ + "/far.off", "OFF\n3 1 0\n-1e308 0 0\n1e308 0 0\n0 1e308 0\n3 0 1 2\n");
   expect_refused("info far.off", "coordinates too large");
   expect_refused("plane --swatch sw.obj --size 8 -o o.obj", "expects L W (2 values), got 1");
+  spit(dir_ + "/tiny.off",
+       "OFF\n4 2 0\n0 0 0\n1e-310 0 0\n1e-310 1e-310 0\n0 1e-310 1e-311\n"
+       "3 0 1 2\n3 0 2 3\n");
+  expect_refused("plane --swatch tiny.off --size 5 5 -o o.obj", "too small or too large");
   spit(dir_ + "/zero.txt", std::string(9 * 2, ' ') +
                                "\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n"
                                "0 0 0\n0 0 0\n0 0 0\n0 0 0\n");
