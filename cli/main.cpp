@@ -55,11 +55,12 @@ int main(int argc, char** argv) {
     try {
       return c.run(argc, argv, 2);
     } catch (const mq::cli::UsageError& e) {
-      std::fprintf(stderr, "meshquilt %s: %s (see 'meshquilt %s --help')\n", c.name, e.what(),
-                   c.name);
+      std::fprintf(stderr, "meshquilt %s: %s (see 'meshquilt %s --help')\n", c.name,
+                   mq::detail::printable(e.what()).c_str(), c.name);
       return 2;
     } catch (const mq::Error& e) {
-      std::fprintf(stderr, "meshquilt %s: error: %s\n", c.name, e.what());
+      std::fprintf(stderr, "meshquilt %s: error: %s\n", c.name,
+                   mq::detail::printable(e.what()).c_str());
       return 1;
     } catch (const std::bad_alloc&) {
       std::fprintf(stderr, "meshquilt %s: error: out of memory\n", c.name);

@@ -44,7 +44,7 @@ class TextCursor {
       : path_(path), p_(begin), end_(end) {}
 
   [[noreturn]] void fail(const std::string& message) const {
-    throw InvalidInput(path_ + ":" + std::to_string(line_) + ": " + message);
+    throw InvalidInput(detail::printable(path_ + ":" + std::to_string(line_) + ": " + message));
   }
 
   bool eof() const { return p_ >= end_; }
@@ -405,8 +405,9 @@ class PlyBinaryReader {
     index_ = index;
   }
   [[noreturn]] void fail(const std::string& message) const {
-    throw InvalidInput(path_ + ": " + (element_ ? *element_ : std::string("data")) + " " +
-                       std::to_string(index_) + ": " + message);
+    throw InvalidInput(detail::printable(path_ + ": " +
+                                         (element_ ? *element_ : std::string("data")) + " " +
+                                         std::to_string(index_) + ": " + message));
   }
 
   void skip(PlyType t, long long n = 1) {

@@ -170,6 +170,9 @@ TEST_F(Reliability, MessagesInTheUsersTerms) {
        "OFF\n4 2 0\n0 0 0\n1e-310 0 0\n1e-310 1e-310 0\n0 1e-310 1e-311\n"
        "3 0 1 2\n3 0 2 3\n");
   expect_refused("plane --swatch tiny.off --size 5 5 -o o.obj", "too small or too large");
+  // The file's own bytes in a message: escaped, not echoed raw nor cut at a NUL.
+  spit(dir_ + "/bytes.off", std::string("\xff\xfe\0OFF\x01 3 1 0\n", 13));
+  expect_refused("info bytes.off", "missing OFF header (found '\\xff\\xfe\\x00OFF\\x01')");
   spit(dir_ + "/zero.txt", std::string(9 * 2, ' ') +
                                "\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n"
                                "0 0 0\n0 0 0\n0 0 0\n0 0 0\n");
