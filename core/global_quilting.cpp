@@ -202,14 +202,6 @@ GlobalParameterization seamless_parameterization(const MatrixX3d& V, const TriMe
 
 }  // namespace
 
-bool lattice_swatch(const TriMesh& swatch_mesh) {
-  const PreparedSwatch swatch = prepare_swatch(swatch_mesh);
-  // The self-matching takes 0.2-2 s; scattered or threaded swatches are told apart without it.
-  if (!repeating_elements(swatch)) return false;
-  const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
-  return tileable(swatch, detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch)));
-}
-
 namespace {
 
 // The global method from a prepared job and the swatch's symmetry (found on job.swatch).

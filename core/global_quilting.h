@@ -32,11 +32,6 @@ struct GlobalQuiltingStats {
   int off_surface = 0;          // left out: a vertex beyond a boundary or around a singular vertex
 };
 
-// Whether a swatch is a lattice of compact elements (periodic, core/swatch_symmetry), the
-// textures for which the global method keeps the structure the patch method loses: what the
-// command's --method auto goes by. Throws InvalidInput for a swatch prepare_swatch rejects.
-bool lattice_swatch(const TriMesh& swatch);
-
 // Like quilt_surface (same options, same result), through a global parameterisation.
 // Throws like quilt_surface.
 SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
@@ -46,8 +41,9 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
                                   GlobalQuiltingStats* global_stats = nullptr,
                                   ProgressSink* progress = nullptr);
 
-// --method auto: quilt_surface_global for a lattice swatch (lattice_swatch, decided on the
-// swatch at the job's scale), quilt_surface otherwise; the swatch's symmetry is found once.
+// --method auto: quilt_surface_global for a lattice of compact elements (periodic and
+// tileable, core/swatch_symmetry: the textures whose structure the patch method loses, decided
+// on the swatch at the job's scale), quilt_surface otherwise; the swatch's symmetry is found once.
 // *used_global (optional) says which ran. Throws like quilt_surface.
 SurfaceQuilt quilt_surface_auto(const TriMesh& base, const TriMesh& swatch,
                                 const SurfaceQuiltingOptions& options,

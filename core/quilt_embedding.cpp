@@ -104,6 +104,13 @@ class ElementGrid {
   std::unordered_map<unsigned long long, std::vector<int>> grid_;
 };
 
+// Every intersecting face pair, within an element (a fold) and between two.
+std::vector<std::pair<int, int>> all_face_pairs(const MatrixX3d& V, const MatrixX3i& F) {
+  IntersectionOptions all_pairs;
+  all_pairs.between_components_only = false;
+  return intersecting_face_pairs(V, F, all_pairs);
+}
+
 std::vector<Eigen::Index> vertex_offsets(const SurfaceQuilt& quilt) {
   std::vector<Eigen::Index> first(quilt.elements.size() + 1, 0);
   for (size_t k = 0; k < quilt.elements.size(); ++k)
@@ -142,9 +149,7 @@ std::vector<std::pair<int, int>> updated_pairs(const SurfaceQuilt& quilt, const 
     if (take[static_cast<size_t>(element_of[f])]) faces.push_back(f);
   MatrixX3i sub(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t i = 0; i < faces.size(); ++i) sub.row(static_cast<Eigen::Index>(i)) = F.row(faces[i]);
-  IntersectionOptions all_pairs;
-  all_pairs.between_components_only = false;
-  for (const auto& [a, b] : intersecting_face_pairs(V, sub, all_pairs)) {
+  for (const auto& [a, b] : all_face_pairs(V, sub)) {
     const int f = faces[static_cast<size_t>(a)], g = faces[static_cast<size_t>(b)];
     if (is_changed(f) || is_changed(g)) pairs.emplace_back(f, g);
   }
@@ -279,9 +284,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     if (options.optimize_stretch) {
       // Pairs of faces that intersect, within an element (it folds through itself) or between
       // two: both kinds keep the unoptimised map.
-      IntersectionOptions all_pairs;
-      all_pairs.between_components_only = false;
-      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+      pairs = all_face_pairs(all.V, all.F);
       // Nothing to revert: post-processing would find the same nothing.
       known_disjoint = pairs.empty();
       std::vector<char> revert(quilt.elements.size(), 0);
@@ -311,9 +314,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   if (options.remove_intersecting) {
     ScopedStageTimer timer(stats.times, "fold repair");
     if (!have_pairs && !known_disjoint) {
-      IntersectionOptions all_pairs;
-      all_pairs.between_components_only = false;
-      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+      pairs = all_face_pairs(all.V, all.F);
       have_pairs = true;
     }
     std::vector<char> folded_now(quilt.elements.size(), 0);
@@ -355,9 +356,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "element removal");
     if (!have_pairs) {
-      IntersectionOptions all_pairs;
-      all_pairs.between_components_only = false;
-      pairs = intersecting_face_pairs(all.V, all.F, all_pairs);
+      pairs = all_face_pairs(all.V, all.F);
     }
     for (const auto& [f, g] : pairs)
       if (element_of[f] == element_of[g]) folded[element_of[f]] = drop[element_of[f]] = 1;
