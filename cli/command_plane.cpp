@@ -61,7 +61,7 @@ int run_plane(int argc, char** argv, int first) {
       "(seed finding, geometry matching, element correspondences, deformation, merging).");
   cl.option("swatch", "FILE", "input swatch mesh (OBJ, PLY or OFF)");
   cl.option("size", "L W", "output extent along the swatch's two long axes", "", 2);
-  cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
+  cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("seed", "N", "random seed (used with --variety)", "1");
   cl.option("cell", "SIZE", "grid cell size (default: from the swatch's element size)");
   cl.option("variety", "EPS", "choose randomly among offsets within (1+EPS) of the best", "0");
@@ -70,6 +70,7 @@ int run_plane(int argc, char** argv, int first) {
             "where large translation-cost evaluations run (small ones stay on the CPU)", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
   cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
+  add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
@@ -77,7 +78,10 @@ int run_plane(int argc, char** argv, int first) {
   if (!cl.has("output")) throw UsageError("-o OUT is required");
   const std::string out_path = cl.get("output");
   mesh_format_from_path(out_path);  // fail on an unknown extension before any work
-  check_paths({out_path, cl.get("stats")}, {cl.get("swatch")});
+  const WriteOptions write_options = output_options(cl);
+  std::vector<std::string> outputs = output_files(out_path, write_options);
+  outputs.push_back(cl.get("stats"));
+  check_paths(outputs, {cl.get("swatch")});
 
   PlanarQuiltingOptions options;
   options.length = cl.get_double("size", 0, 1e-300, 1e300);
@@ -103,7 +107,8 @@ int run_plane(int argc, char** argv, int first) {
            options.width, " domain; nothing written");
   {
     ScopedStageTimer timer(stats.times, "write");
-    write_mesh(out_path, result);
+    ScopedStageProgress shown(run.progress(), "writing");
+    write_output(out_path, result, write_options);
   }
   run.progress()->finish();
   const double wall =

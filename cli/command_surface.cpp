@@ -107,7 +107,7 @@ int run_surface(int argc, char** argv, int first) {
                  "quilting over local conformal patches (paper section 3.1).");
   cl.option("base", "FILE", "base mesh (OBJ, PLY or OFF)");
   cl.option("swatch", "FILE", "swatch mesh; its smallest bounding-box side is the shell height");
-  cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
+  cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("scale", "S", "swatch's longer side as a fraction of the base's bounding-box diagonal",
             "0.1");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
@@ -128,6 +128,7 @@ int run_surface(int argc, char** argv, int first) {
             "chain mail linked); patches: local conformal patches (the paper's); auto: global "
             "for a lattice of compact elements",
             "auto");
+  add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("base")) throw UsageError("--base FILE is required");
@@ -137,8 +138,10 @@ int run_surface(int argc, char** argv, int first) {
     throw UsageError("give at most one of --field, --field-file and --keys");
   const std::string out_path = cl.get("output");
   mesh_format_from_path(out_path);
-  check_paths({out_path, cl.get("stats")},
-              {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
+  const WriteOptions write_options = output_options(cl);
+  std::vector<std::string> outputs = output_files(out_path, write_options);
+  outputs.push_back(cl.get("stats"));
+  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
 
   SurfaceQuiltingOptions options;
   options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
@@ -187,7 +190,7 @@ int run_surface(int argc, char** argv, int first) {
           : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
-  const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats);
+  const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
   // A run that makes no geometry is an error, not an empty file (issue 14).
   MQ_CHECK(!quilt.elements.empty(), InvalidInput,
            "no element of the swatch could be placed on "
@@ -200,7 +203,8 @@ int run_surface(int argc, char** argv, int first) {
            "(try a smaller --scale, or --keep-intersecting); nothing written");
   {
     ScopedStageTimer timer(stats.times, "write");
-    write_mesh(out_path, result);
+    ScopedStageProgress shown(run.progress(), "writing");
+    write_output(out_path, result, write_options);
   }
   run.progress()->finish();
   const double wall =

@@ -19,7 +19,7 @@ int run_swatch(int argc, char** argv, int first) {
                  "  apples     a layer of apple-like blobs of varied size\n"
                  "  ivy        a vine section with leaves");
   cl.positional("KIND", "chainmail | weave | apples | ivy");
-  cl.option("output", "FILE", "output mesh (.obj, .ply or .off)");
+  cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("rows", "N", "chainmail: ring rows; weave: threads along x", "6");
   cl.option("cols", "N", "chainmail: ring columns; weave: threads along y", "6");
   cl.option("count", "N", "apples: number of apples; ivy: number of leaves", "24");
@@ -31,12 +31,14 @@ int run_swatch(int argc, char** argv, int first) {
   cl.option("max-faces", "N",
             "refuse a swatch estimated to have more faces (also bounded by the machine's memory)",
             "2e7");
+  add_output_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("output")) throw UsageError("-o FILE is required");
   const std::string kind = cl.positional_value("KIND");
   const std::string out = cl.get("output");
   mesh_format_from_path(out);
-  check_paths({out}, {});
+  const WriteOptions write_options = output_options(cl);
+  check_paths(output_files(out, write_options), {});
   const double scale = cl.get_double("scale", 0, 1e-6, 1e6);
   const int detail = static_cast<int>(cl.get_int("detail", 0, 256));
   const auto seed = static_cast<uint64_t>(cl.get_int("seed", 0, 1LL << 62));
@@ -101,7 +103,7 @@ int run_swatch(int argc, char** argv, int first) {
   } else {
     throw UsageError("unknown swatch kind '" + kind + "' (chainmail, weave, apples or ivy)");
   }
-  write_mesh(out, mesh);
+  write_output(out, mesh, write_options);
   if (!cl.has("quiet")) {
     std::vector<int> fc;
     const int elements = connected_components(mesh.F, mesh.num_vertices(), fc);

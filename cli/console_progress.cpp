@@ -18,8 +18,11 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
-ConsoleProgress::ConsoleProgress(bool quiet)
-    : quiet_(quiet), terminal_(::isatty(STDERR_FILENO) == 1), start_(Clock::now()) {
+ConsoleProgress::ConsoleProgress(bool quiet, bool machine)
+    : quiet_(quiet && !machine),
+      terminal_(::isatty(STDERR_FILENO) == 1 && !machine),
+      machine_(machine),
+      start_(Clock::now()) {
   last_print_ = start_;
 }
 
@@ -38,7 +41,16 @@ void ConsoleProgress::update(const std::string& stage, double done, double total
   // Remaining time of the current stage extrapolated from its own rate so far.
   const bool can_estimate = fraction > 0.02 && stage_elapsed > 0.5;
   const double remaining = can_estimate ? stage_elapsed * (1 - fraction) / fraction : 0;
-  if (terminal_) {
+  if (machine_) {
+    // Every stage's start and end are printed; in between at most one line per 0.25 s.
+    const bool new_stage = last_fraction_ < 0;
+    if (!new_stage && now - last_print_ < std::chrono::milliseconds(250) && fraction < 1) return;
+    if (fraction >= 1 && last_fraction_ >= 1) return;
+    std::fprintf(stderr, "progress %s %.4f %.2f %.2f\n", stage.c_str(), fraction,
+                 std::chrono::duration<double>(now - start_).count(),
+                 can_estimate ? remaining : -1.0);
+    std::fflush(stderr);
+  } else if (terminal_) {
     if (now - last_print_ < std::chrono::milliseconds(100) && fraction < 1) return;
     const int width = 30;
     const int filled = static_cast<int>(std::lround(fraction * width));

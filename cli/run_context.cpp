@@ -21,9 +21,45 @@ void add_run_options(CommandLine& cl) {
   cl.flag("quiet", "print nothing but errors (no progress, no summary)");
   cl.option("stats", "FILE.json", "write counts and per-stage timings as JSON");
   cl.option("threads", "N", "worker threads (0 = all cores)", "0");
+  cl.flag("progress-lines",
+          "progress as 'progress STAGE FRACTION ELAPSED_S REMAINING_S' lines (for other programs)");
   cl.option("max-faces", "N",
             "refuse a job estimated to output more faces (also bounded by the machine's memory)",
             "2e7");
+}
+
+void add_output_options(CommandLine& cl) {
+  cl.option("groups", "element|kind|none",
+            "OBJ output: one object per element (KIND_ID), one per kind, or none", "element");
+  cl.flag("no-normals", "write no normals (flat shading in viewers)");
+}
+
+WriteOptions output_options(const CommandLine& cl) {
+  WriteOptions o;
+  o.write_elements = true;
+  o.write_normals = !cl.has("no-normals");
+  const std::string g = cl.get("groups");
+  if (g == "element")
+    o.groups = ElementGroups::Element;
+  else if (g == "kind")
+    o.groups = ElementGroups::Kind;
+  else if (g == "none")
+    o.groups = ElementGroups::None;
+  else
+    throw UsageError("--groups expects element, kind or none, got '" + g + "'");
+  return o;
+}
+
+std::vector<std::string> output_files(const std::string& path, const WriteOptions& options) {
+  std::vector<std::string> files{path};
+  if (options.write_elements && mesh_format_from_path(path) == MeshFormat::Obj)
+    files.push_back(std::filesystem::path(path).replace_extension(".mtl").string());
+  return files;
+}
+
+void write_output(const std::string& path, TriMesh mesh, const WriteOptions& options) {
+  mesh.N.resize(0, 3);
+  write_mesh(path, mesh, options);
 }
 
 double face_limit(const CommandLine& cl) {
@@ -86,7 +122,7 @@ RunContext::RunContext(const CommandLine& cl)
     : quiet_(cl.has("quiet")),
       stats_path_(cl.get("stats")),
       threads_(static_cast<int>(cl.get_int("threads", 0, 1024))),
-      progress_(quiet_) {
+      progress_(quiet_, cl.has("progress-lines")) {
   if (!stats_path_.empty()) check_output_directory(stats_path_);
   if (threads_ > 0)
     control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

@@ -9,6 +9,7 @@
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
+#include "core/mesh_io.h"
 #include "host/device.h"
 
 namespace mq::cli {
@@ -32,6 +33,20 @@ double face_limit(const CommandLine& cl);
 // out.obj -o out.obj` would replace the mesh with the JSON; `--stats` naming the swatch would
 // overwrite an input). Empty paths are skipped. Throws InvalidInput naming the path.
 void check_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+
+// --groups element|kind|none and --no-normals: what an output mesh carries (issue 15).
+void add_output_options(CommandLine& cl);
+
+// The write options of an output mesh: element ids and kinds (OBJ groups and materials, PLY
+// properties, glTF attributes) and per-corner normals, unless --no-normals.
+WriteOptions output_options(const CommandLine& cl);
+
+// The files a result written to `path` consists of: path, and for an OBJ with elements its .mtl.
+std::vector<std::string> output_files(const std::string& path, const WriteOptions& options);
+
+// Writes a result mesh: its normals are computed per corner by the writer (write_mesh) rather
+// than carried from the quilting (element normals would smooth over sharp edges).
+void write_output(const std::string& path, TriMesh mesh, const WriteOptions& options);
 
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {

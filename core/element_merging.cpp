@@ -247,6 +247,7 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   constraints.insert(constraints.end(), anchors.begin(), anchors.end());
   result.V = deform_element(stitched->mesh.V, stitched->mesh.F, constraints, deformation);
   result.F = stitched->mesh.F;
+  result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
   result.update();
   // The stitched element must stay within the space of its two parents (a wrongly paired seam
   // drags vertices far away) and must not pass through itself.

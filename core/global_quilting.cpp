@@ -8,6 +8,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/global_parameterization.h"
@@ -225,6 +226,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   Vector2d anchor = Vector2d::Zero();
   {
     ScopedStageTimer timer(times, "parameterization");
+    ScopedStageProgress shown(progress, "parameterization");
     const MatrixX3d V = options.global.smoothing > 0
                             ? smoothed_positions(base, job.topo, options.global.smoothing)
                             : base.V;
@@ -279,6 +281,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   TriMesh plane;
   if (options.global.tile && tileable(swatch, symmetry)) {
     ScopedStageTimer timer(times, "tiling");
+    ScopedStageProgress shown(progress, "tiling");
     plane = tile_lattice(swatch, symmetry, Vector2d::Zero(), Vector2d(po.length, po.width),
                          &gstats.orbits);
     gstats.tiled = true;
@@ -302,6 +305,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   std::vector<SurfaceElement> placed;
   {
     ScopedStageTimer timer(times, "placement");
+    ScopedStageProgress shown(progress, "placement");
     const ChartGrid grid(gp, base.num_faces());
     std::vector<int> fc;
     const int n = connected_components(plane.F, plane.num_vertices(), fc);
@@ -322,6 +326,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
       for (const int f0 : starts) {
         SurfaceElement s;
         s.F = part.F;
+        s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
         s.face.resize(part.V.rows());
         s.barycentric.resize(part.V.rows(), 3);
         s.height.resize(part.V.rows());
@@ -351,6 +356,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   gstats.placed = static_cast<int>(placed.size());
 
   SurfaceQuilt quilt;
+  quilt.kinds = swatch.kinds;
   quilt.shell_height = swatch.size.z();
   quilt.base = job.base;
   quilt.input_base = std::move(job.cleaned);

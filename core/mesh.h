@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace mq {
@@ -20,10 +21,16 @@ using Vector2d = Eigen::Vector2d;
 //   V  #V by 3 vertex positions
 //   F  #F by 3 vertex indices (0-based, counter-clockwise seen from outside)
 //   N  optional: #V by 3 unit vertex normals, or empty
+//   kinds      optional: names of the kinds of element (section 2.1's elements: "ring",
+//              "thread_x", "vine", "leaf", ...), or empty when the mesh has none
+//   face_kind  #F indices into kinds when kinds is not empty (otherwise ignored); an element
+//              (connected component) has one kind
 struct TriMesh {
   MatrixX3d V;
   MatrixX3i F;
   MatrixX3d N;
+  std::vector<std::string> kinds;
+  std::vector<int> face_kind;
 
   int num_vertices() const { return static_cast<int>(V.rows()); }
   int num_faces() const { return static_cast<int>(F.rows()); }

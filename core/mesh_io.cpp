@@ -12,10 +12,15 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <numeric>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "core/corner_normals.h"
+#include "core/element_kinds.h"
+#include "core/gltf_writer.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/input_file.h"
@@ -83,6 +88,19 @@ class TextCursor {
         break;
       }
     }
+  }
+
+  // The rest of this line without surrounding blanks (a '#' starts a comment), capped at 256
+  // bytes: the names of OBJ groups and materials.
+  std::string rest_of_line() {
+    skip_blanks();
+    const char* b = p_;
+    const char* e = p_;
+    while (e < end_ && *e != '\n' && *e != '#') ++e;
+    const char* t = e;
+    while (t > b && is_blank(t[-1])) --t;
+    p_ = e;
+    return std::string(b, std::min<size_t>(static_cast<size_t>(t - b), 256));
   }
 
   // Next whitespace-delimited word on this line (empty at end of line).
@@ -163,6 +181,23 @@ TriMesh read_obj(const std::string& path, const std::string& data) {
   V.reserve(data.size() / 16);
   F.reserve(data.size() / 8);
   bool all_corners_have_normals = true;
+  // Kinds (element_kinds.h): a face's kind is its material (usemtl), else its group (g or o).
+  std::string material, group;
+  std::vector<std::string> kinds;
+  std::unordered_map<std::string, int> kind_of_name;
+  std::vector<int> face_kind;
+  int current_kind = -1;  // -1: no name seen yet
+  const auto kind_id = [&](const std::string& name) {
+    const auto [it, added] = kind_of_name.emplace(name, static_cast<int>(kinds.size()));
+    if (added) kinds.push_back(name);
+    return it->second;
+  };
+  const auto update_kind = [&] {
+    const std::string& name = material.empty() ? group : material;
+    if (name.empty() && current_kind < 0) return;
+    if (current_kind < 0) face_kind.assign(F.size() / 3, kind_id(kDefaultKind));
+    current_kind = kind_id(sanitized_kind(name));
+  };
 
   while (!c.eof()) {
     c.skip_blanks();
@@ -215,15 +250,31 @@ TriMesh read_obj(const std::string& path, const std::string& data) {
           FN.push_back(corners[k].second);
           all_corners_have_normals &= corners[k].second >= 0;
         }
+        if (current_kind >= 0) face_kind.push_back(current_kind);
       }
+    } else if ((c0 == 'g' || c0 == 'o') && is_blank(c1)) {
+      c.advance(1);
+      group = c.rest_of_line();
+      update_kind();
+    } else if (c.remaining() > 7 && std::memcmp(c.pos(), "usemtl", 6) == 0 &&
+               is_blank(c.peek(6))) {
+      c.advance(6);
+      material = c.rest_of_line();
+      if (material == "(null)") material.clear();  // what some exporters write for "none"
+      update_kind();
     }
-    // Everything else (vt, g, o, s, usemtl, mtllib, l, comments) and trailing values such as
+    // Everything else (vt, s, mtllib, l, comments) and trailing values such as
     // the optional w or vertex colours are ignored.
     c.skip_line();
   }
   if (F.empty()) c.fail("no faces");
 
   TriMesh m = make_mesh(V, F);
+  if (current_kind >= 0) {
+    m.kinds = std::move(kinds);
+    m.face_kind = std::move(face_kind);
+    remove_unused_kinds(m);
+  }
   // Per-vertex normals only when each vertex is always paired with the same normal.
   if (!N.empty() && all_corners_have_normals) {
     std::vector<int> vertex_normal(V.size() / 3, -1);
@@ -545,6 +596,7 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
   PlyEncoding encoding = PlyEncoding::Ascii;
   bool have_format = false;
   std::vector<PlyElement> elements;
+  std::vector<std::pair<long long, std::string>> kind_names;  // "comment kind K NAME" lines
   for (;;) {
     if (c.eof()) c.fail("unexpected end of file in header (no end_header)");
     const std::string key = c.word();
@@ -585,7 +637,15 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
       prop.name = c.word();
       if (prop.name.empty()) c.fail("property without a name");
       elements.back().properties.push_back(prop);
-    } else if (key != "comment" && key != "obj_info" && !key.empty()) {
+    } else if (key == "comment") {
+      if (c.word() == "kind" && kind_names.size() < (1 << 16)) {
+        c.skip_blanks();
+        if (std::isdigit(static_cast<unsigned char>(c.peek()))) {
+          const long long k = c.read_int("kind number");
+          kind_names.emplace_back(k, sanitized_kind(c.rest_of_line()));
+        }
+      }
+    } else if (key != "obj_info" && !key.empty()) {
       c.fail("unexpected PLY header keyword '" + key + "'");
     }
     if (key != "end_header") c.skip_line();
@@ -618,6 +678,10 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
     c.fail("PLY vertex element lacks an x, y or z property");
   const bool has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
   for (int k = 0; k < (has_normals ? 6 : 3); ++k) vslot[static_cast<size_t>(found[k])] = k;
+  // Kinds (element_kinds.h): an integer vertex property `kind`; a face takes its first vertex's.
+  const int kind_prop = find_scalar(*vertex_el, "kind");
+  if (kind_prop >= 0 && !ply_is_integer(vertex_el->properties[static_cast<size_t>(kind_prop)].type))
+    c.fail("vertex property 'kind' is not an integer");
   int index_prop = -1;
   for (size_t i = 0; i < face_el->properties.size(); ++i) {
     const PlyProperty& p = face_el->properties[i];
@@ -652,6 +716,7 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
 
   const long long nv = vertex_el->count;
   std::vector<double> V(static_cast<size_t>(3 * nv)), N;
+  std::vector<int> vertex_kind(kind_prop >= 0 ? static_cast<size_t>(nv) : 0);
   if (has_normals) N.resize(static_cast<size_t>(3 * nv));
   std::vector<int> F;
   F.reserve(static_cast<size_t>(3 * face_el->count));
@@ -672,6 +737,10 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
           const int k = vslot[pi];
           const double v = src.read_double(p.type, k < 3 ? "vertex coordinate" : "normal");
           (k < 3 ? V : N)[static_cast<size_t>(3 * i + k % 3)] = v;
+        } else if (is_vertex && static_cast<int>(pi) == kind_prop) {
+          const long long k = src.read_integer(p.type, "kind");
+          if (k < 0 || k >= (1 << 16)) src.fail("kind " + std::to_string(k) + " out of range");
+          vertex_kind[static_cast<size_t>(i)] = static_cast<int>(k);
         } else if (is_face && static_cast<int>(pi) == index_prop) {
           const long long n = src.read_integer(p.count_type, "face vertex count");
           if (n < 3) src.fail("face with " + std::to_string(n) + " vertices (need at least 3)");
@@ -700,6 +769,19 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
   }
   TriMesh m = make_mesh(V, F);
   if (has_normals) m.N = Eigen::Map<const MatrixX3d>(N.data(), m.V.rows(), 3);
+  if (kind_prop >= 0) {
+    int top = 0;
+    for (const int k : vertex_kind) top = std::max(top, k);
+    m.kinds.resize(static_cast<size_t>(top) + 1);
+    for (const auto& [k, name] : kind_names)
+      if (k <= top) m.kinds[static_cast<size_t>(k)] = name;
+    for (size_t k = 0; k < m.kinds.size(); ++k)
+      if (m.kinds[k].empty()) m.kinds[k] = "kind_" + std::to_string(k);
+    m.face_kind.resize(static_cast<size_t>(m.F.rows()));
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      m.face_kind[static_cast<size_t>(f)] = vertex_kind[static_cast<size_t>(m.F(f, 0))];
+    remove_unused_kinds(m);
+  }
   return m;
 }
 
@@ -725,7 +807,45 @@ inline char* put_row(char* out, const MatrixX3d& M, Eigen::Index i, int precisio
   return out;
 }
 
-void write_obj(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, int precision) {
+// Normals of an OBJ file: per vertex (Nv, from the mesh) or per corner (C), or none.
+struct ObjNormals {
+  const MatrixX3d* Nv = nullptr;
+  const CornerNormals* C = nullptr;
+};
+
+// The file name of the .mtl beside an OBJ: same stem.
+std::string mtl_path_for(const std::string& obj_path) {
+  return std::filesystem::path(obj_path).replace_extension(".mtl").string();
+}
+
+std::string padded(int value, int width) {
+  std::string s = std::to_string(value);
+  return std::string(static_cast<size_t>(std::max(0, width - static_cast<int>(s.size()))), '0') + s;
+}
+
+void write_mtl(AtomicOutputFile& out, const std::vector<std::string>& kinds) {
+  out.append("# meshquilt: one material per kind of element\n");
+  for (const std::string& kind : kinds) {
+    const KindMaterial m = kind_material(kind);
+    char buf[256];
+    // Kd/Ks/Ns for any reader, Pm/Pr (the PBR extension Blender reads) for metal and roughness.
+    std::snprintf(buf, sizeof buf,
+                  "Kd %.4f %.4f %.4f\nKs %.4f %.4f %.4f\nNs %.1f\nPm %.3f\nPr %.3f\nd 1\nillum 2\n",
+                  m.r, m.g, m.b, 0.04 + 0.96 * m.metallic * m.r, 0.04 + 0.96 * m.metallic * m.g,
+                  0.04 + 0.96 * m.metallic * m.b, 900.0 * (1 - m.roughness) * (1 - m.roughness),
+                  m.metallic, m.roughness);
+    out.append("\nnewmtl " + kind + "\n");
+    out.append(buf);
+  }
+}
+
+void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normals, int precision,
+               const ElementLabels* labels, ElementGroups groups, const std::string& mtl_name) {
+  if (labels) {
+    out.append("# meshquilt: " + std::to_string(labels->count) + " elements of " +
+               std::to_string(labels->kinds.size()) + " kinds\n");
+    out.append("mtllib " + mtl_name + "\n");
+  }
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     char* p = out.cursor();
     *p++ = 'v';
@@ -733,6 +853,7 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, int 
     *p++ = '\n';
     out.commit_bytes(p);
   }
+  const MatrixX3d* N = normals.C ? &normals.C->N : normals.Nv;
   if (N)
     for (Eigen::Index i = 0; i < N->rows(); ++i) {
       char* p = out.cursor();
@@ -742,7 +863,33 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, int 
       *p++ = '\n';
       out.commit_bytes(p);
     }
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+  // Faces grouped by element or by kind (stable), so each group is one run.
+  std::vector<int> order(static_cast<size_t>(m.F.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  if (labels && groups != ElementGroups::None) {
+    const auto key = [&](int f) {
+      const int e = labels->face_element[static_cast<size_t>(f)];
+      return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
+    };
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  }
+  const int width = labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size())
+                           : 0;
+  int last_element = -1, last_kind = -1;
+  for (const int f : order) {
+    if (labels) {
+      const int e = labels->face_element[static_cast<size_t>(f)];
+      const int k = labels->element_kind[static_cast<size_t>(e)];
+      const std::string& kind = labels->kinds[static_cast<size_t>(k)];
+      if (groups == ElementGroups::Element && e != last_element)
+        out.append("o " + kind + "_" + padded(e, width) + "\n");
+      else if (groups == ElementGroups::Kind && k != last_kind)
+        out.append("o " + kind + "\n");
+      if (k != last_kind || (groups == ElementGroups::Element && e != last_element))
+        out.append("usemtl " + kind + "\n");
+      last_element = e;
+      last_kind = k;
+    }
     char* p = out.cursor();
     *p++ = 'f';
     for (int k = 0; k < 3; ++k) {
@@ -751,7 +898,7 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, int 
       if (N) {
         *p++ = '/';
         *p++ = '/';
-        p = put_int(p, m.F(f, k) + 1LL);
+        p = put_int(p, (normals.C ? normals.C->FN(f, k) : m.F(f, k)) + 1LL);
       }
     }
     *p++ = '\n';
@@ -788,24 +935,57 @@ inline char* put_le(char* out, T v) {
 }
 
 void write_ply(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, bool binary,
-               int precision) {
+               int precision, const ElementLabels* labels) {
   std::string header = "ply\nformat ";
   header += binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
+  if (labels) {
+    header += "comment meshquilt: " + std::to_string(labels->count) + " elements\n";
+    for (size_t k = 0; k < labels->kinds.size(); ++k) {
+      header += "comment kind " + std::to_string(k) + " " + labels->kinds[k] + "\n";
+      // The look other tools give the kind (kind_material): r g b metallic roughness.
+      const KindMaterial m = kind_material(labels->kinds[k]);
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "comment kind_material %zu %.4f %.4f %.4f %.3f %.3f\n", k,
+                    m.r, m.g, m.b, m.metallic, m.roughness);
+      header += buf;
+    }
+  }
   header += "element vertex " + std::to_string(m.V.rows()) + "\n";
   header += "property double x\nproperty double y\nproperty double z\n";
   if (N) header += "property double nx\nproperty double ny\nproperty double nz\n";
+  if (labels) header += "property int element_id\nproperty int kind\n";
   header += "element face " + std::to_string(m.F.rows()) + "\n";
   header += "property list uchar int vertex_indices\nend_header\n";
   out.append(header);
+  // Element and kind of each vertex (every face of an element has its vertices).
+  std::vector<int> vertex_element;
+  if (labels) {
+    vertex_element.assign(static_cast<size_t>(m.V.rows()), 0);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        vertex_element[static_cast<size_t>(m.F(f, k))] = labels->face_element[static_cast<size_t>(f)];
+  }
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     char* p = out.cursor();
+    const int e = labels ? vertex_element[static_cast<size_t>(i)] : 0;
+    const int kind = labels ? labels->element_kind[static_cast<size_t>(e)] : 0;
     if (binary) {
       for (int k = 0; k < 3; ++k) p = put_le(p, m.V(i, k));
       if (N)
         for (int k = 0; k < 3; ++k) p = put_le(p, (*N)(i, k));
+      if (labels) {
+        p = put_le(p, static_cast<std::int32_t>(e));
+        p = put_le(p, static_cast<std::int32_t>(kind));
+      }
     } else {
       p = put_row(p, m.V, i, precision, false);
       if (N) p = put_row(p, *N, i, precision);
+      if (labels) {
+        *p++ = ' ';
+        p = put_int(p, e);
+        *p++ = ' ';
+        p = put_int(p, kind);
+      }
       *p++ = '\n';
     }
     out.commit_bytes(p);
@@ -840,7 +1020,9 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ext == ".obj") return MeshFormat::Obj;
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".off") return MeshFormat::Off;
-  MQ_THROW(InvalidInput, path, ": unknown mesh format '", ext, "' (expected .obj, .ply or .off)");
+  if (ext == ".glb") return MeshFormat::Glb;
+  MQ_THROW(InvalidInput, path, ": unknown mesh format '", ext,
+           "' (expected .obj, .ply, .off or, for output, .glb)");
 }
 
 TriMesh read_mesh(const std::string& path) {
@@ -857,6 +1039,8 @@ TriMesh read_mesh_data(const std::string& data, MeshFormat format, const std::st
       return read_off(path, data);
     case MeshFormat::Ply:
       return read_ply(path, data);
+    case MeshFormat::Glb:
+      MQ_THROW(InvalidInput, path, ": glTF is an output format here; read OBJ, PLY or OFF");
   }
   throw InternalError(path + ": unhandled mesh format");
 }
@@ -874,30 +1058,70 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
       if (mesh.F(f, k) < 0 || mesh.F(f, k) >= nv)
         MQ_THROW(InvalidInput, path, ": cannot write mesh: face ", f, " has vertex index ",
                  mesh.F(f, k), " out of range (", nv, " vertices)");
+  if (!mesh.kinds.empty()) {
+    TriMesh check;
+    check.kinds = mesh.kinds;
+    check.face_kind = mesh.face_kind;
+    check.F.resize(mesh.F.rows(), 3);
+    try {
+      ensure_kinds(check);
+    } catch (const InvalidInput& e) {
+      MQ_THROW(InvalidInput, path, ": cannot write mesh: ", e.what());
+    }
+  }
+  if (format == MeshFormat::Glb) {
+    write_glb(path, mesh, options);
+    return;
+  }
+  const bool per_vertex_file = mesh.N.rows() == nv && nv > 0;
   MatrixX3d computed;
+  CornerNormals corners;
   const MatrixX3d* N = nullptr;
+  ObjNormals obj_normals;
   if (options.write_normals) {
-    if (mesh.N.rows() == nv) {
+    if (per_vertex_file) {
       N = &mesh.N;
+      obj_normals.Nv = N;
+    } else if (format == MeshFormat::Obj) {
+      corners = corner_normals(mesh.V, mesh.F, options.crease_degrees);
+      obj_normals.C = &corners;
+      N = &corners.N;
     } else {
       computed = vertex_normals(mesh.V, mesh.F);
       N = &computed;
     }
-    for (Eigen::Index i = 0; i < nv; ++i)
+    for (Eigen::Index i = 0; i < N->rows(); ++i)
       if (!N->row(i).allFinite())
         MQ_THROW(InvalidInput, path, ": cannot write mesh: normal ", i, " is not finite");
+  }
+  ElementLabels labels;
+  const bool elements = options.write_elements && format != MeshFormat::Off;
+  if (elements) {
+    labels = element_labels(mesh);
+    for (std::string& kind : labels.kinds) kind = sanitized_kind(kind);
   }
 
   AtomicOutputFile out(path);
   switch (format) {
-    case MeshFormat::Obj:
-      write_obj(out, mesh, N, options.precision);
+    case MeshFormat::Obj: {
+      const std::string mtl = mtl_path_for(path);
+      write_obj(out, mesh, obj_normals, options.precision, elements ? &labels : nullptr,
+                options.groups, std::filesystem::path(mtl).filename().string());
+      if (elements) {
+        // The .mtl lands first: the OBJ never names a material file that is not there.
+        AtomicOutputFile materials(mtl);
+        write_mtl(materials, labels.kinds);
+        materials.commit();
+      }
       break;
+    }
     case MeshFormat::Off:
       write_off(out, mesh, N, options.precision);
       break;
     case MeshFormat::Ply:
-      write_ply(out, mesh, N, options.binary, options.precision);
+      write_ply(out, mesh, N, options.binary, options.precision, elements ? &labels : nullptr);
+      break;
+    case MeshFormat::Glb:
       break;
   }
   out.commit();

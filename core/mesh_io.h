@@ -10,9 +10,9 @@
 
 namespace mq {
 
-enum class MeshFormat { Obj, Ply, Off };
+enum class MeshFormat { Obj, Ply, Off, Glb };
 
-// Format from the file extension (.obj .ply .off, case-insensitive).
+// Format from the file extension (.obj .ply .off .glb, case-insensitive); .glb is written only.
 // Throws InvalidInput naming the file for any other extension.
 MeshFormat mesh_format_from_path(const std::string& path);
 
@@ -20,7 +20,9 @@ MeshFormat mesh_format_from_path(const std::string& path);
 //
 // Polygons with more than three corners are fan-triangulated (0,i,i+1). OBJ faces may use the
 // "v", "v/vt", "v//vn" and "v/vt/vn" forms and negative (relative) indices; other OBJ
-// statements (vt, g, o, usemtl, l, ...) are ignored. OFF accepts the OFF/COFF/NOFF/CNOFF/STOFF
+// statements (vt, l, ...) are ignored. Element kinds (element_kinds.h) come from OBJ usemtl
+// names, else g/o names (sanitized_kind), and from a PLY integer vertex property `kind` named by
+// "comment kind K NAME" header lines (a face takes its first vertex's); otherwise kinds is empty. OFF accepts the OFF/COFF/NOFF/CNOFF/STOFF
 // headers and '#' comments. PLY accepts ascii, binary_little_endian and binary_big_endian, any
 // order of vertex properties (x y z as any scalar type), face lists with any integer count and
 // index types, and skips unknown properties and elements.
@@ -40,24 +42,39 @@ TriMesh read_mesh(const std::string& path);
 // fuzz/ call it directly.)
 TriMesh read_mesh_data(const std::string& data, MeshFormat format, const std::string& path);
 
+// How an OBJ groups its faces: one object per element (named KIND_ID, the element id zero-padded),
+// one per kind, or none.
+enum class ElementGroups { Element, Kind, None };
+
 struct WriteOptions {
   // PLY only: binary little-endian (true) or ASCII (false).
   bool binary = true;
-  // Write per-vertex normals (OBJ vn, PLY nx ny nz, NOFF). Uses mesh.N when it is #V by 3,
-  // otherwise area-weighted vertex normals computed from V and F.
+  // Write normals (OBJ vn, PLY nx ny nz, NOFF; glTF always has them). Uses mesh.N when it is
+  // #V by 3; otherwise computes them: per corner in OBJ and glTF (corner_normals.h, split at
+  // edges sharper than crease_degrees), area-weighted per vertex in PLY and OFF.
   bool write_normals = false;
+  double crease_degrees = 60;
+  // Write element identity (element e = connected component e in order of first face) and
+  // kinds (mesh.kinds; kDefaultKind when empty): OBJ groups as `groups` says, `usemtl KIND`
+  // and a NAME.mtl beside the file (written first) with one material per kind; PLY vertex
+  // properties `int element_id` and `int kind` with "comment kind K NAME" lines (and
+  // "comment kind_material K R G B METALLIC ROUGHNESS", the kind's kind_material). glTF always
+  // has them (gltf_writer.h); OFF has no place for them.
+  bool write_elements = false;
+  ElementGroups groups = ElementGroups::Element;
   // Significant digits for coordinates in text formats; 17 round-trips doubles exactly.
   // A value <= 0 writes the shortest text that round-trips exactly.
   int precision = 9;
 };
 
-// Writes mesh to path in the format given by its extension. Output bytes depend only on the mesh
+// Writes mesh to path in the format given by its extension (.glb: write_glb). Output bytes depend only on the mesh
 // and options. PLY coordinates are stored as double.
 //
 // The data go to a temporary file in the same directory which is then renamed over path, so a
 // failed or interrupted write never leaves a partial file at path (an existing file is kept).
 //
-// Preconditions: V finite; F entries in [0, #V); N, when used, finite and #V by 3.
+// Preconditions: V finite; F entries in [0, #V); N, when used, finite and #V by 3; face_kind
+// empty or #F indices into kinds when kinds is not empty.
 // Throws InvalidInput for an unknown extension or a violated precondition; Error naming the file
 // for an I/O failure (unwritable directory, disk full).
 void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions& options = {});

@@ -4,6 +4,7 @@
 #include <array>
 #include <numeric>
 
+#include "core/element_kinds.h"
 #include "core/errors.h"
 
 namespace mq {
@@ -191,6 +192,12 @@ TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces,
     out.N.resize(out.V.rows(), 3);
     for (size_t i = 0; i < old_index.size(); ++i) out.N.row(i) = mesh.N.row(old_index[i]);
   }
+  if (has_kinds(mesh)) {
+    out.kinds = mesh.kinds;
+    out.face_kind.resize(faces.size());
+    for (size_t i = 0; i < faces.size(); ++i)
+      out.face_kind[i] = mesh.face_kind[static_cast<size_t>(faces[i])];
+  }
   if (vertex_map) *vertex_map = std::move(old_index);
   return out;
 }
@@ -201,8 +208,19 @@ void append_mesh(TriMesh& a, const TriMesh& b) {
   const Eigen::Index nv = a.V.rows(), nf = a.F.rows();
   a.V.conservativeResize(nv + b.V.rows(), 3);
   a.V.bottomRows(b.V.rows()) = b.V;
+  // Kinds are merged by name; a mesh without kinds contributes kDefaultKind faces.
+  const bool kinds_a = has_kinds(a), kinds_b = has_kinds(b);
+  if (kinds_a || kinds_b) {
+    if (!kinds_a) set_single_kind(a, kDefaultKind);
+    std::vector<int> map(b.kinds.size());
+    for (size_t k = 0; k < b.kinds.size(); ++k) map[k] = kind_index(a.kinds, b.kinds[k]);
+    const int plain = kinds_b ? 0 : kind_index(a.kinds, kDefaultKind);
+    for (Eigen::Index f = 0; f < b.F.rows(); ++f)
+      a.face_kind.push_back(kinds_b ? map[static_cast<size_t>(b.face_kind[f])] : plain);
+  }
   a.F.conservativeResize(nf + b.F.rows(), 3);
   a.F.bottomRows(b.F.rows()) = b.F.array() + static_cast<int>(nv);
+  if (nf == 0) remove_unused_kinds(a);  // the kDefaultKind an empty a was given
   if (normals) {
     a.N.conservativeResize(nv + b.N.rows(), 3);
     a.N.bottomRows(b.N.rows()) = b.N;

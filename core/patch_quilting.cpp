@@ -166,7 +166,10 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
       for (size_t j = 0; j < solved.size(); ++j) {
         const auto [is_out, k] = owners[j];
         Element& e = is_out ? deformed_out[k] : moved[k];
-        if (is_out) e.F = frame[k].F;
+        if (is_out) {
+          e.F = frame[k].F;
+          e.kind = frame[k].kind;
+        }
         e.V = std::move(solved[j]);
         e.update();
       }

@@ -275,6 +275,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
         Element t;
         t.V = part.V;
         t.F = part.F;
+        t.kind = e.kind;
         t.update();
         trimmed.push_back(std::move(t));
         ++stats.trimmed;
@@ -285,6 +286,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     for (const Element& e : trimmed) kept.push_back(&e);
   }
   TriMesh result = merge_elements(kept);
+  result.kinds = swatch.kinds;
   // Back to the swatch's own axes (the thickness axis returns to where it was).
   const Eigen::Matrix3d back = swatch.rotation.transpose();
   result.V = (result.V * back.transpose()).eval();

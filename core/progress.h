@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 namespace mq {
 
@@ -21,5 +22,22 @@ inline void report_progress(ProgressSink* sink, const std::string& stage, double
                             double total) {
   if (sink) sink->update(stage, done, total);
 }
+
+// A stage without finer progress: reported at 0 when the scope starts and done when it ends,
+// so that whatever shows progress names every stage of a run (the shell map, the stretch
+// optimisation, ...), not only those with many units of work.
+class ScopedStageProgress {
+ public:
+  ScopedStageProgress(ProgressSink* sink, std::string stage) : sink_(sink), stage_(std::move(stage)) {
+    report_progress(sink_, stage_, 0, 1);
+  }
+  ~ScopedStageProgress() { report_progress(sink_, stage_, 1, 1); }
+  ScopedStageProgress(const ScopedStageProgress&) = delete;
+  ScopedStageProgress& operator=(const ScopedStageProgress&) = delete;
+
+ private:
+  ProgressSink* sink_;
+  std::string stage_;
+};
 
 }  // namespace mq

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
@@ -29,8 +30,10 @@ std::vector<Element> split_elements(const TriMesh& mesh) {
   std::vector<int> fc;
   const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
   const auto groups = component_faces(fc, n);
+  const std::vector<int> kinds = component_kinds(mesh, fc, n);
   std::vector<Element> elements(n);
   for (int c = 0; c < n; ++c) {
+    elements[c].kind = kinds[static_cast<size_t>(c)];
     const TriMesh part = extract_faces(mesh, groups[c]);
     elements[c].V = part.V;
     elements[c].F = part.F;
@@ -49,8 +52,10 @@ TriMesh merge_elements(const std::vector<const Element*>& elements) {
   out.V.resize(nv, 3);
   out.F.resize(nf, 3);
   out.N.resize(nv, 3);
+  out.face_kind.reserve(static_cast<size_t>(nf));
   nv = nf = 0;
   for (const Element* e : elements) {
+    out.face_kind.insert(out.face_kind.end(), static_cast<size_t>(e->F.rows()), e->kind);
     out.V.middleRows(nv, e->V.rows()) = e->V;
     out.N.middleRows(nv, e->V.rows()) = e->N;
     out.F.middleRows(nf, e->F.rows()) = e->F.array() + static_cast<int>(nv);
@@ -95,6 +100,8 @@ PreparedSwatch prepare_swatch(const TriMesh& swatch) {
   MQ_CHECK(std::min(s.size.x(), s.size.y()) > 1e-100 && s.size.maxCoeff() < 1e100, InvalidInput,
            "the swatch's size (", s.size.x(), " x ", s.size.y(), " x ", s.size.z(),
            ") is too small or too large to compute with; rescale it");
+  ensure_kinds(m);
+  s.kinds = m.kinds;
   s.elements = split_elements(m);
   s.mean_edge_length = mean_edge_length(m.V, m.F);
   double diameter = 0;
@@ -103,6 +110,7 @@ PreparedSwatch prepare_swatch(const TriMesh& swatch) {
   std::vector<const Element*> ptrs;
   for (const Element& e : s.elements) ptrs.push_back(&e);
   s.mesh = merge_elements(ptrs);
+  s.mesh.kinds = s.kinds;
   int f0 = 0, v0 = 0;
   for (size_t e = 0; e < s.elements.size(); ++e) {
     s.element_first_face.push_back(f0);

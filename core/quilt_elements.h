@@ -2,6 +2,7 @@
 // move, deform, cut and stitch, and the swatch put in its synthesis frame.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/mesh.h"
@@ -15,6 +16,7 @@ struct Element {
   MatrixX3d N;  // #V by 3 unit vertex normals (kept in sync by update())
   Vector2d lo = Vector2d::Zero(), hi = Vector2d::Zero();  // xy footprint bounding box
   double z_lo = 0, z_hi = 0;
+  int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds); copies keep it
 
   // Recomputes normals and bounds after V changed.
   void update();
@@ -30,10 +32,12 @@ struct Element {
   }
 };
 
-// Splits a mesh into elements, in order of each component's first face.
+// Splits a mesh into elements, in order of each component's first face. An element's kind is
+// the one most of its faces have in mesh (component_kinds), 0 when mesh has no kinds.
 std::vector<Element> split_elements(const TriMesh& mesh);
 
-// Concatenates elements into one mesh (in order).
+// Concatenates elements into one mesh (in order). face_kind holds each face's element kind;
+// kinds is left empty for the caller to name (PreparedSwatch::kinds).
 TriMesh merge_elements(const std::vector<const Element*>& elements);
 
 // The swatch in its synthesis frame: thickness axis (smallest bounding-box side) along z and
@@ -44,6 +48,7 @@ struct PreparedSwatch {
   std::vector<int> face_element;  // #F: element of each face of mesh
   std::vector<int> element_first_face;  // first face of each element in mesh
   std::vector<int> element_first_vertex;
+  std::vector<std::string> kinds;  // names of Element::kind: the swatch's, or {kDefaultKind}
   Vector3d size = Vector3d::Zero();
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // input frame -> synthesis frame
   Vector3d translation = Vector3d::Zero();                 // applied after rotation

@@ -205,7 +205,8 @@ int shrink_to_fit(const SurfaceQuilt& quilt, const std::vector<char>& folded, Ma
 }  // namespace
 
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
-                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats_out) {
+                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats_out,
+                    ProgressSink* progress) {
   QuiltEmbeddingStats stats;
   LocalCoordinates points;
   Eigen::Index nv = 0, nf = 0;
@@ -242,6 +243,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     ShellMapOptions map_options;
     map_options.height = quilt.shell_height;
     ScopedStageTimer timer(stats.times, "shell map");
+    ScopedStageProgress shown(progress, "shell map");
     try {
       map = std::make_unique<ShellMap>(quilt.input_base.V, quilt.input_base.F, map_options);
       stats.atlas_charts = map->atlas().num_charts;
@@ -266,10 +268,12 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     MatrixX3d unoptimized;
     if (options.optimize_stretch) {
       ScopedStageTimer timer(stats.times, "embedding");
+      ScopedStageProgress shown(progress, "embedding");
       unoptimized = ShellEmbedding(*map).embed(points);
     }
     {
       ScopedStageTimer timer(stats.times, "stretch optimization");
+    ScopedStageProgress shown(progress, "stretch optimization");
       stats.stretch_before = stats.stretch_after = map->stretch(stretch);
       if (options.optimize_stretch) {
         ShellOptimizeOptions o;
@@ -280,6 +284,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       }
     }
     ScopedStageTimer timer(stats.times, "embedding");
+    ScopedStageProgress shown(progress, "embedding");
     all.V = ShellEmbedding(*map).embed(points);
     if (options.optimize_stretch) {
       // Pairs of faces that intersect, within an element (it folds through itself) or between
@@ -304,6 +309,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     }
   } else {
     ScopedStageTimer timer(stats.times, "embedding");
+    ScopedStageProgress shown(progress, "embedding");
     all.V = normal_displacement(quilt.input_base.V, quilt.input_base.F, points);
   }
 
@@ -313,6 +319,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // unfolded by construction, in its place and at its size.
   if (options.remove_intersecting) {
     ScopedStageTimer timer(stats.times, "fold repair");
+    ScopedStageProgress shown(progress, "fold repair");
     if (!have_pairs && !known_disjoint) {
       pairs = all_face_pairs(all.V, all.F);
       have_pairs = true;
@@ -355,6 +362,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "element removal");
+    ScopedStageProgress shown(progress, "element removal");
     if (!have_pairs) {
       pairs = all_face_pairs(all.V, all.F);
     }
@@ -367,6 +375,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     if (options.shrink_to_fit) stats.shrunk_to_fit = shrink_to_fit(quilt, folded, all.V, drop);
   }
   TriMesh out;
+  out.kinds = quilt.kinds;
   std::vector<double> areas;
   {
     Eigen::Index kv = 0, kf = 0, v0 = 0, f0 = 0;
@@ -391,6 +400,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       } else {
         out.V.middleRows(kv, ev) = all.V.middleRows(v0, ev);
         out.F.middleRows(kf, ef) = e.F.array() + static_cast<int>(kv);
+        out.face_kind.insert(out.face_kind.end(), static_cast<size_t>(ef), e.kind);
         areas.push_back(face_areas(all.V.middleRows(v0, ev), e.F).sum());
         kv += ev;
         kf += ef;
@@ -415,6 +425,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   }
   {
     ScopedStageTimer timer(stats.times, "coverage");
+    ScopedStageProgress shown(progress, "coverage");
     // Sampled at the refined base's face centroids (edges at most 0.3 of the swatch side): the
     // input's faces can be far larger than the swatch (the brick wall's 84 faces made the
     // figure jump by 0.2 between runs of nearly identical output).

@@ -48,8 +48,10 @@ struct QuiltEmbeddingStats {
 // back to normal displacement and says why in stats->shell_map_failure. With stretch
 // optimisation, elements that the optimised map makes intersect another element are mapped
 // through the map as it was before optimisation (stats->unoptimized_elements). Throws
-// DeviceError from the evaluator.
+// DeviceError from the evaluator. Each stage (shell map, stretch optimization, fold repair,
+// element removal, coverage) is reported to `progress` as it starts and ends.
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
-                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats = nullptr);
+                    TetStretchEvaluator& stretch, QuiltEmbeddingStats* stats = nullptr,
+                    ProgressSink* progress = nullptr);
 
 }  // namespace mq

@@ -363,6 +363,7 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
   const TriMesh& base = quilt.base;
   const MatrixX3d N = vertex_normals(base.V, base.F);
   TriMesh out;
+  out.kinds = quilt.kinds;
   Eigen::Index nv = 0, nf = 0;
   for (const SurfaceElement& e : quilt.elements) {
     nv += static_cast<Eigen::Index>(e.face.size());
@@ -377,6 +378,7 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
           displace_along_normal(base, N, e.face[v], e.barycentric.row(v).transpose(), e.height(v))
               .transpose();
     out.F.middleRows(nf, e.F.rows()) = e.F.array() + static_cast<int>(nv);
+    out.face_kind.insert(out.face_kind.end(), static_cast<size_t>(e.F.rows()), e.kind);
     nv += static_cast<Eigen::Index>(e.face.size());
     nf += e.F.rows();
   }
@@ -564,6 +566,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         const SurfaceElement& s = store.elements[id];
         Element e;
         e.F = s.F;
+        e.kind = s.kind;
         e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
         for (size_t v = 0; v < s.face.size(); ++v) {
           const Vector2d q = frame->to_frame(s.face[v], s.barycentric.row(v).transpose());
@@ -641,6 +644,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         const Element& e = framed.frame_element(id);
         SurfaceElement s;
         s.F = e.F;
+        s.kind = e.kind;
         s.face.resize(e.V.rows());
         s.barycentric.resize(e.V.rows(), 3);
         s.height.resize(e.V.rows());
@@ -710,6 +714,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
   }
 
   SurfaceQuilt quilt;
+  quilt.kinds = swatch.kinds;
   quilt.shell_height = H;
   quilt.base = base;
   quilt.input_base = std::move(cleaned);

@@ -28,6 +28,7 @@ struct SurfaceElement {
   // placement (a rigid copy of its swatch element). The embedding falls back to it, moved
   // rigidly, where the map folds the element through itself.
   MatrixX3d flat;
+  int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds)
 };
 
 struct SurfaceQuilt {
@@ -36,6 +37,7 @@ struct SurfaceQuilt {
   TriMesh base;           // the (refined) base mesh the local coordinates refer to
   TriMesh input_base;     // the base as given, coincident vertices welded
   Refinement refinement;  // base faces in input_base faces (empty: base is input_base)
+  std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
 };
 
 // Local coordinates on the refined base expressed on the input base: refined faces are affine

@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
@@ -221,7 +222,8 @@ TriMesh chainmail_4in1(const ChainMailOptions& o) {
         C[i] = centre + R * (std::cos(t) * e1 + std::sin(t) * e2);
         T[i] = -std::sin(t) * e1 + std::cos(t) * e2;
       }
-      const TriMesh ring = tube_mesh(C, T, e1.cross(e2), o.wire_radius, o.wire_segments, true);
+      TriMesh ring = tube_mesh(C, T, e1.cross(e2), o.wire_radius, o.wire_segments, true);
+      set_single_kind(ring, "ring");
       if (mail.empty())
         mail = ring;
       else
@@ -256,8 +258,8 @@ TriMesh plain_weave(const WeaveOptions& o) {
         C[k] = dir == 0 ? Vector3d(u, j * s, z) : Vector3d(j * s, u, z);
         T[k] = dir == 0 ? Vector3d(1, 0, dz) : Vector3d(0, 1, dz);
       }
-      const TriMesh thread =
-          tube_mesh(C, T, Vector3d::UnitZ(), o.thread_radius, o.tube_segments, false);
+      TriMesh thread = tube_mesh(C, T, Vector3d::UnitZ(), o.thread_radius, o.tube_segments, false);
+      set_single_kind(thread, dir == 0 ? "thread_x" : "thread_y");
       if (cloth.empty())
         cloth = thread;
       else
@@ -316,6 +318,7 @@ TriMesh apple_layer(const AppleOptions& o) {
   for (int a = 0; a < o.count; ++a) {
     apples[a].V.col(0).array() += pos[a].x();
     apples[a].V.col(1).array() += pos[a].y();
+    set_single_kind(apples[a], "apple");
     if (layer.empty())
       layer = apples[a];
     else
@@ -342,6 +345,7 @@ TriMesh ivy_section(const IvyOptions& o) {
         Vector3d(1, wave * 2 * M_PI / wavelength * std::cos(2 * M_PI * x / wavelength + phase), 0);
   }
   TriMesh ivy = tube_mesh(C, T, Vector3d::UnitZ(), rv, 8, false);
+  set_single_kind(ivy, "vine");
   const TriMesh vine = ivy;
 
   std::vector<TriMesh> placed;
@@ -370,6 +374,7 @@ TriMesh ivy_section(const IvyOptions& o) {
       ok = !meshes_intersect(leaf, vine);
       for (std::size_t p = 0; p < placed.size() && ok; ++p) ok = !meshes_intersect(leaf, placed[p]);
     }
+    set_single_kind(leaf, "leaf");
     placed.push_back(leaf);
     append_mesh(ivy, leaf);
   }

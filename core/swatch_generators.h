@@ -3,6 +3,8 @@
 // Every generator returns a TriMesh with outward-oriented closed manifold components (one per
 // element) placed with min corner at the origin: x-y is the footprint, z in [0, thickness].
 // Output is deterministic for the given options (seeded std::mt19937_64, raw output only).
+// Elements carry kinds (TriMesh::kinds): "ring"; "thread_x" and "thread_y"; "apple"; "vine"
+// and "leaf".
 #pragma once
 
 #include <cstdint>

@@ -387,7 +387,9 @@ TriMesh tile_lattice(const PreparedSwatch& swatch, const SwatchSymmetry& symmetr
   }
   out.reserve(copies.size());
   for (const Element& e : copies) out.push_back(&e);
-  return merge_elements(out);
+  TriMesh tiled = merge_elements(out);
+  tiled.kinds = swatch.kinds;
+  return tiled;
 }
 
 }  // namespace mq

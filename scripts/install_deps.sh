@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libtbb-dev libeigen3-dev libembree-dev libtet1.5-dev libboost-graph-dev
-  libpng-dev libgtest-dev libbenchmark-dev python3
+  libpng-dev libgtest-dev libbenchmark-dev libtinygltf-dev python3
   clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do

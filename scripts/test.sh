@@ -7,6 +7,10 @@ jobs=$(nproc)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
+# The Blender add-on in real Blender, headless (issue 15); installs Blender when missing.
+if [ "${MESHQUILT_SKIP_BLENDER:-0}" != 1 ]; then
+  bash scripts/test_blender.sh build/meshquilt
+fi
 if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHQUILT_SANITIZE=ON \
         -DMESHQUILT_BUILD_BENCH=OFF

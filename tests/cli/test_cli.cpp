@@ -107,7 +107,7 @@ TEST(Cli, PlaneEndToEndWithStats) {
   EXPECT_EQ(json_value(stats.substr(output), "elements"), json_value(i.out, "elements"));
   EXPECT_EQ(json_value(i.out, "closed"), "true");
   // No temporary files left beside the outputs.
-  const std::vector<std::string> expected{"out.ply", "s.json", "sw.obj"};
+  const std::vector<std::string> expected{"out.ply", "s.json", "sw.mtl", "sw.obj"};
   EXPECT_EQ(listing(dir), expected);
 }
 
@@ -218,9 +218,81 @@ TEST(Cli, ProgressLinesOnStderrWhenNotATerminal) {
   // Plain lines (no carriage returns: stderr is a file), ending with the stage at 100%.
   EXPECT_EQ(r.err.find('\r'), std::string::npos);
   for (const std::string& line : lines) EXPECT_EQ(line.rfind("[", 0), 0u) << line;
-  EXPECT_NE(lines.back().find("quilting 100%"), std::string::npos) << lines.back();
+  EXPECT_NE(lines.back().find("writing 100%"), std::string::npos) << lines.back();
+  EXPECT_NE(r.err.find("quilting 100%"), std::string::npos) << r.err;
   // The summary goes to stdout, not stderr.
   EXPECT_NE(r.out.find("iterations"), std::string::npos) << r.out;
+}
+
+TEST(Cli, ProgressLinesForOtherPrograms) {
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  const CliRun r =
+      meshquilt(dir, "plane --swatch " + sw + " --size 8 6 -o p.ply --progress-lines --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  int lines = 0;
+  for (const std::string& line : r.err_lines()) {
+    // progress STAGE FRACTION ELAPSED_S REMAINING_S
+    std::istringstream in(line);
+    std::string word, stage;
+    double fraction = -1, elapsed = -1, remaining = -2;
+    in >> word >> stage >> fraction >> elapsed >> remaining;
+    ASSERT_TRUE(in && word == "progress") << line;
+    EXPECT_TRUE(fraction >= 0 && fraction <= 1 && elapsed >= 0 && remaining >= -1) << line;
+    ++lines;
+  }
+  EXPECT_GE(lines, 1);
+}
+
+TEST(Cli, OutputsCarryElementsKindsAndNormals) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(meshquilt(dir, "swatch ivy --count 4 --length 6 -o ivy.obj --quiet").status, 0);
+  const std::string job = "plane --swatch ivy.obj --size 10 8 --quiet";
+  ASSERT_EQ(meshquilt(dir, job + " -o e.obj").status, 0);
+  ASSERT_EQ(meshquilt(dir, job + " -o k.obj --groups kind").status, 0);
+  ASSERT_EQ(meshquilt(dir, job + " -o n.obj --groups none --no-normals").status, 0);
+  ASSERT_EQ(meshquilt(dir, job + " -o g.glb").status, 0);
+  ASSERT_EQ(meshquilt(dir, job + " -o p.ply").status, 0);
+  const auto count = [](const std::string& text, const std::string& prefix) {
+    int n = 0;
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) n += line.rfind(prefix, 0) == 0;
+    return n;
+  };
+  const std::string e = slurp(dir + "/e.obj"), k = slurp(dir + "/k.obj"), n = slurp(dir + "/n.obj");
+  const CliRun info = meshquilt(dir, "info e.obj --json");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_EQ(count(e, "o "), std::stoi(json_value(info.out, "elements")));
+  EXPECT_GT(count(e, "vn "), 0);
+  EXPECT_EQ(count(k, "o "), 2);  // vine and leaf
+  EXPECT_EQ(count(n, "o "), 0);
+  EXPECT_EQ(count(n, "vn "), 0);
+  for (const std::string* text : {&e, &k, &n}) {
+    EXPECT_GE(count(*text, "usemtl vine"), 1);
+    EXPECT_GE(count(*text, "usemtl leaf"), 1);
+    EXPECT_EQ(count(*text, "mtllib "), 1);
+  }
+  EXPECT_NE(slurp(dir + "/e.mtl").find("newmtl leaf"), std::string::npos);
+  EXPECT_EQ(slurp(dir + "/g.glb").substr(0, 4), "glTF");
+  EXPECT_NE(slurp(dir + "/p.ply").find("property int element_id"), std::string::npos);
+  // The same geometry whatever the grouping: info reads the same counts.
+  for (const char* f : {"k.obj", "n.obj", "p.ply"}) {
+    const CliRun i = meshquilt(dir, std::string("info ") + f + " --json");
+    EXPECT_EQ(json_value(i.out, "faces"), json_value(info.out, "faces")) << f;
+    EXPECT_EQ(json_value(i.out, "elements"), json_value(info.out, "elements")) << f;
+  }
+  // Bad --groups, and an output's .mtl named as another output, are refused before work.
+  const CliRun bad = meshquilt(dir, job + " -o b.obj --groups rings");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--groups"), std::string::npos) << bad.err;
+  const CliRun clash = meshquilt(dir, job + " -o b.obj --stats b.mtl");
+  EXPECT_EQ(clash.status, 1);
+  EXPECT_FALSE(fs::exists(dir + "/b.obj") || fs::exists(dir + "/b.mtl"));
+  // Reading a .glb is refused by name.
+  const CliRun read = meshquilt(dir, "info g.glb");
+  EXPECT_EQ(read.status, 1);
+  EXPECT_NE(read.err.find("output format"), std::string::npos) << read.err;
 }
 
 TEST(Cli, RenderWritesAPng) {
@@ -319,15 +391,19 @@ TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
   const std::string dir = test::temp_dir();
   const std::string sw = small_swatch(dir);
   const std::string common = "plane --swatch " + sw + " --size 8 7 --variety 0.2 --seed 5 --quiet";
-  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 1 -o t1.obj").status, 0);
-  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 2 -o t2.obj").status, 0);
-  const std::string t1 = slurp(dir + "/t1.obj");
+  // One name in three directories: an OBJ names its .mtl, so files of one name are compared.
+  for (const char* sub : {"t1", "t2", "cl"}) fs::create_directory(dir + "/" + sub);
+  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 1 -o t1/q.obj").status, 0);
+  ASSERT_EQ(meshquilt(dir, common + " --device cpu --threads 2 -o t2/q.obj").status, 0);
+  const std::string t1 = slurp(dir + "/t1/q.obj"), m1 = slurp(dir + "/t1/q.mtl");
   ASSERT_FALSE(t1.empty());
-  EXPECT_TRUE(t1 == slurp(dir + "/t2.obj")) << "--threads 1 and 2 differ";
+  ASSERT_FALSE(m1.empty());
+  EXPECT_TRUE(t1 == slurp(dir + "/t2/q.obj")) << "--threads 1 and 2 differ";
+  EXPECT_TRUE(m1 == slurp(dir + "/t2/q.mtl")) << "--threads 1 and 2 differ";
   if (!opencl_platform_present()) GTEST_SKIP() << "clinfo -l lists no OpenCL platform";
-  const CliRun g = meshquilt(dir, common + " --device opencl --threads 2 -o cl.obj");
+  const CliRun g = meshquilt(dir, common + " --device opencl --threads 2 -o cl/q.obj");
   ASSERT_EQ(g.status, 0) << g.err;
-  EXPECT_TRUE(t1 == slurp(dir + "/cl.obj")) << "--device cpu and opencl differ";
+  EXPECT_TRUE(t1 == slurp(dir + "/cl/q.obj")) << "--device cpu and opencl differ";
 }
 
 }  // namespace

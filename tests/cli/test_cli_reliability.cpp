@@ -127,19 +127,19 @@ TEST_F(Reliability, NoGeometryIsAnErrorNotAnEmptyFile) {
   twice = "OFF\n9 16 0\n" + twice.substr(twice.find('\n', 4) + 1) + twice.substr(faces_at + 1);
   spit(dir_ + "/twice.off", twice);
   spit(dir_ + "/dup.off", grid_off("3 4 5 8\n", 1));
-  const CliRun ref = meshquilt(dir_, "surface --base grid.off --swatch sw.obj -o ref.obj --quiet");
+  const CliRun ref = meshquilt(dir_, "surface --base grid.off --swatch sw.obj -o ref.ply --quiet");
   ASSERT_EQ(ref.status, 0) << ref.err;
   for (const char* base : {"twice.off", "dup.off"}) {
     const CliRun r = meshquilt(dir_, std::string("surface --base ") + base +
-                                         " --swatch sw.obj -o o.obj --stats s.json --quiet");
+                                         " --swatch sw.obj -o o.ply --stats s.json --quiet");
     ASSERT_EQ(r.status, 0) << base << ": " << r.err;
-    EXPECT_TRUE(slurp(dir_ + "/o.obj") == slurp(dir_ + "/ref.obj")) << base;
+    EXPECT_TRUE(slurp(dir_ + "/o.ply") == slurp(dir_ + "/ref.ply")) << base;
     EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "duplicate_faces"),
               std::string(base) == "dup.off" ? "1" : "8");
-    fs::remove(dir_ + "/o.obj");
+    fs::remove(dir_ + "/o.ply");
     fs::remove(dir_ + "/s.json");
   }
-  fs::remove(dir_ + "/ref.obj");
+  fs::remove(dir_ + "/ref.ply");
   spit(dir_ + "/degenerate.off", grid_off("3 4 4 8\n", 1));
   expect_refused("surface --base degenerate.off --swatch sw.obj -o o.obj", "repeats a vertex");
   spit(dir_ + "/point.off", "OFF\n3 1 0\n1 1 1\n1 1 1\n1 1 1\n3 0 1 2\n");

@@ -260,7 +260,9 @@ void check_local_pull(const TriMesh& m, int source) {
   EXPECT_LT(dL.rowwise().norm().maxCoeff(), d.norm());
 
   // Same connectivity; no face flips or collapses for a small pull.
-  TriMesh out{W, m.F, {}};
+  TriMesh out;
+  out.V = W;
+  out.F = m.F;
   const TopologyReport before = topology_report(m), after = topology_report(out);
   EXPECT_EQ(after.num_components, before.num_components);
   EXPECT_EQ(after.closed(), before.closed());

@@ -1,0 +1,171 @@
+"""The one place the add-on runs the meshquilt engine.
+
+Every engine call goes through `Job`: it starts the command-line tool in the background, reads
+its machine progress lines (``--progress-lines``), and reports completion, the engine's error
+message or a cancellation. A new engine command (e.g. re-embedding a saved quilt on an edited
+base) is one more function that builds an argument list and returns a Job.
+"""
+
+import os
+import queue
+import shutil
+import signal
+import subprocess
+import threading
+import time
+
+
+class EngineError(Exception):
+    """The engine could not be found or reported an error (its one-line message)."""
+
+
+def find_engine(configured=""):
+    """The meshquilt executable: the add-on preference, $MESHQUILT_ENGINE, or PATH."""
+    for candidate in (configured, os.environ.get("MESHQUILT_ENGINE", ""), "meshquilt"):
+        if not candidate:
+            continue
+        path = shutil.which(os.path.expanduser(candidate))
+        if path:
+            return path
+    raise EngineError(
+        "meshquilt engine not found: set its path in the add-on preferences "
+        "(Edit > Preferences > Add-ons > meshquilt) or put meshquilt on PATH")
+
+
+def _die_with_parent():
+    """In the engine's process, before exec: Linux ends it with SIGTERM when Blender exits, so
+    closing Blender mid-run leaves no engine behind (elsewhere the job's cancel() does)."""
+    try:
+        import ctypes
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):
+        pass
+
+
+class Job:
+    """One engine run in the background.
+
+    poll() returns "running", "done", "failed" or "cancelled"; stage, fraction and remaining
+    describe the latest progress line; error holds the engine's message once failed.
+    """
+
+    def __init__(self, engine, args, cwd=None, progress=True):
+        # --progress-lines: the synthesis commands' machine progress (the swatch generator
+        # is quick and has none).
+        self.args = [engine] + list(args) + (["--progress-lines"] if progress else [])
+        self.stage = "starting"
+        self.fraction = 0.0
+        self.elapsed = 0.0
+        self.remaining = -1.0
+        self.error = ""
+        self.state = "running"
+        self._lines = queue.Queue()
+        self._stderr_tail = []
+        self._started = time.monotonic()
+        try:
+            self._process = subprocess.Popen(
+                self.args, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE, text=True, errors="replace",
+                preexec_fn=_die_with_parent if os.name == "posix" else None)
+        except OSError as e:
+            raise EngineError("cannot start the meshquilt engine: %s" % e)
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+
+    def _read(self):
+        for line in self._process.stderr:
+            self._lines.put(line.rstrip("\n"))
+        self._lines.put(None)
+
+    def _drain(self):
+        while True:
+            try:
+                line = self._lines.get_nowait()
+            except queue.Empty:
+                return
+            if line is None:
+                continue
+            parts = line.split()
+            if len(parts) == 5 and parts[0] == "progress":
+                try:
+                    self.stage = parts[1]
+                    self.fraction = float(parts[2])
+                    self.elapsed = float(parts[3])
+                    self.remaining = float(parts[4])
+                except ValueError:
+                    self._stderr_tail.append(line)
+            elif line.strip():
+                self._stderr_tail = (self._stderr_tail + [line])[-20:]
+
+    def poll(self):
+        if self.state != "running":
+            return self.state
+        self._drain()
+        code = self._process.poll()
+        if code is None:
+            return self.state
+        self._reader.join(timeout=5)
+        self._drain()
+        if code == 0:
+            self.state = "done"
+        else:
+            self.state = "failed"
+            # The engine's error is its last line: "meshquilt surface: error: ..." or similar.
+            self.error = self._stderr_tail[-1] if self._stderr_tail else (
+                "meshquilt exited with code %d" % code)
+        return self.state
+
+    def wait(self, timeout=None):
+        """Blocks until the job ends (for scripts and tests); returns the final state."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while self.poll() == "running":
+            if deadline is not None and time.monotonic() > deadline:
+                self.cancel()
+                raise EngineError("meshquilt did not finish within %g s" % timeout)
+            time.sleep(0.05)
+        return self.state
+
+    def cancel(self):
+        """Stops the engine (SIGTERM: it removes its temporary files), waits for it to end."""
+        if self.state != "running":
+            return
+        if self._process.poll() is None:
+            self._process.send_signal(signal.SIGTERM)
+            try:
+                self._process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait()
+        self._reader.join(timeout=5)
+        self.state = "cancelled"
+
+    def status_text(self):
+        """'quilting 42%, about 0:05 left' for Blender's status bar."""
+        text = "meshquilt: %s %d%%" % (self.stage, int(100 * self.fraction))
+        if self.remaining >= 0:
+            s = int(round(self.remaining))
+            text += ", about %d:%02d left" % (s // 60, s % 60)
+        return text
+
+
+def swatch_job(engine, kind, output, seed=1):
+    """Generates a sample swatch (chainmail, weave, apples, ivy)."""
+    return Job(engine, ["swatch", kind, "-o", output, "--seed", str(seed), "--quiet"],
+               progress=False)
+
+
+def surface_job(engine, base, swatch, output, scale, seed=1, stretch=True, field=None,
+                field_file=None, threads=0):
+    """Quilts the swatch over the base; `field` is an (x, y, z) direction, `field_file` a file
+    of one vector per base vertex (at most one of them)."""
+    args = ["surface", "--base", base, "--swatch", swatch, "-o", output,
+            "--scale", repr(float(scale)), "--seed", str(int(seed)),
+            "--threads", str(int(threads))]
+    if not stretch:
+        args.append("--no-stretch-opt")
+    if field is not None:
+        args += ["--field"] + [repr(float(c)) for c in field]
+    if field_file:
+        args += ["--field-file", field_file]
+    return Job(engine, args)

@@ -1,0 +1,283 @@
+"""The Blender add-on in real Blender, headless (issue 15). Run by scripts/test_blender.sh:
+
+    blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
+        ENGINE ADDON_ZIP WORK_DIR
+
+Installs the zipped add-on as a user would, then: registration; Run on a generated sphere with
+the sample chain mail (an object parented to the base, element ids, one material per kind);
+Cancel (the engine stops, no object, no files left); an engine error reported; the engine's OBJ
+and .glb outputs through Blender's own importers with per-element data intact; selecting an
+element by id.
+"""
+
+import glob
+import json
+import os
+import struct
+import sys
+import time
+import traceback
+
+import bpy
+import numpy as np
+
+ENGINE, ZIP, WORK = sys.argv[sys.argv.index("--") + 1:][:3]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        raise AssertionError(message)
+
+
+def test(fn):
+    start = time.monotonic()
+    try:
+        fn()
+        print("[blender] PASS %s (%.1f s)" % (fn.__name__, time.monotonic() - start), flush=True)
+    except Exception:
+        failures.append(fn.__name__)
+        print("[blender] FAIL %s\n%s" % (fn.__name__, traceback.format_exc()), flush=True)
+    return fn
+
+
+def new_scene():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    enable_addon()
+    return bpy.context.scene
+
+
+def enable_addon():
+    bpy.ops.preferences.addon_enable(module="meshquilt")
+    bpy.context.preferences.addons["meshquilt"].preferences.engine_path = ENGINE
+
+
+def sphere(name="Sphere", radius=1.0):
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=radius, segments=48, ring_count=24)
+    obj = bpy.context.active_object
+    obj.name = name
+    return obj
+
+
+def face_ids(obj):
+    ids = np.empty(len(obj.data.polygons), dtype=np.int32)
+    obj.data.attributes["element_id"].data.foreach_get("value", ids)
+    return ids
+
+
+@test
+def test_installs_and_registers():
+    bpy.ops.preferences.addon_install(filepath=ZIP, overwrite=True)
+    enable_addon()
+    check("meshquilt" in bpy.context.preferences.addons, "add-on not enabled")
+    check(hasattr(bpy.types.Scene, "meshquilt"), "scene settings not registered")
+    for op in ("run", "cancel", "select_element"):
+        check(hasattr(bpy.ops.meshquilt, op), "operator meshquilt.%s missing" % op)
+    check(hasattr(bpy.types, "MESHQUILT_PT_panel"), "panel not registered")
+    s = bpy.context.scene.meshquilt
+    check(s.stretch is True, "distortion minimisation must be on by default")
+
+
+@test
+def test_run_on_a_sphere_with_sample_chain_mail():
+    scene = new_scene()
+    base = sphere()
+    s = scene.meshquilt
+    s.base = base
+    s.swatch_source = "SAMPLE"
+    s.sample = "chainmail"
+    s.scale = 0.25
+    before = set(bpy.data.objects)
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    added = [o for o in bpy.data.objects if o not in before]
+    check(len(added) == 1, "expected one new object, got %d" % len(added))
+    obj = added[0]
+    check(obj.parent == base, "result not parented to the base")
+    me = obj.data
+    check(len(me.polygons) > 1000, "only %d faces" % len(me.polygons))
+    check("element_id" in me.attributes and me.attributes["element_id"].domain == "FACE",
+          "no element_id face attribute")
+    check([m.name for m in me.materials] == ["ring"], "materials %s" % [m.name for m in me.materials])
+    ids = face_ids(obj)
+    # Ids number the loose parts 0..n-1: as many ids as rings, each ring one connected piece.
+    n = int(ids.max()) + 1
+    check(len(np.unique(ids)) == n, "element ids are not 0..%d" % (n - 1))
+    check(n > 50, "only %d rings" % n)
+    check(all(p.use_smooth for p in me.polygons[:100]), "not smooth shaded")
+    check(me.validate() is False, "Blender had to repair the mesh")
+    # Lies on the sphere's shell: every vertex within the shell of radius 1.
+    V = np.empty(3 * len(me.vertices))
+    me.vertices.foreach_get("co", V)
+    r = np.linalg.norm(V.reshape(-1, 3), axis=1)
+    check(r.min() > 0.9 and r.max() < 1.3, "vertices at radius %.3f..%.3f" % (r.min(), r.max()))
+    # Selecting one element by id selects exactly its faces.
+    bpy.context.view_layer.objects.active = obj
+    check(bpy.ops.meshquilt.select_element(element=7) == {"FINISHED"}, "select failed")
+    sel = np.empty(len(me.polygons), dtype=bool)
+    me.polygons.foreach_get("select", sel)
+    check(np.array_equal(sel, ids == 7), "selection is not element 7")
+
+
+@test
+def test_object_swatch_kinds_come_from_its_materials():
+    scene = new_scene()
+    base = sphere()
+    # A swatch object with two materials: the engine's ivy, imported through the add-on's reader.
+    sw_path = os.path.join(WORK, "ivy_swatch.ply")
+    import meshquilt
+    from meshquilt import engine, exchange
+    check(engine.swatch_job(ENGINE, "ivy", sw_path).wait(60) == "done", "swatch failed")
+    result = exchange.read_ply(sw_path)
+    me = exchange.build_mesh(bpy, "ivy", result, meshquilt.material_for)
+    swatch = bpy.data.objects.new("ivy", me)
+    scene.collection.objects.link(swatch)
+    check([m.name for m in me.materials] == ["vine", "leaf"], "swatch materials %s"
+          % [m.name for m in me.materials])
+    s = scene.meshquilt
+    s.base, s.swatch_source, s.swatch, s.scale = base, "OBJECT", swatch, 0.5
+    s.stretch = False
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    obj = bpy.data.objects["Sphere_quilt"]
+    names = sorted(m.name for m in obj.data.materials)
+    check(names == ["leaf", "vine"], "result materials %s" % names)
+
+
+@test
+def test_cancel_stops_the_engine_and_adds_nothing():
+    scene = new_scene()
+    base = sphere()
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = base, "chainmail", 0.1  # 6,000 rings: about 20 s
+    import meshquilt
+    before = set(bpy.data.objects)
+    run = meshquilt.Run(bpy.context, s)
+    start = time.monotonic()
+    # Until the engine has reported progress twice (it is well into the job).
+    lines = 0
+    last = None
+    while run.step() == "running" and lines < 2:
+        if run.job is not None and (run.job.stage, run.job.fraction) != last:
+            last = (run.job.stage, run.job.fraction)
+            lines += 1
+        if time.monotonic() - start > 120:
+            run.cancel()
+            check(False, "no progress within 120 s")
+        time.sleep(0.02)
+    if run.state != "running":
+        run.cleanup()
+        check(False, "finished before it could be cancelled: %s" % run.state)
+    process = run.job._process
+    t = time.monotonic()
+    run.cancel()
+    check(process.poll() is not None, "engine still running after cancel")
+    check(time.monotonic() - t < 10, "cancel took %.1f s" % (time.monotonic() - t))
+    check(run.state == "cancelled", "state %s" % run.state)
+    check(set(bpy.data.objects) == before, "cancel left an object")
+    check(not os.path.exists(run.dir), "temporary directory left")
+
+
+@test
+def test_engine_error_is_reported():
+    scene = new_scene()
+    bpy.ops.mesh.primitive_plane_add()
+    flat = bpy.context.active_object
+    for v in flat.data.vertices:
+        v.co = (0.0, 0.0, 0.0)  # a base of zero size: the engine refuses it by name
+    s = scene.meshquilt
+    s.base = flat
+    import meshquilt
+    run = meshquilt.Run(bpy.context, s)
+    start = time.monotonic()
+    while run.step() == "running":
+        check(time.monotonic() - start < 60, "no answer within 60 s")
+        time.sleep(0.05)
+    check(run.state == "failed", "state %s" % run.state)
+    check("size" in run.error or "degenerate" in run.error, "message: %r" % run.error)
+    run.cleanup()
+    before = set(bpy.data.objects)
+    # The operator reports the engine's message as an error (a RuntimeError for a script).
+    try:
+        bpy.ops.meshquilt.run()
+        check(False, "operator did not report the failure")
+    except RuntimeError as e:
+        check("zero size" in str(e), "reported: %s" % e)
+    check(set(bpy.data.objects) == before, "a failed run added an object")
+    # A missing engine is an error too, not a crash.
+    bpy.context.preferences.addons["meshquilt"].preferences.engine_path = "/nonexistent/meshquilt"
+    os.environ.pop("MESHQUILT_ENGINE", None)
+    path = os.environ.get("PATH", "")
+    os.environ["PATH"] = "/nonexistent"
+    try:
+        try:
+            bpy.ops.meshquilt.run()
+            check(False, "missing engine not reported")
+        except RuntimeError as e:
+            check("engine not found" in str(e), "reported: %s" % e)
+    finally:
+        os.environ["PATH"] = path
+        enable_addon()
+
+
+def engine_output(name):
+    """A small job written by the engine itself (OBJ with groups, .glb), for the importers."""
+    from meshquilt import engine
+    sw = os.path.join(WORK, "weave.ply")
+    check(engine.swatch_job(ENGINE, "weave", sw).wait(60) == "done", "swatch failed")
+    base = os.path.join(WORK, "base.ply")
+    from meshquilt import exchange
+    u, v = np.meshgrid(np.linspace(0, 1, 21), np.linspace(0, 1, 21))
+    V = np.stack([u.ravel(), v.ravel(), np.zeros(u.size)], axis=1)
+    idx = np.arange(441).reshape(21, 21)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    exchange.write_ply(base, V, np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]))
+    out = os.path.join(WORK, name)
+    job = engine.surface_job(ENGINE, base, sw, out, 0.3, stretch=False)
+    check(job.wait(120) == "done", "engine failed: %s" % job.error)
+    return out
+
+
+@test
+def test_obj_split_by_objects_gives_one_object_per_element():
+    new_scene()
+    path = engine_output("weave_quilt.obj")
+    elements = sum(1 for line in open(path) if line.startswith("o "))
+    # Blender 3.4's OBJ importer (File > Import > Wavefront) makes one object per "o".
+    bpy.ops.wm.obj_import(filepath=path)
+    objs = [o for o in bpy.data.objects if o.type == "MESH"]
+    check(len(objs) == elements, "%d objects for %d elements" % (len(objs), elements))
+    kinds = {o.name.rsplit("_", 1)[0] for o in objs}
+    check(kinds == {"thread_x", "thread_y"}, "object kinds %s" % kinds)
+    for o in objs:
+        mats = [m.name for m in o.data.materials]
+        check(len(mats) == 1 and o.name.startswith(mats[0]), "%s has materials %s" % (o.name, mats))
+        check(o.data.polygons[0].use_smooth or any(l.normal for l in o.data.loops[:1]),
+              "no normals on %s" % o.name)
+
+
+@test
+def test_glb_imports_with_materials_and_has_the_element_id_attribute():
+    new_scene()
+    path = engine_output("weave_quilt.glb")
+    data = open(path, "rb").read()
+    json_length = struct.unpack("<I", data[12:16])[0]
+    gltf = json.loads(data[20:20 + json_length])
+    prims = gltf["meshes"][0]["primitives"]
+    for p in prims:
+        check("_ELEMENT_ID" in p["attributes"], "no _ELEMENT_ID attribute")
+        check(gltf["accessors"][p["attributes"]["_ELEMENT_ID"]]["count"] ==
+              gltf["accessors"][p["attributes"]["POSITION"]]["count"], "id count differs")
+    # Debian 12's Blender 3.4 importer fails in its default "NORMALS" shading mode (it uses
+    # numpy.bool, gone in numpy 1.24); "SMOOTH" takes the file's normals as they are.
+    bpy.ops.import_scene.gltf(filepath=path, import_shading="SMOOTH")
+    objs = [o for o in bpy.data.objects if o.type == "MESH"]
+    check(len(objs) == 1, "%d objects" % len(objs))
+    mats = sorted(m.name for m in objs[0].data.materials)
+    check(mats == ["thread_x", "thread_y"], "materials %s" % mats)
+    faces = sum(gltf["accessors"][p["indices"]]["count"] // 3 for p in prims)
+    check(len(objs[0].data.polygons) == faces, "%d faces for %d" % (len(objs[0].data.polygons), faces))
+
+
+print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
+if failures:
+    sys.exit(1)
