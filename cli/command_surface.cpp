@@ -39,6 +39,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("base_faces", s.base_faces)
       .value("welded_vertices", s.welded_vertices)
       .value("duplicate_faces", s.duplicate_faces)
+      .value("flipped_components", s.flipped_components)
       .value("swatch_scale", s.swatch_scale)
       .value("shell_height", s.shell_height)
       .value("cell_size", s.cell_size)
@@ -123,6 +124,8 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("embedding", "shell|normal",
             "place the texture through the shell map or by plain normal displacement", "shell");
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
+  cl.flag("keep-orientation",
+          "grow the texture along the base's normals as given, even where they face inward");
   cl.option("method", "auto|global|patches",
             "global: one field-aligned parameterisation, seamless for a periodic swatch (keeps "
             "chain mail linked); patches: local conformal patches (the paper's); auto: global "
@@ -148,6 +151,7 @@ int run_surface(int argc, char** argv, int first) {
   options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
   options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
   options.patch.deform = !cl.has("no-deform");
+  options.orient_outward = !cl.has("keep-orientation");
   QuiltEmbeddingOptions embedding;
   const std::string embedding_name = cl.get("embedding");
   if (embedding_name != "shell" && embedding_name != "normal")
@@ -227,6 +231,10 @@ int run_surface(int argc, char** argv, int first) {
         "covered\n",
         out_path.c_str(), embedding_stats.faces, embedding_stats.vertices, embedding_stats.elements,
         stats.shell_height, 100.0 * embedding_stats.coverage);
+    if (stats.flipped_components > 0)
+      std::printf("base: %d components faced inward and were turned outward "
+                  "(--keep-orientation keeps them)\n",
+                  stats.flipped_components);
     if (!embedding_stats.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
                   embedding_stats.shell_map_failure.c_str());

@@ -10,6 +10,7 @@
 
 #include "core/closest_point_query.h"
 #include "core/errors.h"
+#include "core/outward_orientation.h"
 #include "core/geometry_measures.h"
 #include "core/local_patch.h"
 #include "core/mesh_intersections.h"
@@ -413,6 +414,9 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   job.cleaned = weld_vertices(base_in, &stats.welded_vertices);
   std::vector<int> input_face;  // job.cleaned's faces -> base_in's
   job.cleaned = without_duplicate_faces(job.cleaned, input_face, &stats.duplicate_faces);
+  // The shell grows along the normal: components turned inside out would hide the texture
+  // inside the object.
+  if (options.orient_outward) stats.flipped_components = orient_outward(job.cleaned);
   // The output estimated before any work: the swatch's faces per unit of footprint area at its
   // scale on the surface, over the base's area (issue 14: --scale 1e-6 ran out of memory).
   {

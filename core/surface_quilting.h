@@ -72,6 +72,8 @@ struct SurfaceQuiltingOptions {
   // Refuse a job whose output is estimated above this many faces (the swatch's faces per unit
   // of footprint area times the base's area): issue 14.
   double max_faces = 2e7;
+  // Turn base components whose faces point inward to face outward (orient_outward) first.
+  bool orient_outward = true;
   // The global-parameterisation method (core/global_quilting).
   struct Global {
     // Weight of the guidance field against the line field's smoothness: small lets the
@@ -93,6 +95,7 @@ struct SurfaceQuiltingStats {
   int base_faces = 0;       // after refinement
   int welded_vertices = 0;  // base vertices merged with another at the same position
   int duplicate_faces = 0;  // base faces that repeated another, removed
+  int flipped_components = 0;  // base components turned to face outward (orient_outward)
   int patches_shrunk = 0;
   double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;
