@@ -312,42 +312,48 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     const std::vector<std::vector<int>> groups = component_faces(fc, n);
     std::vector<std::vector<SurfaceElement>> per(static_cast<size_t>(n));
     std::vector<int> off(static_cast<size_t>(n), 0);
-    tbb::parallel_for(0, n, [&](int c) {
-      const TriMesh part = extract_faces(plane, groups[c]);
-      const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
-      // One placement per place on the surface: faces of one chart around the centre (it lies
-      // on their common edge or vertex) are the same place.
-      std::vector<int> starts;
-      for (const int f : grid.containing(centre)) {
-        bool same = false;
-        for (const int g : starts) same = same || share_wedge(gp, f, g);
-        if (!same) starts.push_back(f);
-      }
-      for (const int f0 : starts) {
-        SurfaceElement s;
-        s.F = part.F;
-        s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
-        s.face.resize(part.V.rows());
-        s.barycentric.resize(part.V.rows(), 3);
-        s.height.resize(part.V.rows());
-        int face = f0;
-        ChartTransform to_current;  // from f0's chart to the walk's current face's
-        bool ok = true;
-        for (Eigen::Index v = 0; v < part.V.rows() && ok; ++v) {
-          Vector2d x = to_current(part.V.row(v).head<2>().transpose());
-          Vector3d b;
-          ok = locate_in_charts(gp, job.topo, job.TT, base.F, face, x, b, 256, &to_current);
-          s.face[v] = face;
-          s.barycentric.row(v) = b.transpose();
-          s.height(v) = std::clamp(part.V(v, 2), 0.0, swatch.size.z());
+    // In blocks, so that progress is reported from this thread between them (each element's
+    // placement depends only on it: the result is the same whatever the blocks).
+    const int block = std::max(64, n / 50);
+    for (int first = 0; first < n; first += block) {
+      report_progress(progress, "placement", first, n);
+      tbb::parallel_for(first, std::min(n, first + block), [&](int c) {
+        const TriMesh part = extract_faces(plane, groups[c]);
+        const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
+        // One placement per place on the surface: faces of one chart around the centre (it lies
+        // on their common edge or vertex) are the same place.
+        std::vector<int> starts;
+        for (const int f : grid.containing(centre)) {
+          bool same = false;
+          for (const int g : starts) same = same || share_wedge(gp, f, g);
+          if (!same) starts.push_back(f);
         }
-        if (ok) {
-          s.flat = part.V;
-          per[c].push_back(std::move(s));
-        } else
-          ++off[c];
-      }
-    });
+        for (const int f0 : starts) {
+          SurfaceElement s;
+          s.F = part.F;
+          s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
+          s.face.resize(part.V.rows());
+          s.barycentric.resize(part.V.rows(), 3);
+          s.height.resize(part.V.rows());
+          int face = f0;
+          ChartTransform to_current;  // from f0's chart to the walk's current face's
+          bool ok = true;
+          for (Eigen::Index v = 0; v < part.V.rows() && ok; ++v) {
+            Vector2d x = to_current(part.V.row(v).head<2>().transpose());
+            Vector3d b;
+            ok = locate_in_charts(gp, job.topo, job.TT, base.F, face, x, b, 256, &to_current);
+            s.face[v] = face;
+            s.barycentric.row(v) = b.transpose();
+            s.height(v) = std::clamp(part.V(v, 2), 0.0, swatch.size.z());
+          }
+          if (ok) {
+            s.flat = part.V;
+            per[c].push_back(std::move(s));
+          } else
+            ++off[c];
+        }
+      });
+    }
     for (int c = 0; c < n; ++c) {
       gstats.off_surface += off[c];
       for (SurfaceElement& s : per[c]) placed.push_back(std::move(s));

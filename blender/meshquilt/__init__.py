@@ -243,6 +243,9 @@ class MESHQUILT_OT_run(bpy.types.Operator):
         if run.state == "done":
             try:
                 obj = run.import_result(context)
+            except (OSError, ValueError, KeyError) as e:
+                self.report({"ERROR"}, "meshquilt: cannot read the result: %s" % e)
+                return {"CANCELLED"}
             finally:
                 run.cleanup()
             self.report({"INFO"}, "meshquilt: %s, %d faces" % (obj.name, len(obj.data.polygons)))

@@ -143,7 +143,7 @@ class Job:
     def status_text(self):
         """'quilting 42%, about 0:05 left' for Blender's status bar."""
         text = "meshquilt: %s %d%%" % (self.stage, int(100 * self.fraction))
-        if self.remaining >= 0:
+        if self.remaining >= 0 and 0 < self.fraction < 1:
             s = int(round(self.remaining))
             text += ", about %d:%02d left" % (s // 60, s % 60)
         return text

@@ -144,6 +144,36 @@ def test_object_swatch_kinds_come_from_its_materials():
 
 
 @test
+def test_guidance_by_an_objects_axis_and_by_a_vertex_attribute():
+    scene = new_scene()
+    base = sphere()
+    s = scene.meshquilt
+    s.base, s.sample, s.scale, s.stretch = base, "weave", 0.5, False
+    bpy.ops.object.empty_add()
+    guide = bpy.context.active_object
+    guide.rotation_euler = (0.0, 1.2, 0.3)
+    s.guidance, s.guide_object, s.guide_axis = "AXIS", guide, "X"
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "axis guidance run failed")
+    bpy.data.objects.remove(bpy.data.objects["Sphere_quilt"])
+    # A vector per vertex: the tangent of circles around z.
+    attribute = base.data.attributes.new("guide", "FLOAT_VECTOR", "POINT")
+    V = np.empty(3 * len(base.data.vertices))
+    base.data.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    T = np.stack([-V[:, 1], V[:, 0], np.zeros(len(V))], axis=1)
+    attribute.data.foreach_set("vector", T.ravel())
+    s.guidance, s.guide_attribute = "ATTRIBUTE", "guide"
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "attribute guidance run failed")
+    check("Sphere_quilt" in bpy.data.objects, "no result")
+    s.guide_attribute = "missing"
+    try:
+        bpy.ops.meshquilt.run()
+        check(False, "a missing attribute was not reported")
+    except RuntimeError as e:
+        check("no vertex vector attribute" in str(e), "reported: %s" % e)
+
+
+@test
 def test_cancel_stops_the_engine_and_adds_nothing():
     scene = new_scene()
     base = sphere()
