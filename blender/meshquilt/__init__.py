@@ -97,7 +97,7 @@ class Run:
         depsgraph = context.evaluated_depsgraph_get()
         base_path = os.path.join(self.dir, "base.ply")
         field = field_file = None
-        V, T = self._export(depsgraph, base, base_path)
+        V = self._export(depsgraph, base, base_path)[0]
         if settings.guidance == "AXIS":
             axis = {"X": 0, "Y": 1, "Z": 2}[settings.guide_axis]
             field = tuple(settings.guide_object.matrix_world.to_3x3().col[axis])
@@ -105,9 +105,11 @@ class Run:
             field_file = os.path.join(self.dir, "field.txt")
             self._export_field(depsgraph, base, settings.guide_attribute, field_file, len(V))
         self.jobs = []
+        self.material_names = {}  # the engine's kind name -> the swatch's material name
         if settings.swatch_source == "OBJECT":
             swatch_path = os.path.join(self.dir, "swatch.ply")
-            self._export(depsgraph, settings.swatch, swatch_path, with_kinds=True)
+            kinds = self._export(depsgraph, settings.swatch, swatch_path, with_kinds=True)[2]
+            self.material_names = {_engine_kind_name(k): k for k in kinds}
         else:
             swatch_path = os.path.join(self.dir, "swatch_%s.ply" % settings.sample)
             self.jobs.append(lambda: engine.swatch_job(self.engine, settings.sample, swatch_path,
@@ -139,7 +141,7 @@ class Run:
         W = np.array(obj.matrix_world)
         V = V @ W[:3, :3].T + W[:3, 3]
         exchange.write_ply(path, V, T, kinds, M if kinds else None)
-        return V, T
+        return V, T, kinds or []
 
     @staticmethod
     def _export_field(depsgraph, obj, name, path, count):
@@ -191,7 +193,9 @@ class Run:
     def import_result(self, context):
         result = exchange.read_ply(self.result_path)
         name = "%s_quilt" % self.base.name
-        me = exchange.build_mesh(bpy, name, result, material_for)
+        # The swatch's own materials for its kinds (the engine's names replace spaces).
+        me = exchange.build_mesh(bpy, name, result, lambda kind, look: material_for(
+            self.material_names.get(kind, kind), look))
         obj = bpy.data.objects.new(name, me)
         collection = self.base.users_collection[0] if self.base.users_collection else \
             context.scene.collection
@@ -204,6 +208,12 @@ class Run:
 
     def cleanup(self):
         shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def _engine_kind_name(name):
+    """A kind name as the engine writes it (core/element_kinds.cpp sanitized_kind)."""
+    s = "".join(c if " " < c < "\x7f" and c != "#" else "_" for c in name)
+    return s or "element"
 
 
 def material_for(kind, look):

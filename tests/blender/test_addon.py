@@ -134,13 +134,16 @@ def test_object_swatch_kinds_come_from_its_materials():
     scene.collection.objects.link(swatch)
     check([m.name for m in me.materials] == ["vine", "leaf"], "swatch materials %s"
           % [m.name for m in me.materials])
+    # A material name with a space: the result reuses the swatch's own material.
+    me.materials[1].name = "Leaf Green"
     s = scene.meshquilt
     s.base, s.swatch_source, s.swatch, s.scale = base, "OBJECT", swatch, 0.5
     s.stretch = False
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
     obj = bpy.data.objects["Sphere_quilt"]
     names = sorted(m.name for m in obj.data.materials)
-    check(names == ["leaf", "vine"], "result materials %s" % names)
+    check(names == ["Leaf Green", "vine"], "result materials %s" % names)
+    check(obj.data.materials["Leaf Green"] == me.materials[1], "the swatch's material not reused")
 
 
 @test
