@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -198,6 +199,30 @@ TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
                    "cannot write in the directory");
     fs::permissions(dir_ + "/ro", fs::perms::owner_all);
   }
+}
+
+// A full disk, simulated by a file size limit (RLIMIT_FSIZE, with SIGXFSZ ignored so that the
+// write fails with EFBIG as it would with ENOSPC): exit 1, one line naming the output, the old
+// file at the path untouched and no temporary file left (issue 14).
+TEST_F(Reliability, AFullDiskLeavesTheOldFileAndNoTemporary) {
+  spit(dir_ + "/big.obj", "old\n");
+  spit(dir_ + "/big.mtl", "old mtl\n");
+  const std::vector<std::string> before = listing(dir_);
+  const std::string err = dir_ + "/.err";
+  // dash's ulimit -f counts 512-byte blocks: 64 KiB, far less than the layer's OBJ.
+  const std::string cmd = "cd '" + dir_ + "' && trap '' XFSZ && ulimit -f 128 && exec '" +
+                          std::string(MESHQUILT_CLI) +
+                          "' plane --swatch sw.obj --size 12 12 -o big.obj --quiet 2>'" + err +
+                          "' </dev/null >/dev/null";
+  const int raw = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(raw)) << "killed by signal " << WTERMSIG(raw);
+  EXPECT_EQ(WEXITSTATUS(raw), 1);
+  const std::string message = slurp(err);
+  fs::remove(err);
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  EXPECT_NE(message.find("big."), std::string::npos) << message;
+  EXPECT_EQ(slurp(dir_ + "/big.obj"), "old\n");
+  EXPECT_EQ(listing(dir_), before);
 }
 
 }  // namespace
