@@ -8,6 +8,7 @@
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/atomic_file.h"
+#include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
@@ -104,6 +105,13 @@ int run_info(int argc, char** argv, int first) {
     crossing = static_cast<long long>(intersecting_face_pairs(mesh.V, mesh.F).size());
     self_crossing = static_cast<long long>(self_intersecting_components(mesh.V, mesh.F).size());
   }
+  // Elements per kind (element_kinds.h), in the order the file names the kinds.
+  std::vector<std::pair<std::string, int>> per_kind;
+  if (has_kinds(mesh)) {
+    const ElementLabels labels = element_labels(mesh);
+    for (const std::string& k : labels.kinds) per_kind.emplace_back(k, 0);
+    for (const int k : labels.element_kind) ++per_kind[static_cast<size_t>(k)].second;
+  }
   if (cl.has("json")) {
     JsonWriter j;
     j.begin_object()
@@ -111,7 +119,9 @@ int run_info(int argc, char** argv, int first) {
         .value("faces", mesh.num_faces())
         .value("vertices", mesh.num_vertices())
         .value("elements", topo.num_components)
-        .begin_array("bbox_min");
+        .begin_object("kinds");
+    for (const auto& [name, count] : per_kind) j.value(name, count);
+    j.end_object().begin_array("bbox_min");
     for (int k = 0; k < 3; ++k) j.value("", box.min(k));
     j.end_array().begin_array("bbox_max");
     for (int k = 0; k < 3; ++k) j.value("", box.max(k));
@@ -139,6 +149,12 @@ int run_info(int argc, char** argv, int first) {
   std::printf("faces:             %d\n", mesh.num_faces());
   std::printf("vertices:          %d\n", mesh.num_vertices());
   std::printf("elements:          %d\n", topo.num_components);
+  if (!per_kind.empty()) {
+    std::string text;
+    for (const auto& [name, count] : per_kind)
+      text += (text.empty() ? "" : ", ") + std::to_string(count) + " " + name;
+    std::printf("kinds:             %s\n", text.c_str());
+  }
   std::printf("bounding box:      [%.6g, %.6g, %.6g] - [%.6g, %.6g, %.6g]\n", box.min.x(),
               box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z());
   std::printf("size:              %.6g x %.6g x %.6g (thickness %.6g)\n", size.x(), size.y(),

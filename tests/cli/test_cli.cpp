@@ -264,6 +264,10 @@ TEST(Cli, OutputsCarryElementsKindsAndNormals) {
   const CliRun info = meshquilt(dir, "info e.obj --json");
   ASSERT_EQ(info.status, 0) << info.err;
   EXPECT_EQ(count(e, "o "), std::stoi(json_value(info.out, "elements")));
+  // info counts elements per kind: a vine or more, and the rest leaves.
+  EXPECT_GE(std::stoi(json_value(info.out, "vine")), 1) << info.out;
+  EXPECT_EQ(std::stoi(json_value(info.out, "vine")) + std::stoi(json_value(info.out, "leaf")),
+            std::stoi(json_value(info.out, "elements")));
   EXPECT_GT(count(e, "vn "), 0);
   EXPECT_EQ(count(k, "o "), 2);  // vine and leaf
   EXPECT_EQ(count(n, "o "), 0);
