@@ -25,6 +25,11 @@ void ensure_kinds(TriMesh& mesh) {
     set_single_kind(mesh, kDefaultKind);
     return;
   }
+  check_kinds(mesh);
+}
+
+void check_kinds(const TriMesh& mesh) {
+  if (mesh.face_kind.empty()) return;
   MQ_CHECK(mesh.face_kind.size() == static_cast<size_t>(mesh.F.rows()), InvalidInput,
            "the mesh has ", mesh.face_kind.size(), " face kinds for ", mesh.F.rows(), " faces");
   const int n = static_cast<int>(mesh.kinds.size());
@@ -88,6 +93,10 @@ ElementLabels element_labels(const TriMesh& mesh) {
   ElementLabels l;
   l.count = connected_components(mesh.F, mesh.num_vertices(), l.face_element);
   l.element_kind = component_kinds(mesh, l.face_element, l.count);
+  l.vertex_element.assign(static_cast<size_t>(mesh.num_vertices()), 0);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      l.vertex_element[static_cast<size_t>(mesh.F(f, k))] = l.face_element[static_cast<size_t>(f)];
   l.kinds = has_kinds(mesh) ? mesh.kinds : std::vector<std::string>{kDefaultKind};
   return l;
 }

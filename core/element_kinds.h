@@ -20,6 +20,9 @@ bool has_kinds(const TriMesh& mesh);
 // Gives every face of mesh the one kind `name` (replacing any kinds it had).
 void set_single_kind(TriMesh& mesh, const std::string& name);
 
+// Throws InvalidInput unless face_kind is empty, or #F indices into kinds.
+void check_kinds(const TriMesh& mesh);
+
 // Makes mesh carry kinds: a mesh without any gets the single kind kDefaultKind.
 // Throws InvalidInput when face_kind is neither empty nor #F, or holds an index out of range.
 void ensure_kinds(TriMesh& mesh);
@@ -46,6 +49,7 @@ std::string sanitized_kind(const std::string& name);
 struct ElementLabels {
   int count = 0;
   std::vector<int> face_element;  // #F
+  std::vector<int> vertex_element;  // #V: the element of each vertex (0 for unused ones)
   std::vector<int> element_kind;  // #elements, indices into kinds
   std::vector<std::string> kinds; // the mesh's kinds, or {kDefaultKind} when it has none
 };

@@ -76,11 +76,6 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
     }
   const size_t nv = gl_vertex.size();
   std::vector<float> position(3 * nv), normal(3 * nv), element(nv);
-  std::vector<int> vertex_element(static_cast<size_t>(mesh.V.rows()), 0);
-  for (Eigen::Index f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k)
-      vertex_element[static_cast<size_t>(mesh.F(f, k))] =
-          labels.face_element[static_cast<size_t>(f)];
   std::vector<double> lo(3, std::numeric_limits<double>::infinity()), hi(3, -lo[0]);
   for (size_t i = 0; i < nv; ++i) {
     for (int k = 0; k < 3; ++k) {
@@ -90,7 +85,7 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
       lo[k] = std::min(lo[k], static_cast<double>(p));
       hi[k] = std::max(hi[k], static_cast<double>(p));
     }
-    element[i] = static_cast<float>(vertex_element[static_cast<size_t>(gl_vertex[i])]);
+    element[i] = static_cast<float>(labels.vertex_element[static_cast<size_t>(gl_vertex[i])]);
   }
 
   tinygltf::Model model;

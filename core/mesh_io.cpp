@@ -957,17 +957,9 @@ void write_ply(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, bool
   header += "element face " + std::to_string(m.F.rows()) + "\n";
   header += "property list uchar int vertex_indices\nend_header\n";
   out.append(header);
-  // Element and kind of each vertex (every face of an element has its vertices).
-  std::vector<int> vertex_element;
-  if (labels) {
-    vertex_element.assign(static_cast<size_t>(m.V.rows()), 0);
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-      for (int k = 0; k < 3; ++k)
-        vertex_element[static_cast<size_t>(m.F(f, k))] = labels->face_element[static_cast<size_t>(f)];
-  }
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     char* p = out.cursor();
-    const int e = labels ? vertex_element[static_cast<size_t>(i)] : 0;
+    const int e = labels ? labels->vertex_element[static_cast<size_t>(i)] : 0;
     const int kind = labels ? labels->element_kind[static_cast<size_t>(e)] : 0;
     if (binary) {
       for (int k = 0; k < 3; ++k) p = put_le(p, m.V(i, k));
@@ -1059,12 +1051,8 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
         MQ_THROW(InvalidInput, path, ": cannot write mesh: face ", f, " has vertex index ",
                  mesh.F(f, k), " out of range (", nv, " vertices)");
   if (!mesh.kinds.empty()) {
-    TriMesh check;
-    check.kinds = mesh.kinds;
-    check.face_kind = mesh.face_kind;
-    check.F.resize(mesh.F.rows(), 3);
     try {
-      ensure_kinds(check);
+      check_kinds(mesh);
     } catch (const InvalidInput& e) {
       MQ_THROW(InvalidInput, path, ": cannot write mesh: ", e.what());
     }

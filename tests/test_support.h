@@ -11,6 +11,10 @@ namespace mq::test {
 // Absolute path of a file in ../shared/data (e.g. "base/bunny_igl_7k.off").
 std::string shared_data(const std::string& relative);
 
+// The bytes of a file (empty when it cannot be read), and a file written with `text`.
+std::string slurp(const std::string& path);
+void spit(const std::string& path, const std::string& text);
+
 // A fresh, empty temporary directory unique to the calling test.
 std::string temp_dir();
 

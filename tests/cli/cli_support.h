@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_support.h"
+
 namespace mq {
 
 namespace fs = std::filesystem;
@@ -27,16 +29,8 @@ struct CliRun {
   }
 };
 
-inline std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-inline void spit(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
+using test::slurp;
+using test::spit;
 
 // Runs `meshquilt ARGS` in `dir` with stdout and stderr captured in files (so neither is a
 // terminal); with timeout_seconds > 0 under timeout(1), which kills it after that long (exit

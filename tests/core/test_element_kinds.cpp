@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -21,17 +20,6 @@
 
 namespace mq {
 namespace {
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
 
 // Faces per kind name.
 std::map<std::string, int> faces_per_kind(const TriMesh& m) {
@@ -71,7 +59,7 @@ TEST(ElementKinds, ObjMaterialsNameKindsBeforeGroups) {
   const std::string dir = test::temp_dir();
   // Two triangles in group a with material m1, one in group b without a material change, one
   // with group c and material (null) (as some exporters write), one before any name.
-  write_text(dir + "/k.obj",
+  test::spit(dir + "/k.obj",
              "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
              "g a\nusemtl m1\nf 1 2 3\nf 1 3 2\n"
              "g b\nf 2 3 1\n"
@@ -86,7 +74,7 @@ TEST(ElementKinds, ObjMaterialsNameKindsBeforeGroups) {
   EXPECT_EQ(name(3), "m1");  // g b keeps material m1
   EXPECT_EQ(name(4), "c");   // (null) is no material: the object name
   // A file with no names has no kinds.
-  write_text(dir + "/plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  test::spit(dir + "/plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   EXPECT_FALSE(has_kinds(read_mesh(dir + "/plain.obj")));
   // The shared leaf swatches name theirs.
   const TriMesh rose = read_mesh(test::shared_data("swatch/leaf_rose_311.obj"));
@@ -105,7 +93,7 @@ TEST(ElementKinds, ObjGroupsByElementKindOrNoneRoundTrip) {
     o.write_normals = true;
     o.groups = g;
     write_mesh(dir + "/ivy.obj", mesh, o);
-    const std::string text = read_text(dir + "/ivy.obj");
+    const std::string text = test::slurp(dir + "/ivy.obj");
     int objects = 0;
     std::set<std::string> names, materials;
     std::istringstream lines(text);
@@ -128,7 +116,7 @@ TEST(ElementKinds, ObjGroupsByElementKindOrNoneRoundTrip) {
       EXPECT_EQ(objects, 0);
     }
     // The .mtl defines every material used.
-    const std::string mtl = read_text(dir + "/ivy.mtl");
+    const std::string mtl = test::slurp(dir + "/ivy.mtl");
     EXPECT_NE(mtl.find("newmtl leaf\n"), std::string::npos);
     EXPECT_NE(mtl.find("newmtl vine\n"), std::string::npos);
     // Read back: same faces (as a set), same kinds per face count.
@@ -151,7 +139,7 @@ TEST(ElementKinds, PlyCarriesElementIdAndKindPerVertex) {
     o.write_normals = true;
     o.binary = binary;
     write_mesh(dir + "/w.ply", mesh, o);
-    const std::string text = read_text(dir + "/w.ply");
+    const std::string text = test::slurp(dir + "/w.ply");
     EXPECT_NE(text.find("property int element_id\nproperty int kind\n"), std::string::npos);
     EXPECT_NE(text.find("comment kind 0 thread_x\n"), std::string::npos);
     EXPECT_NE(text.find("comment kind 1 thread_y\n"), std::string::npos);
@@ -165,7 +153,7 @@ TEST(ElementKinds, PlyCarriesElementIdAndKindPerVertex) {
   o.write_elements = true;
   o.binary = false;
   write_mesh(dir + "/a.ply", mesh, o);
-  std::istringstream in(read_text(dir + "/a.ply"));
+  std::istringstream in(test::slurp(dir + "/a.ply"));
   std::string line;
   while (std::getline(in, line) && line != "end_header") {
   }

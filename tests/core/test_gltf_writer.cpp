@@ -9,10 +9,8 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "core/element_kinds.h"
 #include "core/errors.h"
@@ -23,13 +21,6 @@
 
 namespace mq {
 namespace {
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 uint32_t u32(const std::string& b, size_t at) {
   uint32_t v;
@@ -54,7 +45,7 @@ int component_size(int type) {
 
 // Checks a .glb; `model` receives what tinygltf reads.
 void check_glb_into(const std::string& path, tinygltf::Model& model) {
-  const std::string b = read_bytes(path);
+  const std::string b = test::slurp(path);
   EXPECT_GE(b.size(), 28u);
   EXPECT_EQ(b.substr(0, 4), "glTF");
   EXPECT_EQ(u32(b, 4), 2u);
@@ -200,9 +191,9 @@ TEST(GltfWriter, MeshWithoutKindsAndSameBytesEveryTime) {
   const TriMesh t = test::torus(1.0, 0.25, 32, 12);
   const std::string dir = test::temp_dir();
   write_glb(dir + "/a.glb", t);
-  const std::string first = read_bytes(dir + "/a.glb");
+  const std::string first = test::slurp(dir + "/a.glb");
   write_glb(dir + "/a.glb", t);
-  EXPECT_TRUE(read_bytes(dir + "/a.glb") == first);  // (the mesh is named after the file)
+  EXPECT_TRUE(test::slurp(dir + "/a.glb") == first);  // (the mesh is named after the file)
   const tinygltf::Model m = check_glb(dir + "/a.glb");
   ASSERT_EQ(m.materials.size(), 1u);
   EXPECT_EQ(m.materials[0].name, kDefaultKind);
