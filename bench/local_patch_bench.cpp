@@ -56,6 +56,20 @@ void BM_LscmOf500FacePatch(benchmark::State& state) {
 }
 BENCHMARK(BM_LscmOf500FacePatch)->Unit(benchmark::kMicrosecond);
 
+// LSCM of one patch of about N faces: how the cost of a patch grows with the faces it holds (a
+// finer base gives a patch of the same area more faces; issue 14's 1M-face base).
+void BM_LscmOfPatch(benchmark::State& state) {
+  const TriMesh base = bunny70k();
+  LocalPatchBuilder builder(base);
+  const LocalPatch p = builder.grow(12345, patch_options(base, static_cast<double>(state.range(0))));
+  for (auto _ : state) benchmark::DoNotOptimize(lscm(p.mesh.V, p.mesh.F).data());
+  state.counters["faces"] = static_cast<double>(p.faces.size());
+  state.counters["us_per_face"] = benchmark::Counter(
+      static_cast<double>(p.faces.size()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_LscmOfPatch)->Arg(500)->Arg(2000)->Arg(8000)->Arg(24000)->Unit(benchmark::kMillisecond);
+
 void BM_BuilderSetup(benchmark::State& state) {
   const TriMesh base = bunny70k();
   for (auto _ : state) {

@@ -234,52 +234,68 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   Vector2d pinned[2] = {Vector2d::Zero(), Vector2d(pin_distance, 0)};
   auto pinned_uv = [&](int v) { return v == pin0 ? pinned[0] : pinned[1]; };
 
-  // Per triangle, in a local orthonormal frame with edges e_j = p_{j+2} - p_{j+1}, the residual
-  // of Cauchy-Riemann is proportional to sum_j u_j e_j + v_j rot90(e_j); weight 1 / (2 sqrt(A)).
+  // The energy sum_T A_T |grad v - rot90(grad u)|^2 splits into the Dirichlet energies of u and
+  // v (cotangent weights) minus twice the signed area of the image, and that area is a sum over
+  // the boundary edges alone (Levy et al. 2002; Desbrun et al. 2002). Assembled that way u and v
+  // are coupled on the boundary only: the factor of the 2n x 2n system fills in like two
+  // Laplacians instead of a system coupled at every vertex, which is what made a large patch
+  // (a fine base, issue 14) cost several times more per face than a small one.
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<size_t>(nf) * 12);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
+  triplets.reserve(static_cast<size_t>(nf) * 24);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nu);
+  // E(z) = z^T Q z over z = (u, v): adds q to Q(a, b) and Q(b, a), moving pinned terms to the
+  // right-hand side of Q_ff z_f = -Q_fp z_p.
+  auto value = [&](int vertex, int coord) {
+    const Vector2d q = pinned_uv(vertex);
+    return coord == 0 ? q.x() : q.y();
+  };
+  auto add = [&](int va, int ca, int vb, int cb, double q) {
+    const bool fa = unknown[va] >= 0, fb = unknown[vb] >= 0;
+    const int ia = fa ? ca * nu + unknown[va] : -1, ib = fb ? cb * nu + unknown[vb] : -1;
+    if (fa && fb) {
+      triplets.emplace_back(ia, ib, q);
+      triplets.emplace_back(ib, ia, q);
+    } else if (fa) {
+      rhs(ia) -= q * value(vb, cb);
+    } else if (fb) {
+      rhs(ib) -= q * value(va, ca);
+    }
+  };
   for (int f = 0; f < nf; ++f) {
-    const Vector3d P0 = row3(V, F(f, 0)), P1 = row3(V, F(f, 1)), P2 = row3(V, F(f, 2));
-    const Vector3d normal = (P1 - P0).cross(P2 - P0);
-    const double twice_area = normal.norm();
-    const double l01 = (P1 - P0).norm();
-    MQ_CHECK(twice_area > 0 && l01 > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
+    const Vector3d P[3] = {row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2))};
+    const double twice_area = (P[1] - P[0]).cross(P[2] - P[0]).norm();
+    MQ_CHECK(twice_area > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
              " has zero area");
-    const Vector3d x = (P1 - P0) / l01;
-    const Vector3d y = normal.cross(x).normalized();
-    const Vector2d p[3] = {Vector2d::Zero(), Vector2d(l01, 0),
-                           Vector2d((P2 - P0).dot(x), (P2 - P0).dot(y))};
-    const double w = 1.0 / std::sqrt(2.0 * twice_area);  // 1 / (2 sqrt(A))
-    for (int j = 0; j < 3; ++j) {
-      const Vector2d e = w * (p[(j + 2) % 3] - p[(j + 1) % 3]);
-      const Vector2d r(-e.y(), e.x());  // rot90(e)
-      const int vj = F(f, j);
-      // Row 2f: u_j e.x + v_j r.x; row 2f+1: u_j e.y + v_j r.y.
-      if (unknown[vj] >= 0) {
-        const int cu = unknown[vj], cv = nu + unknown[vj];
-        triplets.emplace_back(2 * f, cu, e.x());
-        triplets.emplace_back(2 * f, cv, r.x());
-        triplets.emplace_back(2 * f + 1, cu, e.y());
-        triplets.emplace_back(2 * f + 1, cv, r.y());
-      } else {
-        const Vector2d q = pinned_uv(vj);
-        rhs(2 * f) -= q.x() * e.x() + q.y() * r.x();
-        rhs(2 * f + 1) -= q.x() * e.y() + q.y() * r.y();
+    for (int k = 0; k < 3; ++k) {
+      // Edge (i, j) opposite corner k: Dirichlet weight cot(angle at k) / 2 on (u_i - u_j)^2
+      // and (v_i - v_j)^2.
+      const int i = F(f, (k + 1) % 3), j = F(f, (k + 2) % 3);
+      const Vector3d a = P[(k + 1) % 3] - P[k], b = P[(k + 2) % 3] - P[k];
+      const double w = 0.5 * a.dot(b) / twice_area;
+      for (int c = 0; c < 2; ++c) {
+        add(i, c, i, c, 0.5 * w);  // the diagonal is added twice by add
+        add(j, c, j, c, 0.5 * w);
+        add(i, c, j, c, -w);
       }
+    }
+    for (int k = 0; k < 3; ++k) {
+      // -2 x signed area: -(u_i v_j - u_j v_i) per boundary edge i -> j in its face's order.
+      if (!topo.is_boundary(topo.FE(f, k))) continue;
+      const int i = F(f, k), j = F(f, (k + 1) % 3);
+      add(i, 0, j, 1, -0.5);
+      add(j, 0, i, 1, 0.5);
     }
   }
   MatrixX2d UV(n, 2);
   UV.row(pin0) = pinned[0].transpose();
   UV.row(pin1) = pinned[1].transpose();
   if (nu > 0) {
-    Eigen::SparseMatrix<double> A(2 * nf, 2 * nu);
-    A.setFromTriplets(triplets.begin(), triplets.end());
-    const Eigen::SparseMatrix<double> AtA = A.transpose() * A;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(AtA);
+    Eigen::SparseMatrix<double> Q(2 * nu, 2 * nu);
+    Q.setFromTriplets(triplets.begin(), triplets.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(Q);
     MQ_CHECK(solver.info() == Eigen::Success, SolverFailure,
              "lscm: factorisation of the conformal energy failed");
-    const Eigen::VectorXd x = solver.solve(A.transpose() * rhs);
+    const Eigen::VectorXd x = solver.solve(rhs);
     MQ_CHECK(solver.info() == Eigen::Success && x.allFinite(), SolverFailure,
              "lscm: the conformal solve failed");
     for (int v = 0; v < n; ++v)
