@@ -45,6 +45,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("cell_size", s.cell_size)
       .value("iterations", s.iterations)
       .value("patches_shrunk", s.patches_shrunk)
+      .value("patch_faces", s.patch_faces)
       .value("embedding", em.shell_map_failure.empty() ? embedding : std::string("normal"))
       .value("shell_map_failure", em.shell_map_failure)
       .value("stretch_before", em.stretch_before)

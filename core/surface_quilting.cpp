@@ -553,6 +553,7 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
         continue;
       }
       if (patch.shrink_steps > 0) ++stats.patches_shrunk;
+      stats.patch_faces += static_cast<long long>(patch.faces.size());
       frame =
           std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose(), embree);
     }
