@@ -3,7 +3,7 @@
 # for SECONDS (default 12) from a copy of its seed corpus in fuzz/corpus/. Fails on any finding
 # (crash, sanitizer report, leak, a single allocation over 200 MB, an input taking over 5 s);
 # the input is kept in build-fuzz/artifacts/. Longer runs: bash scripts/fuzz.sh 3600 (see
-# fuzz/README.md).
+# fuzz/README.md). FUZZ_TARGETS="obj ply" runs only those targets (for parallel long runs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-12}
@@ -12,7 +12,7 @@ cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWith
 cmake --build build-fuzz -j"$(nproc)" >> build-fuzz.log 2>&1 || { tail -50 build-fuzz.log; exit 1; }
 rm -f build-fuzz.log
 mkdir -p build-fuzz/artifacts
-for target in obj ply off keys field; do
+for target in ${FUZZ_TARGETS:-obj ply off keys field}; do
   work=build-fuzz/corpus-$target
   mkdir -p "$work"
   cp -n fuzz/corpus/$target/* "$work"/ 2>/dev/null || true
