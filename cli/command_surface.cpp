@@ -52,6 +52,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("stretch_after", em.stretch_after)
       .value("stretch_optimization_sweeps", em.optimization_sweeps)
       .value("atlas_charts", em.atlas_charts)
+      .value("shell_smoothing_steps", em.shell_smoothing_steps)
       .value("fold_repaired_vertices", em.fold_repaired_vertices)
       .begin_object("output")
       .value("faces", em.faces)

@@ -104,6 +104,27 @@ MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterat
 
 }  // namespace
 
+MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
+                            int* steps_out) {
+  MQ_CHECK(options.smoothing_iterations >= 0, InvalidInput,
+           "offset surface: smoothing_iterations must be >= 0, got ", options.smoothing_iterations);
+  MQ_CHECK(std::isfinite(options.smoothing_radius) && options.smoothing_radius >= 0, InvalidInput,
+           "offset surface: smoothing_radius must be finite and >= 0, got ",
+           options.smoothing_radius);
+  int steps = options.smoothing_iterations;
+  double edges = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) edges += (V.row(F(f, k)) - V.row(F(f, (k + 1) % 3))).norm();
+  const double mean_edge = F.rows() > 0 ? edges / (3.0 * static_cast<double>(F.rows())) : 0.0;
+  if (mean_edge > 0 && std::isfinite(options.height)) {
+    const double reach = options.smoothing_radius * options.height / mean_edge;
+    // Bounded: past 10^4 steps the reach is far beyond any shell (the base is degenerate).
+    steps = std::max(steps, static_cast<int>(std::ceil(std::min(reach * reach, 1e4))));
+  }
+  if (steps_out) *steps_out = steps;
+  return smoothed_directions(V, F, steps);
+}
+
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
   MQ_CHECK(std::isfinite(options.height) && options.height > 0.0, InvalidInput,
            "offset surface: height must be finite and > 0, got ", options.height);
@@ -120,7 +141,7 @@ OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const Offse
   const Adjacency vv = vertex_adjacency(F, n);
 
   OffsetSurface out;
-  out.directions = smoothed_directions(V, F, options.smoothing_iterations);
+  out.directions = offset_directions(V, F, options, &out.smoothing_steps);
   std::vector<char> used(n, 0);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;

@@ -247,6 +247,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     try {
       map = std::make_unique<ShellMap>(quilt.input_base.V, quilt.input_base.F, map_options);
       stats.atlas_charts = map->atlas().num_charts;
+      stats.shell_smoothing_steps = map->offset().smoothing_steps;
       stats.fold_repaired_vertices = static_cast<int>(map->fold_repair().moved_vertices.size());
     } catch (const TopologyError& e) {
       // No valid shell of this height over this base (a fold that relaxation cannot undo):

@@ -24,6 +24,7 @@ struct QuiltEmbeddingStats {
   double stretch_before = 0, stretch_after = 0;  // Eq. (9), 1.0 the lower bound
   int optimization_sweeps = 0;
   int atlas_charts = 0;
+  int shell_smoothing_steps = 0;  // normal diffusion steps of the offset surface
   int fold_repaired_vertices = 0;
   int removed_intersecting = 0;       // intersecting another element
   int removed_self_intersecting = 0;  // folded through itself, and no repair possible

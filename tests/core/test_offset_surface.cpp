@@ -115,6 +115,40 @@ TEST(OffsetSurface, ConcaveFoldIsLoweredConvexSideIsNot) {
   EXPECT_EQ(num_shrunk(opt, r), 0);
 }
 
+// The smoothing reaches as far over the surface whatever its tessellation: the real bunny and
+// the same surface split 1-to-4 twice get nearly the same directions at the bunny's own
+// vertices, where a fixed count of steps (smoothing_radius 0) reaches a quarter as far on the
+// finer one and leaves its directions much closer to the raw normals (a 1M-face base split that
+// way had no valid shell with the fixed count).
+TEST(OffsetSurface, SmoothingDoesNotDependOnTheTessellation) {
+  const TriMesh coarse = read_mesh(test::shared_data("base/bunny_igl_7k.off"));
+  const TriMesh fine = test::midpoint_split(test::midpoint_split(coarse));
+  OffsetOptions opt;
+  opt.height = 0.04 * test::bbox_diagonal(coarse);
+  opt.smoothing_iterations = 0;  // the radius alone sets the steps
+  int coarse_steps = 0, fine_steps = 0;
+  const MatrixX3d Dc = offset_directions(coarse.V, coarse.F, opt, &coarse_steps);
+  const MatrixX3d Df = offset_directions(fine.V, fine.F, opt, &fine_steps);
+  EXPECT_GE(coarse_steps, 4);
+  EXPECT_NEAR(fine_steps, 16 * coarse_steps, 0.2 * fine_steps);  // edges a quarter as long (ceil)
+  OffsetOptions fixed = opt;
+  fixed.smoothing_radius = 0;
+  fixed.smoothing_iterations = coarse_steps;
+  const MatrixX3d Dfixed = offset_directions(fine.V, fine.F, fixed);
+  double scaled = 0, unscaled = 0;
+  const int n = coarse.num_vertices();
+  for (int i = 0; i < n; ++i) {
+    scaled += std::acos(std::clamp(Dc.row(i).dot(Df.row(i)), -1.0, 1.0));
+    unscaled += std::acos(std::clamp(Dc.row(i).dot(Dfixed.row(i)), -1.0, 1.0));
+  }
+  scaled *= 180 / M_PI / n;
+  unscaled *= 180 / M_PI / n;
+  std::printf("mean angle to the coarse directions: %.2f deg scaled, %.2f deg fixed steps\n",
+              scaled, unscaled);
+  EXPECT_LT(scaled, 3.0);  // measured 1.3 degrees
+  EXPECT_LT(scaled, 0.25 * unscaled);  // measured 12.6
+}
+
 TEST(OffsetSurface, IndependentOfThreadCount) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
   OffsetOptions opt;
