@@ -146,9 +146,11 @@ bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
 
 // Shared implementation: when label is given, only pairs with different labels are tested, or
 // with same_label only pairs with the same label.
+// active (optional, #F): only pairs with at least one active face are tested.
 std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i& F,
                                             const std::vector<int>* label, bool stop_at_first,
-                                            bool same_label = false) {
+                                            bool same_label = false,
+                                            const std::vector<char>* active = nullptr) {
   const int nf = static_cast<int>(F.rows());
   std::vector<std::pair<int, int>> result;
   if (nf == 0) return result;
@@ -216,10 +218,12 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   }
 
   // Narrow phase per face f against later faces g; a pair is tested only in the cell holding
-  // the min corner of the intersection of the two boxes, so it is tested once.
+  // the min corner of the intersection of the two boxes, so it is tested once. With an active
+  // set, a pair is tested by its active face (the first, if both are).
   std::vector<std::vector<int>> hits(nf);
   tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
     for (int f = r.begin(); f != r.end(); ++f) {
+      if (active && !(*active)[f]) continue;
       std::array<int, 3> c0, c1;
       cell_range(f, c0, c1);
       for (int k = c0[2]; k <= c1[2]; ++k)
@@ -228,7 +232,7 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
             const int c = cell_index(i, j, k);
             for (int m = offsets[c]; m < offsets[c + 1]; ++m) {
               const int g = members[m];
-              if (g <= f) continue;
+              if (g == f || (g < f && (!active || (*active)[g]))) continue;
               if (label && ((*label)[f] == (*label)[g]) != same_label) continue;
               bool overlap = true, home = true;
               for (int a = 0; a < 3 && overlap; ++a) {
@@ -244,9 +248,10 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     }
   });
   for (int f = 0; f < nf; ++f) {
-    for (int g : hits[f]) result.emplace_back(f, g);
+    for (int g : hits[f]) result.emplace_back(std::min(f, g), std::max(f, g));
     if (stop_at_first && !result.empty()) break;
   }
+  if (active) std::sort(result.begin(), result.end());
   return result;
 }
 
@@ -284,6 +289,14 @@ std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, con
   std::vector<int> component;
   connected_components(F, static_cast<int>(V.rows()), component);
   return find_pairs(V, F, &component, false);
+}
+
+std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
+                                                                  const MatrixX3i& F,
+                                                                  const std::vector<char>& active) {
+  MQ_CHECK(static_cast<Eigen::Index>(active.size()) == F.rows(), InvalidInput,
+           "intersection test: ", active.size(), " active flags for ", F.rows(), " faces");
+  return find_pairs(V, F, nullptr, false, false, &active);
 }
 
 std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {

@@ -32,6 +32,13 @@ struct IntersectionOptions {
 std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
                                                          const IntersectionOptions& options = {});
 
+// The pairs of intersecting_face_pairs with between_components_only = false that hold at least
+// one face with active[f] != 0 (#F flags), at a cost in proportion to the active faces' share
+// of the narrow phase: for re-testing after a few faces moved. Same order and throws.
+std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
+                                                                  const MatrixX3i& F,
+                                                                  const std::vector<char>& active);
+
 // The vertex-connected components (elements, numbered as connected_components numbers them)
 // that intersect themselves: two of their faces overlap beyond a shared vertex or edge (a
 // fold, a tube pressed through itself). Ascending. Throws like intersecting_face_pairs.

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <random>
 
 #include "core/errors.h"
 #include "core/mesh_intersections.h"
@@ -57,6 +58,33 @@ TEST(MeshIntersections, MeshesIntersectAgreesWithTheFullPairTest) {
   }
   EXPECT_GT(hits, 0);
   EXPECT_GT(misses, 0);  // the placements reach beyond the torus: both answers are exercised
+}
+
+// The re-test after some faces moved: exactly the full test's pairs that hold an active face,
+// for masks from none to all (both orders of a pair with one active face are reached).
+TEST(MeshIntersections, PairsTouchingActiveFacesAreTheFullTestsFiltered) {
+  const TriMesh a = test::torus(2.0, 0.4, 32, 10);
+  TriMesh both = a;
+  for (int i = 1; i <= 3; ++i) {
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(0.5 * i, Vector3d(1, 0.3, 0.1).normalized()).toRotationMatrix();
+    append_mesh(both, transformed(a, R, Vector3d(0.4 * i, 0.1 * i, 0.05 * i)));
+  }
+  IntersectionOptions all;
+  all.between_components_only = false;
+  const auto full = intersecting_face_pairs(both.V, both.F, all);
+  ASSERT_GT(full.size(), 100u);
+  std::mt19937 rng(3);
+  for (const double share : {0.0, 0.01, 0.2, 0.7, 1.0}) {
+    std::vector<char> active(static_cast<size_t>(both.F.rows()));
+    for (char& x : active) x = std::uniform_real_distribution<double>(0, 1)(rng) < share;
+    std::vector<std::pair<int, int>> expected;
+    for (const auto& [f, g] : full)
+      if (active[f] || active[g]) expected.emplace_back(f, g);
+    EXPECT_EQ(intersecting_face_pairs_touching(both.V, both.F, active), expected) << share;
+  }
+  EXPECT_THROW(intersecting_face_pairs_touching(both.V, both.F, std::vector<char>(3, 1)),
+               InvalidInput);
 }
 
 TEST(MeshIntersections, LinkedToriDoNotIntersectOverlappingDo) {
