@@ -113,10 +113,7 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
            "offset surface: smoothing_radius must be finite and >= 0, got ",
            options.smoothing_radius);
   int steps = options.smoothing_iterations;
-  double edges = 0;
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) edges += (V.row(F(f, k)) - V.row(F(f, (k + 1) % 3))).norm();
-  const double mean_edge = F.rows() > 0 ? edges / (3.0 * static_cast<double>(F.rows())) : 0.0;
+  const double mean_edge = mean_edge_length(V, F);
   if (mean_edge > 0 && std::isfinite(options.height)) {
     const double reach = options.smoothing_radius * options.height / mean_edge;
     // Bounded: past 10^4 steps the reach is far beyond any shell (the base is degenerate).
@@ -129,8 +126,6 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
   MQ_CHECK(std::isfinite(options.height) && options.height > 0.0, InvalidInput,
            "offset surface: height must be finite and > 0, got ", options.height);
-  MQ_CHECK(options.smoothing_iterations >= 0, InvalidInput,
-           "offset surface: smoothing_iterations must be >= 0, got ", options.smoothing_iterations);
   MQ_CHECK(options.min_fraction > 0.0 && options.min_fraction <= 1.0, InvalidInput,
            "offset surface: min_fraction must lie in (0, 1], got ", options.min_fraction);
   MQ_CHECK(options.max_rounds >= 1, InvalidInput, "offset surface: max_rounds must be >= 1");

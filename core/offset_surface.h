@@ -11,7 +11,7 @@ namespace mq {
 
 struct OffsetOptions {
   double height = 0.0;            // shell height w (> 0), e.g. a few % of the bbox diagonal
-  int smoothing_iterations = 10;  // Laplacian diffusion steps of the vertex normals (>= 0), at least
+  int smoothing_iterations = 10;  // least Laplacian diffusion steps of the vertex normals (>= 0)
   // Diffusion reach in heights (>= 0): on a base whose mean edge e is short against the height,
   // the steps are raised to ceil((smoothing_radius * height / e)^2), since k steps of diffusion
   // reach about sqrt(k) edges. A finer tessellation of the same surface then gets the same

@@ -97,7 +97,7 @@ struct SurfaceQuiltingStats {
   int duplicate_faces = 0;  // base faces that repeated another, removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
   int patches_shrunk = 0;
-  long long patch_faces = 0;  // faces of every local patch flattened, summed (per-patch cost)
+  long long patch_faces = 0;  // faces of every local patch used (after shrinking), summed
   double swatch_scale = 0;  // factor applied to the swatch
   double shell_height = 0;
   double cell_size = 0;
