@@ -91,7 +91,7 @@ int linking_number(const Loop& a, const Loop& b) {
   return crossings;
 }
 
-std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int bins) {
+std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, int bins) {
   MQ_CHECK(bins >= 8, InvalidInput, "a centre loop needs at least 8 bins, got ", bins);
   if (F.rows() == 0 || V.rows() == 0) return std::nullopt;
   const EdgeTopology topo = edge_topology(F, static_cast<int>(V.rows()));
@@ -135,23 +135,45 @@ std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int
   // A coarse ring (16 cross sections) leaves some of 32 bins empty: halve the bins until each
   // holds a vertex. Each loop point is then the mean of whole cross sections, which stays
   // inside the tube as long as the ring has at least 8 of them.
+  RingBins out;
+  out.of_vertex.assign(static_cast<size_t>(V.rows()), -1);
   for (int n = bins; n >= 8; n /= 2) {
-    std::vector<Vector3d> sum(n, Vector3d::Zero());
     std::vector<int> count(n, 0);
     for (Eigen::Index v = 0; v < V.rows(); ++v) {
       if (!used[v]) continue;
       double turn = (angle[v] - start) / (2 * M_PI) + 0.5 / n;
       turn -= std::floor(turn);
       const int k = std::clamp(static_cast<int>(std::floor(turn * n)), 0, n - 1);
-      sum[k] += V.row(v).transpose();
+      out.of_vertex[static_cast<size_t>(v)] = k;
       ++count[k];
     }
     if (std::find(count.begin(), count.end(), 0) != count.end()) continue;
-    Loop loop(n);
-    for (int k = 0; k < n; ++k) loop[k] = sum[k] / count[k];
-    return loop;
+    out.count = n;
+    return out;
   }
   return std::nullopt;
+}
+
+Loop loop_from_bins(const MatrixX3d& V, const RingBins& bins) {
+  MQ_CHECK(static_cast<Eigen::Index>(bins.of_vertex.size()) == V.rows(), InvalidInput,
+           "loop_from_bins: ", bins.of_vertex.size(), " bins for ", V.rows(), " vertices");
+  std::vector<Vector3d> sum(static_cast<size_t>(bins.count), Vector3d::Zero());
+  std::vector<int> count(static_cast<size_t>(bins.count), 0);
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const int k = bins.of_vertex[static_cast<size_t>(v)];
+    if (k < 0) continue;
+    sum[k] += V.row(v).transpose();
+    ++count[k];
+  }
+  Loop loop(static_cast<size_t>(bins.count));
+  for (int k = 0; k < bins.count; ++k) loop[k] = sum[k] / std::max(count[k], 1);
+  return loop;
+}
+
+std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int bins) {
+  const std::optional<RingBins> b = ring_loop_bins(V, F, bins);
+  if (!b) return std::nullopt;
+  return loop_from_bins(V, *b);
 }
 
 }  // namespace mq

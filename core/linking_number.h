@@ -36,4 +36,17 @@ double gauss_linking_integral(const Loop& a, const Loop& b);
 // or even 8 bins leave one empty (the element does not surround its mean point).
 std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int bins = 32);
 
+// The binning behind ring_centre_loop, kept to follow a ring as it moves or bends: the loop
+// point each vertex belongs to (-1 for a vertex no face uses), and the number of points.
+struct RingBins {
+  int count = 0;
+  std::vector<int> of_vertex;  // #V
+};
+// Nothing when ring_centre_loop would return nothing. Same arguments and throws.
+std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, int bins = 32);
+// The centre loop of positions V binned by `bins` (found on these or on other positions of
+// the same vertices: a ring's flat shape bins its bent copies). Throws InvalidInput when the
+// sizes differ.
+Loop loop_from_bins(const MatrixX3d& V, const RingBins& bins);
+
 }  // namespace mq
