@@ -84,6 +84,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("tiled", global->tiled)
         .value("orbits", global->orbits)
         .value("singular_vertices", global->singular_vertices)
+        .value("cancelled_cone_pairs", global->cancelled_cone_pairs)
         .value("pinned_cones", global->pinned_cones)
         .value("cut_edges", global->cut_edges)
         .value("cut_paths", global->cut_paths)

@@ -20,7 +20,8 @@ struct GlobalQuiltingStats {
   bool seamless = false;      // cones pinned and transitions fixed at the texture's symmetries
   bool tiled = false;         // the plane texture is the lattice tiling (else a planar quilt)
   int orbits = 0;             // elements per lattice cell, when tiled
-  int singular_vertices = 0;  // of the line field
+  int singular_vertices = 0;  // of the line field, after cancelling adjacent pairs
+  int cancelled_cone_pairs = 0;
   int pinned_cones = 0;
   int cut_edges = 0, cut_paths = 0;
   // Largest distance of a transition from the texture's nearest symmetry, in lattice periods

@@ -268,4 +268,41 @@ DirectionField smooth_direction_field(const MatrixX3d& V, const MatrixX3i& F,
   return direction_field_matching(V, F, topo, direction, N);
 }
 
+int cancel_singular_pairs(const MatrixX3d& V, const MatrixX3i& F, const EdgeTopology& topo,
+                          DirectionField& field) {
+  const int N = field.N;
+  const int ne = topo.num_edges();
+  if (N < 2) return 0;
+  const FaceFrames fr = face_frames(V, F);
+  const double unit = kTwoPi / N;
+  // The sign with which the smooth rotation across e enters the rotation sum around each of
+  // its ends (direction_field_matching: each end's fan counts it once, the two ends opposite).
+  std::vector<int> sign_at_first(static_cast<size_t>(ne), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int e = topo.FE(f, (c + 2) % 3);
+      if (!interior(topo, e)) continue;
+      if (F(f, c) != topo.E(e, 0)) continue;
+      sign_at_first[e] = topo.edge_faces.begin(e)[0] == f ? 1 : -1;
+    }
+  int cancelled = 0;
+  for (int e = 0; e < ne; ++e) {
+    if (!interior(topo, e) || sign_at_first[e] == 0) continue;
+    const int a = topo.E(e, 0), b = topo.E(e, 1);
+    const int ia = field.index[a], ib = field.index[b];
+    if (ia == 0 || ia != -ib) continue;
+    // Rotation across e changed by -ia units at a (and +ia at b): both indices become 0.
+    const long shift = -static_cast<long>(ia) * sign_at_first[e];
+    const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
+    const double raw = angle_of(field.direction.row(g).transpose(), fr, g) -
+                       (angle_of(field.direction.row(f).transpose(), fr, f) +
+                        transport(V, topo, fr, e));
+    const long k = std::lround(raw / unit) - shift;
+    field.matching[e] = static_cast<int>(((k % N) + N) % N);
+    field.index[a] = field.index[b] = 0;
+    ++cancelled;
+  }
+  return cancelled;
+}
+
 }  // namespace mq

@@ -67,4 +67,13 @@ DirectionField direction_field_matching(const MatrixX3d& V, const MatrixX3i& F,
                                         const EdgeTopology& topo, const MatrixX3d& direction,
                                         int N);
 
+// Cancels singularities of opposite index at the two ends of one edge (a + and a - half-turn
+// cone side by side: on a coarse base, the tip of a thin spike and its foot). The field is
+// unchanged; the edge's matching takes the other turn, so that the rotation across it is no
+// longer the smallest but both ends are regular: no cone and no cut where a texture element
+// is larger than the spike. Returns the pairs cancelled. field: from direction_field_matching
+// or smooth_direction_field on (V, F, topo).
+int cancel_singular_pairs(const MatrixX3d& V, const MatrixX3i& F, const EdgeTopology& topo,
+                          DirectionField& field);
+
 }  // namespace mq

@@ -84,6 +84,8 @@ struct SurfaceQuiltingOptions {
     double smoothing = 1.0;
     // Pin the cones and fix the transitions at the texture's symmetries (periodic swatches).
     bool seamless = true;
+    // Cancel + and - cones at the two ends of one edge (cancel_singular_pairs).
+    bool cancel_cone_pairs = true;
     // A periodic swatch of compact elements is tiled over the parameter plane (the planar
     // quilt it would give); else the plane is quilted.
     bool tile = true;

@@ -77,5 +77,50 @@ TEST(LineField, MatchingOfAGivenFieldIsFoundAgain) {
   EXPECT_THROW(direction_field_matching(fx.mesh.V, fx.mesh.F, fx.topo, d, 5), InvalidInput);
 }
 
+// A + and a - half-turn cone at the two ends of one edge of a flat grid (the field turns
+// half as fast as the angle about the one and against the angle about the other): the pair is
+// cancelled, the directions stay, and only that edge's matching changes.
+TEST(LineField, AdjacentOppositeConesCancel) {
+  const Fixture fx(test::plane_grid(2, 2, 10, 10));
+  const int p = 5 * 11 + 5, q = p + 1;  // the middle vertex and its neighbour along x
+  const Vector3d cp = fx.mesh.V.row(p).transpose(), cq = fx.mesh.V.row(q).transpose();
+  MatrixX3d d(fx.mesh.num_faces(), 3);
+  for (int f = 0; f < fx.mesh.num_faces(); ++f) {
+    Vector3d c = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) c += fx.mesh.V.row(fx.mesh.F(f, k)).transpose() / 3;
+    const double theta =
+        0.5 * std::atan2(c.y() - cp.y(), c.x() - cp.x()) - 0.5 * std::atan2(c.y() - cq.y(), c.x() - cq.x());
+    d.row(f) << std::cos(theta), std::sin(theta), 0;
+  }
+  DirectionField f = direction_field_matching(fx.mesh.V, fx.mesh.F, fx.topo, d, 2);
+  ASSERT_EQ(f.index[p], 1);
+  ASSERT_EQ(f.index[q], -1);
+  int singular = 0;
+  for (const int i : f.index) singular += i != 0;
+  ASSERT_EQ(singular, 2);
+  const DirectionField before = f;
+  EXPECT_EQ(cancel_singular_pairs(fx.mesh.V, fx.mesh.F, fx.topo, f), 1);
+  for (const int i : f.index) EXPECT_EQ(i, 0);
+  EXPECT_EQ(f.direction, before.direction);
+  int changed = 0;
+  for (int e = 0; e < fx.topo.num_edges(); ++e)
+    if (f.matching[e] != before.matching[e]) {
+      ++changed;
+      EXPECT_TRUE((fx.topo.E(e, 0) == p && fx.topo.E(e, 1) == q) ||
+                  (fx.topo.E(e, 0) == q && fx.topo.E(e, 1) == p));
+    }
+  EXPECT_EQ(changed, 1);
+  // Nothing left to cancel; a field without pairs is unchanged.
+  EXPECT_EQ(cancel_singular_pairs(fx.mesh.V, fx.mesh.F, fx.topo, f), 0);
+}
+
+// The sphere's four cones are far apart: none cancelled.
+TEST(LineField, DistantConesStay) {
+  const Fixture sphere(test::icosphere(4));
+  DirectionField f = sphere.field(smooth_tangent_field(sphere.mesh.V, sphere.mesh.F), 2, 1e-3);
+  EXPECT_EQ(cancel_singular_pairs(sphere.mesh.V, sphere.mesh.F, sphere.topo, f), 0);
+  EXPECT_EQ(index_sum(f), 4);
+}
+
 }  // namespace
 }  // namespace mq
