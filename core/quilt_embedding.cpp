@@ -1,15 +1,20 @@
 #include "core/quilt_embedding.h"
 
+#include <tbb/parallel_for.h>
+
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <vector>
 
+#include "core/closest_point_query.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
+#include "core/ring_separation.h"
 #include "core/shell_embedding.h"
 #include "core/shell_map.h"
 #include "core/surface_coverage.h"
@@ -202,6 +207,40 @@ int shrink_to_fit(const SurfaceQuilt& quilt, const std::vector<char>& folded, Ma
   return restored;
 }
 
+// Rings that separation took farther from the base than the shell (or than they already were,
+// where the map left them farther) are put back: the texture stays in its shell. Distances
+// from every vertex of a moved ring (exact closest points on the base). Restores those rings'
+// rows of V from `before` and clears their `moved` flags; returns how many.
+int keep_in_shell(const SurfaceQuilt& quilt, const std::vector<Eigen::Index>& first,
+                  const MatrixX3d& before, MatrixX3d& V, std::vector<char>& moved) {
+  if (std::find(moved.begin(), moved.end(), 1) == moved.end()) return 0;
+  const ClosestPointQuery base(quilt.input_base.V, quilt.input_base.F);
+  const auto farthest = [&](const MatrixX3d& X, size_t k, double within) {
+    double d = 0;
+    for (Eigen::Index v = first[k]; v < first[k + 1]; ++v) {
+      const ClosestPointHit hit = base.closest(Vector3d(X.row(v).transpose()), within);
+      if (hit.face < 0) return std::numeric_limits<double>::infinity();
+      d = std::max(d, hit.distance);
+    }
+    return d;
+  };
+  std::vector<char> back(moved.size(), 0);
+  tbb::parallel_for(size_t{0}, moved.size(), [&](size_t k) {
+    if (!moved[k]) return;
+    const double limit = std::max(quilt.shell_height, farthest(before, k, std::numeric_limits<double>::infinity()));
+    back[k] = farthest(V, k, limit) > limit;
+  });
+  int count = 0;
+  for (size_t k = 0; k < moved.size(); ++k)
+    if (back[k]) {
+      V.middleRows(first[k], first[k + 1] - first[k]) =
+          before.middleRows(first[k], first[k + 1] - first[k]);
+      moved[k] = 0;
+      ++count;
+    }
+  return count;
+}
+
 }  // namespace
 
 TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
@@ -356,10 +395,57 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), folded_now);
   }
 
+  // Rings pressed into each other are moved apart whole, links kept (core/ring_separation);
+  // what still touches is left to the post-processing. Armor job: interior rings with the
+  // swatch's 4 links 84.2 -> 91.3%, rings removed 122 -> 32.
+  if (options.remove_intersecting && options.separate_rings && have_pairs) {
+    ScopedStageTimer timer(stats.times, "ring separation");
+    ScopedStageProgress shown(progress, "ring separation");
+    const size_t ne = quilt.elements.size();
+    std::vector<char> touching(ne, 0), folded_now(ne, 0);
+    for (const auto& [f, g] : pairs) {
+      if (element_of[f] == element_of[g]) folded_now[static_cast<size_t>(element_of[f])] = 1;
+      else touching[static_cast<size_t>(element_of[f])] = touching[static_cast<size_t>(element_of[g])] = 1;
+    }
+    for (size_t k = 0; k < ne; ++k) touching[k] = touching[k] && !folded_now[k];
+    if (std::find(touching.begin(), touching.end(), 1) != touching.end()) {
+      const std::vector<Eigen::Index> first = vertex_offsets(quilt);
+      const ElementGrid grid(all.V, first, std::vector<char>(ne, 0));
+      std::vector<char> near(ne, 0);
+      for (size_t k = 0; k < ne; ++k)
+        if (touching[k]) {
+          near[k] = 1;
+          for (const int j : grid.near(grid.box[k])) near[static_cast<size_t>(j)] = 1;
+        }
+      // Each ring binned on its flat shape (a ring the map bent keeps its cross sections).
+      std::vector<std::optional<RingBins>> bins(ne), link_bins(ne);
+      tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
+        if (!near[k] || folded_now[k]) return;
+        const SurfaceElement& e = quilt.elements[k];
+        const Eigen::Index ev = static_cast<Eigen::Index>(e.face.size());
+        const MatrixX3d placed = all.V.middleRows(first[k], ev);
+        link_bins[k] = ring_loop_bins(placed, e.F);
+        if (!link_bins[k]) return;
+        bins[k] = e.flat.rows() == ev ? ring_loop_bins(e.flat, e.F) : link_bins[k];
+      });
+      const MatrixX3d before = all.V;
+      RingSeparationStats sep;
+      std::vector<char> moved =
+          separate_rings(all.V, first, bins, link_bins, touching, {}, &sep);
+      stats.separation_left_shell = keep_in_shell(quilt, first, before, all.V, moved);
+      sep.moved -= stats.separation_left_shell;
+      stats.separated_rings = sep.moved;
+      stats.separation_reverted = sep.reverted;
+      stats.separation_iterations = sep.iterations;
+      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), moved);
+    }
+  }
+
   // Post-processing (issue 13: no folded element reaches the output): an element that
   // intersects itself goes; of intersecting elements as few as can go (greedy_vertex_cover), and
-  // those are tried again smaller (shrink_to_fit). Over the knight (armor job) this keeps 4 links
-  // on 80.4% of interior rings where dropping the later of each pair kept 78.0%.
+  // those are tried again smaller (shrink_to_fit). Over the knight (armor job, before ring
+  // separation) this kept 4 links on 80.4% of interior rings where dropping the later of each
+  // pair kept 78.0%; after separation 32 rings are left to remove instead of 122.
   std::vector<char> drop(quilt.elements.size(), 0), folded(quilt.elements.size(), 0);
   if (options.remove_intersecting && !known_disjoint) {
     ScopedStageTimer timer(stats.times, "element removal");

@@ -17,6 +17,8 @@ struct QuiltEmbeddingOptions {
   bool remove_intersecting = true;  // post-processing
   // Before removing an element that touches a neighbour, try it at 95%, 90%, 85% of its size.
   bool shrink_to_fit = true;
+  // Before removing rings that touch each other, move them apart whole (core/ring_separation).
+  bool separate_rings = true;
   std::uint64_t seed = 1;
 };
 
@@ -30,6 +32,10 @@ struct QuiltEmbeddingStats {
   int removed_self_intersecting = 0;  // folded through itself, and no repair possible
   int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
   int shrunk_to_fit = 0;              // elements kept at 85-95% of their size instead of removed
+  int separated_rings = 0;            // rings moved apart from those they touched
+  int separation_reverted = 0;        // moved, then put back: a link would have changed
+  int separation_left_shell = 0;      // moved, then put back: it left the shell
+  int separation_iterations = 0;
   // Elements mapped through the shell map as it was before stretch optimisation, because the
   // optimised map made them intersect another element.
   int unoptimized_elements = 0;
