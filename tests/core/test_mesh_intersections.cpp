@@ -87,6 +87,36 @@ TEST(MeshIntersections, PairsTouchingActiveFacesAreTheFullTestsFiltered) {
                InvalidInput);
 }
 
+// The grid's broad phase (float boxes rounded outward, each pair tested in one cell) misses no
+// pair and reports none twice: the same pairs as testing every pair of faces, for tori placed
+// every which way through each other and at scales where float rounding matters.
+TEST(MeshIntersections, PairsAreThoseOfTestingEveryPair) {
+  for (const double scale : {1.0, 1e-4, 3e5}) {
+    const TriMesh a = test::torus(2.0, 0.4, 24, 8);
+    TriMesh both = a;
+    for (int i = 1; i <= 3; ++i) {
+      const Eigen::Matrix3d R =
+          Eigen::AngleAxisd(0.9 * i, Vector3d(0.2, 1, 0.4).normalized()).toRotationMatrix();
+      append_mesh(both, transformed(a, R, Vector3d(0.7 * i, -0.3 * i, 0.2 * i)));
+    }
+    both.V *= scale;
+    both.V.array() += 7.0 * scale;  // away from the origin, where floats are coarser
+    std::vector<int> part;
+    connected_components(both.F, both.num_vertices(), part);
+    std::vector<std::pair<int, int>> expected;
+    const auto P = [&](int f, int k) -> Vector3d { return both.V.row(both.F(f, k)).transpose(); };
+    for (int f = 0; f < both.num_faces(); ++f)
+      for (int g = f + 1; g < both.num_faces(); ++g)
+        if (part[f] != part[g] &&
+            triangles_intersect(P(f, 0), P(f, 1), P(f, 2), P(g, 0), P(g, 1), P(g, 2)))
+          expected.emplace_back(f, g);
+    ASSERT_GT(expected.size(), 50u) << scale;
+    IntersectionOptions between;
+    between.between_components_only = true;
+    EXPECT_EQ(intersecting_face_pairs(both.V, both.F, between), expected) << scale;
+  }
+}
+
 TEST(MeshIntersections, LinkedToriDoNotIntersectOverlappingDo) {
   const TriMesh a = test::torus(2.0, 0.4, 48, 12);
   // A chain link: rotated into the xz plane and shifted by R along x, through a's hole.
