@@ -303,6 +303,8 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // up to date as elements move (updated_pairs): one full pass instead of three.
   std::vector<std::pair<int, int>> pairs;
   bool have_pairs = false;
+  // Elements moved since `pairs` was found (their pairs are out of date until updated_pairs).
+  std::vector<char> stale(quilt.elements.size(), 0);
   if (map) {
     // The unoptimised map creates no intersections where the base is concave (the shell is
     // valid and elements lie in it apart); the optimised one bends its tetrahedra a little, and
@@ -336,19 +338,18 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       pairs = all_face_pairs(all.V, all.F);
       // Nothing to revert: post-processing would find the same nothing.
       known_disjoint = pairs.empty();
-      std::vector<char> revert(quilt.elements.size(), 0);
       for (const auto& [f, g] : pairs)
-        revert[static_cast<size_t>(element_of[f])] = revert[static_cast<size_t>(element_of[g])] = 1;
+        stale[static_cast<size_t>(element_of[f])] = stale[static_cast<size_t>(element_of[g])] = 1;
       Eigen::Index v0 = 0;
       for (size_t k = 0; k < quilt.elements.size(); ++k) {
         const Eigen::Index ev = static_cast<Eigen::Index>(quilt.elements[k].face.size());
-        if (revert[k]) {
+        if (stale[k]) {
           all.V.middleRows(v0, ev) = unoptimized.middleRows(v0, ev);
           ++stats.unoptimized_elements;
         }
         v0 += ev;
       }
-      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), revert);
+      // Their pairs are found again after the fold repair, which moves some of them too.
       have_pairs = true;
     }
   } else {
@@ -368,35 +369,50 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       pairs = all_face_pairs(all.V, all.F);
       have_pairs = true;
     }
-    std::vector<char> folded_now(quilt.elements.size(), 0);
+    const size_t ne = quilt.elements.size();
+    const std::vector<Eigen::Index> first = vertex_offsets(quilt);
+    // Folded: a pair within the element, or for an element moved since the pairs were found
+    // (kept on the unoptimised map), its own test.
+    std::vector<char> folded_now(ne, 0);
     for (const auto& [f, g] : pairs)
-      if (element_of[f] == element_of[g]) folded_now[static_cast<size_t>(element_of[f])] = 1;
-    Eigen::Index v0 = 0;
-    for (size_t k = 0; k < quilt.elements.size(); ++k) {
+      if (element_of[f] == element_of[g] && !stale[static_cast<size_t>(element_of[f])])
+        folded_now[static_cast<size_t>(element_of[f])] = 1;
+    tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
+      if (stale[k])
+        folded_now[k] = !self_intersecting_components(
+                             MatrixX3d(all.V.middleRows(first[k], first[k + 1] - first[k])),
+                             quilt.elements[k].F)
+                             .empty();
+    });
+    tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
       const SurfaceElement& e = quilt.elements[k];
-      const Eigen::Index ev = static_cast<Eigen::Index>(e.face.size());
-      if (folded_now[k] && e.flat.rows() == ev) {
-        // As little rigidity as removes the fold: the mapped shape blended towards the fitted
-        // flat one, the first blend without a self-intersection (the flat shape has none).
-        const MatrixX3d placed = all.V.middleRows(v0, ev);
-        const MatrixX3d rigid = similarity_fit(e.flat, placed);
-        MatrixX3d best = rigid;
-        for (const double keep : {0.75, 0.5, 0.25}) {
-          const MatrixX3d blend = keep * placed + (1 - keep) * rigid;
-          if (self_intersecting_components(blend, e.F).empty()) {
-            best = blend;
-            break;
-          }
-        }
-        all.V.middleRows(v0, ev) = best;
-        ++stats.rigid_repairs;
-      } else {
+      const Eigen::Index v0 = first[k], ev = first[k + 1] - first[k];
+      if (!folded_now[k] || e.flat.rows() != ev) {
         folded_now[k] = 0;  // left as it is
+        return;
       }
-      v0 += ev;
+      // As little rigidity as removes the fold: the mapped shape blended towards the fitted
+      // flat one, the first blend without a self-intersection (the flat shape has none).
+      const MatrixX3d placed = all.V.middleRows(v0, ev);
+      const MatrixX3d rigid = similarity_fit(e.flat, placed);
+      MatrixX3d best = rigid;
+      for (const double keep : {0.75, 0.5, 0.25}) {
+        const MatrixX3d blend = keep * placed + (1 - keep) * rigid;
+        if (self_intersecting_components(blend, e.F).empty()) {
+          best = blend;
+          break;
+        }
+      }
+      all.V.middleRows(v0, ev) = best;
+    });
+    for (size_t k = 0; k < ne; ++k) {
+      stats.rigid_repairs += folded_now[k];
+      stale[k] = stale[k] || folded_now[k];
     }
-    if (have_pairs)
-      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), folded_now);
+    if (have_pairs) {
+      pairs = updated_pairs(quilt, all.V, all.F, element_of, std::move(pairs), stale);
+      std::fill(stale.begin(), stale.end(), 0);
+    }
   }
 
   // Rings pressed into each other are moved apart whole, links kept (core/ring_separation);

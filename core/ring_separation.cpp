@@ -311,10 +311,13 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
   std::vector<Loop> start_tubes(nt);
   for (size_t i = 0; i < nt; ++i) start_tubes[i] = tubes[i].loop;
   std::vector<std::vector<Contact>> contacts(pairs.size());
+  // Rings that moved in the last iteration: only their pairs' contacts can have changed.
+  std::vector<char> stepped(nt, 1);
   const auto find_contacts = [&] {
     tbb::parallel_for(size_t{0}, pairs.size(), [&](size_t p) {
-      tube_contacts(tubes[pairs[p].first], tubes[pairs[p].second], options.clearance,
-                    contacts[p]);
+      if (stepped[pairs[p].first] || stepped[pairs[p].second])
+        tube_contacts(tubes[pairs[p].first], tubes[pairs[p].second], options.clearance,
+                      contacts[p]);
     });
     int overlapping = 0;
     for (const auto& c : contacts) overlapping += !c.empty();
@@ -356,6 +359,7 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
         }
       }
     }
+    std::fill(stepped.begin(), stepped.end(), 0);
     tbb::parallel_for(size_t{0}, nt, [&](size_t i) {
       if (!free[i] || count[i] == 0) return;
       touched[i] = 1;
@@ -384,6 +388,7 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
         turn *= 0.5;
         R = rotation_of(turn);
       }
+      stepped[i] = 1;
       for (Vector3d& p : t.loop) p = t.centre + step + R * (p - t.centre);
       t.rotation = (R * t.rotation).eval();
       t.translation = R * (t.translation - t.centre) + t.centre + step;
