@@ -41,6 +41,9 @@ $mq render "$work/bunny_link.obj" --color links --base $data/bunny_igl_7k.off \
   -o docs/bunny_link.png --quiet
 $mq render "$work/armor.obj" --color links --base $data/knight_decimated_1k.off \
   -o docs/armor_links.png --quiet
+# One ring's scale: under one of the knight's arms, where it meets the body (a cone there).
+$mq render "$work/armor.obj" --color links --crop 0.39 0.65 0.49 0.07 --azimuth 0 --elevation 20 \
+  -o docs/armor_shoulder_crop.png --width 640 --height 480 --quiet
 $mq render "$work/cup_weave.obj" --base $data/cup_mug_11k.off --azimuth 120 --elevation 60 \
   -o docs/cup_weave.png --quiet
 
