@@ -9,25 +9,11 @@
 #include <unordered_map>
 
 #include "core/errors.h"
+#include "core/union_find.h"
 
 namespace mq {
 
 namespace {
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(static_cast<size_t>(n)) {
-    std::iota(parent.begin(), parent.end(), 0);
-  }
-  int find(int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  }
-  void unite(int a, int b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
 
 int corner_of(const MatrixX3i& F, int f, int v) {
   for (int k = 0; k < 3; ++k)

@@ -16,7 +16,7 @@ double orient(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vec
   return (b - a).dot((c - a).cross(d - a));
 }
 
-int sign(double x) { return (x > 0) - (x < 0); }
+int sign_of(double x) { return (x > 0) - (x < 0); }
 
 Vector3d mean_point(const Loop& a) {
   Vector3d c = Vector3d::Zero();
@@ -49,7 +49,7 @@ double gauss_linking_integral(const Loop& a, const Loop& b) {
       for (int k = 0; k < 4; ++k)
         omega += std::asin(std::clamp(n[k].dot(n[(k + 1) % 4]), -1.0, 1.0));
       const double s = (p4 - p3).cross(p2 - p1).dot(r13);
-      total += omega * sign(s);
+      total += omega * sign_of(s);
     }
   }
   // Signed as linking_number counts: b passing along the normal of a's right-handed disk.
@@ -76,7 +76,7 @@ int linking_number(const Loop& a, const Loop& b) {
       const double hp = orient(c, a0, a1, p), hq = orient(c, a0, a1, q);
       if ((hp > 0 && hq > 0) || (hp < 0 && hq < 0)) continue;  // same side of the plane
       const double g = orient(p, q, a0, a1);
-      const int s0 = sign(e[k]), s1 = sign(g), s2 = sign(-e[k + 1]);
+      const int s0 = sign_of(e[k]), s1 = sign_of(g), s2 = sign_of(-e[k + 1]);
       // Two edge signs that disagree: the segment's line misses the triangle.
       if (s0 * s1 < 0 || s1 * s2 < 0 || s0 * s2 < 0) continue;
       if (hp == 0 || hq == 0 || s0 == 0 || s1 == 0 || s2 == 0) {

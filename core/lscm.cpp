@@ -14,9 +14,9 @@
 namespace mq {
 namespace {
 
-Vector3d row3(const MatrixX3d& V, int i) { return V.row(i).transpose(); }
+Vector3d vertex_row(const MatrixX3d& V, int i) { return V.row(i).transpose(); }
 
-void check_indices(const MatrixX3i& F, Eigen::Index n) {
+void check_patch_indices(const MatrixX3i& F, Eigen::Index n) {
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       MQ_CHECK(F(f, k) >= 0 && F(f, k) < n, InvalidInput, "face ", f, " has vertex index ", F(f, k),
@@ -126,7 +126,7 @@ std::optional<MatrixX2d> developable_unfolding(const MatrixX3d& V, const MatrixX
   const double tolerance = 1e-9 * extent;
   MatrixX2d UV = MatrixX2d::Zero(n, 2);
   std::vector<char> placed(n, 0), reached(nf, 0);
-  const auto length = [&](int a, int b) { return (row3(V, a) - row3(V, b)).norm(); };
+  const auto length = [&](int a, int b) { return (vertex_row(V, a) - vertex_row(V, b)).norm(); };
   // c to the left of a -> b at its 3D distances from a and b; false if the face is degenerate.
   const auto place = [&](int a, int b, int c, Vector2d& out) {
     const Vector2d pa = UV.row(a).transpose(), pb = UV.row(b).transpose();
@@ -187,7 +187,7 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   const int n = static_cast<int>(V.rows());
   const int nf = static_cast<int>(F.rows());
   MQ_CHECK(nf > 0, InvalidInput, "lscm: the patch has no faces");
-  check_indices(F, n);
+  check_patch_indices(F, n);
   MQ_CHECK(V.allFinite(), InvalidInput, "lscm: non-finite vertex position");
   std::vector<char> used(n, 0);
   for (int f = 0; f < nf; ++f) {
@@ -205,14 +205,14 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
     int best = boundary[0];
     double best_d = -1;
     for (int v : boundary) {
-      const double d = (row3(V, v) - row3(V, from)).squaredNorm();
+      const double d = (vertex_row(V, v) - vertex_row(V, from)).squaredNorm();
       if (d > best_d) best_d = d, best = v;
     }
     return best;
   };
   const int pin1 = farthest(boundary[0]);
   const int pin0 = farthest(pin1);
-  const double pin_distance = (row3(V, pin1) - row3(V, pin0)).norm();
+  const double pin_distance = (vertex_row(V, pin1) - vertex_row(V, pin0)).norm();
   MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
 
   // Total 3D area, summed in face order (the scale both paths below are normalised to).
@@ -262,7 +262,7 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
     }
   };
   for (int f = 0; f < nf; ++f) {
-    const Vector3d P[3] = {row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2))};
+    const Vector3d P[3] = {vertex_row(V, F(f, 0)), vertex_row(V, F(f, 1)), vertex_row(V, F(f, 2))};
     const double twice_area = (P[1] - P[0]).cross(P[2] - P[0]).norm();
     MQ_CHECK(twice_area > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
              " has zero area");
@@ -308,11 +308,11 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
 Eigen::VectorXd face_area_distortion(const MatrixX3d& V, const MatrixX3i& F, const MatrixX2d& UV) {
   MQ_CHECK(V.rows() == UV.rows(), InvalidInput, "face_area_distortion: ", V.rows(),
            " vertices but ", UV.rows(), " UV rows");
-  check_indices(F, V.rows());
+  check_patch_indices(F, V.rows());
   Eigen::VectorXd d(F.rows());
   for (int f = 0; f < F.rows(); ++f) {
-    const Vector3d P0 = row3(V, F(f, 0));
-    const double a3 = 0.5 * (row3(V, F(f, 1)) - P0).cross(row3(V, F(f, 2)) - P0).norm();
+    const Vector3d P0 = vertex_row(V, F(f, 0));
+    const double a3 = 0.5 * (vertex_row(V, F(f, 1)) - P0).cross(vertex_row(V, F(f, 2)) - P0).norm();
     const Vector2d ab = (UV.row(F(f, 1)) - UV.row(F(f, 0))).transpose();
     const Vector2d ac = (UV.row(F(f, 2)) - UV.row(F(f, 0))).transpose();
     const double a2 = 0.5 * std::abs(ab.x() * ac.y() - ab.y() * ac.x());
@@ -323,7 +323,7 @@ Eigen::VectorXd face_area_distortion(const MatrixX3d& V, const MatrixX3i& F, con
 }
 
 int count_flipped(const MatrixX3i& F, const MatrixX2d& UV) {
-  check_indices(F, UV.rows());
+  check_patch_indices(F, UV.rows());
   int flipped = 0;
   for (int f = 0; f < F.rows(); ++f) {
     const Vector2d ab = (UV.row(F(f, 1)) - UV.row(F(f, 0))).transpose();

@@ -9,6 +9,9 @@
 
 namespace mq {
 
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr double kTwoPi = 6.283185307179586476925286766559;
+
 // Row-major so that rows are contiguous xyz triples: they go to Embree and OpenCL unchanged.
 using MatrixX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using MatrixX3i = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;

@@ -6,6 +6,7 @@
 
 #include "core/element_kinds.h"
 #include "core/errors.h"
+#include "core/union_find.h"
 
 namespace mq {
 
@@ -45,20 +46,6 @@ void check_indices(const MatrixX3i& F, int num_vertices) {
       MQ_CHECK(F(f, k) >= 0 && F(f, k) < num_vertices, InvalidInput, "face ", f,
                " references vertex ", F(f, k), " but the mesh has ", num_vertices, " vertices");
 }
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
 
 }  // namespace
 

@@ -8,44 +8,11 @@
 #include <unordered_map>
 
 #include "core/errors.h"
+#include "core/segment_distance.h"
 
 namespace mq {
 
 namespace {
-
-// Closest points of segments p0-p1 and q0-q1 (Ericson, Real-Time Collision Detection, 5.1.9):
-// parameters s, t in [0, 1].
-void closest_on_segments(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0,
-                         const Vector3d& q1, double& s, double& t) {
-  const Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  const double tiny = 1e-300;
-  if (a <= tiny && e <= tiny) {
-    s = t = 0;
-    return;
-  }
-  if (a <= tiny) {
-    s = 0;
-    t = std::clamp(f / e, 0.0, 1.0);
-    return;
-  }
-  const double c = d1.dot(r);
-  if (e <= tiny) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-    return;
-  }
-  const double b = d1.dot(d2), denom = a * e - b * b;
-  s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-  t = (b * s + f) / e;
-  if (t < 0) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1) {
-    t = 1;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-}
 
 // A ring as the solver sees it: its centre loop, the tube's radius per loop segment, and its
 // rigid motion so far (x = rotation * x0 + translation).
@@ -66,13 +33,6 @@ struct Tube {
     box.max.array() += r;
   }
 };
-
-double point_segment_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b) {
-  const Vector3d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
-}
 
 Tube make_tube(const MatrixX3d& V, Eigen::Index v0, Eigen::Index v1, const RingBins& bins) {
   Tube t;
@@ -143,7 +103,7 @@ void tube_contacts(const Tube& a, const Tube& b, double clearance, std::vector<C
           (p0.cwiseMin(p1).array() > hi.array()).any())
         continue;
       double s = 0, t = 0;
-      closest_on_segments(p0, p1, q0, q1, s, t);
+      closest_points_on_segments(p0, p1, q0, q1, s, t);
       const Vector3d pa = p0 + s * (p1 - p0), pb = q0 + t * (q1 - q0);
       const double d = (pa - pb).norm();
       const double depth = need - d;

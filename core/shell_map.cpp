@@ -16,8 +16,6 @@ namespace mq {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 // SplitMix64 finaliser: decorrelates (seed, sweep, vertex) before seeding mt19937_64.
 std::uint64_t mix(std::uint64_t x) {

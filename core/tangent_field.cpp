@@ -21,7 +21,7 @@ constexpr double kParallel = 1e-6;
 
 Vector3d row3(const MatrixX3d& M, Eigen::Index i) { return M.row(i).transpose(); }
 
-Vector3d project(const Vector3d& t, const Vector3d& n) { return t - t.dot(n) * n; }
+Vector3d tangent_part(const Vector3d& t, const Vector3d& n) { return t - t.dot(n) * n; }
 
 void check_mesh(const MatrixX3d& V, const MatrixX3i& F) {
   MQ_CHECK(V.allFinite(), InvalidInput, "tangent field: non-finite vertex position");
@@ -42,7 +42,7 @@ std::vector<int> axes_by_extent(const MatrixX3d& V, const MatrixX3i& F) {
 // Projection of the longest bounding-box axis usable on a face with unit normal n.
 Vector3d axis_fallback(const std::vector<int>& axes, const Vector3d& n) {
   for (int a : axes) {
-    const Vector3d t = project(Vector3d::Unit(a), n);
+    const Vector3d t = tangent_part(Vector3d::Unit(a), n);
     if (t.norm() > 0.1) return t.normalized();  // some axis has |n.e|^2 <= 1/3
   }
   return Vector3d::Unit(axes[0]);  // zero normal: any unit vector is orthogonal to it
@@ -70,7 +70,7 @@ void fill_undefined(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N, 
       for (int k = 0; k < 3; ++k) {
         const int v = F(f, k);
         for (const int* g = vf.begin(v); g != vf.end(v); ++g)
-          if (defined[*g] == 1) sum += project(row3(T, *g), n);
+          if (defined[*g] == 1) sum += tangent_part(row3(T, *g), n);
       }
       if (sum.norm() > kParallel) {
         newly.push_back(f);
@@ -101,7 +101,7 @@ MatrixX3d finish_field(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& 
   MatrixX3d T(nf, 3);
   std::vector<char> defined(nf, 0);
   for (int f = 0; f < nf; ++f) {
-    const Vector3d t = project(row3(raw, f), row3(N, f));
+    const Vector3d t = tangent_part(row3(raw, f), row3(N, f));
     const double len = t.norm();
     if (len > kParallel * scale) {
       T.row(f) = (t / len).transpose();
@@ -210,7 +210,7 @@ MatrixX3d interpolated_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
              ": direction must be finite and non-zero");
     MQ_CHECK(key_of[key.vertex] < 0, InvalidInput, "key vector ", i, ": vertex ", key.vertex,
              " already has a key");
-    const Vector3d t = project(key.direction.normalized(), row3(VN, key.vertex));
+    const Vector3d t = tangent_part(key.direction.normalized(), row3(VN, key.vertex));
     MQ_CHECK(t.norm() > kParallel, InvalidInput, "key vector ", i, ": direction at vertex ",
              key.vertex, " is parallel to the surface normal");
     key_of[key.vertex] = static_cast<int>(i);
@@ -353,7 +353,7 @@ MatrixX3d vertex_field_from_key_vectors(const MatrixX3d& V, const MatrixX3i& F,
   const MatrixX3d fallback = vertex_tangent_field(V, F, face_field_from_raw_vertex(V, F, X));
   MatrixX3d out(V.rows(), 3);
   for (int v = 0; v < V.rows(); ++v) {
-    const Vector3d t = project(row3(X, v), row3(VN, v));
+    const Vector3d t = tangent_part(row3(X, v), row3(VN, v));
     out.row(v) = (t.norm() > kParallel ? Vector3d(t / t.norm()) : row3(fallback, v)).transpose();
   }
   return out;
@@ -384,7 +384,7 @@ MatrixX3d smooth_tangent_field(const MatrixX3d& V, const MatrixX3i& F, int itera
       Vector3d sum = row3(T, f);
       for (int k = 0; k < 3; ++k)
         if (TT(f, k) >= 0) sum += row3(T, TT(f, k));
-      const Vector3d t = project(sum, n);
+      const Vector3d t = tangent_part(sum, n);
       next.row(f) = (t.norm() > kParallel ? Vector3d(t / t.norm()) : row3(T, f)).transpose();
     }
     T.swap(next);
@@ -412,8 +412,8 @@ MatrixX3d vertex_tangent_field(const MatrixX3d& V, const MatrixX3i& F,
   for (int v = 0; v < n; ++v) {
     if (largest[v] < 0) continue;
     const Vector3d nv = row3(VN, v);
-    Vector3d t = project(row3(sum, v), nv);
-    if (t.norm() <= kParallel) t = project(row3(face_field, largest[v]), nv);
+    Vector3d t = tangent_part(row3(sum, v), nv);
+    if (t.norm() <= kParallel) t = tangent_part(row3(face_field, largest[v]), nv);
     if (t.norm() <= kParallel) t = axis_fallback({0, 1, 2}, nv);
     out.row(v) = t.normalized().transpose();
   }

@@ -12,7 +12,6 @@ namespace mq {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Eq. (8) for one tet, closed form; mirrored operation for operation in kernels/tet_stretch.cl.
 // J = S Tt^-1 = S adj(Tt) / det(Tt), with S and Tt holding the edges from corner 0 as columns.

@@ -15,6 +15,7 @@
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
 #include "core/quilt_elements.h"
+#include "core/segment_distance.h"
 
 namespace mq {
 
@@ -67,13 +68,6 @@ class HashGrid3 {
   double cell_;
   std::unordered_map<unsigned long long, std::vector<int>> cells_;
 };
-
-double point_segment_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b) {
-  const Vector3d d = b - a;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * d - p).norm();
-}
 
 // Vertex graph distances from `source` over the element's edges (Dijkstra).
 std::vector<double> graph_distances(const MatrixX3d& V, const Adjacency& adj, int source) {

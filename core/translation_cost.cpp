@@ -17,7 +17,6 @@ namespace mq {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Eq. (1) for one point-face pair, given the squared distance. Kept in one place (and mirrored
 // in kernels/translation_cost.cl) so that every path evaluates it identically.

@@ -2,11 +2,20 @@
 #pragma once
 
 #include <functional>
+#include <random>
 #include <string>
 
 #include "core/mesh.h"
 
 namespace mq::test {
+
+// Uniform doubles from a 64-bit generator (its top 53 bits): in [0, 1), and in [lo, hi).
+inline double uniform01(std::mt19937_64& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+inline double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * uniform01(rng);
+}
 
 // Absolute path of a file in ../shared/data (e.g. "base/bunny_igl_7k.off").
 std::string shared_data(const std::string& relative);

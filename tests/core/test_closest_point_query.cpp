@@ -14,13 +14,10 @@
 namespace mq {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Uniform in [0, 1) from the raw engine output (portable across standard libraries).
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * uniform01(rng);
-}
+using test::uniform;
+using test::uniform01;
 
 Vector3d random_unit(std::mt19937_64& rng) {
   for (;;) {

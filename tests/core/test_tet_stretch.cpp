@@ -10,13 +10,12 @@
 #include "core/shell_tetrahedra.h"
 #include "core/tet_stretch.h"
 #include "tests/core/shell_fixtures.h"
+#include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53;
-}
+using test::uniform;
 
 // The shell of a small icosphere: a fixture with tets of many shapes.
 StretchProblem sphere_shell_identity() {

@@ -15,9 +15,7 @@ namespace mq {
 namespace {
 
 // Uniform in [lo, hi) from the raw engine output (portable across standard libraries).
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53;
-}
+using test::uniform;
 
 // Reference Eq. (2) for one query point: the minimum over every face.
 double min_face_cost_reference(const MatrixX3d& V, const MatrixX3i& F, const Vector3d& q,

@@ -12,13 +12,12 @@
 #include "host/tet_stretch_evaluator.h"
 #include "host/tet_stretch_opencl.h"
 #include "tests/core/shell_fixtures.h"
+#include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53;
-}
+using test::uniform;
 
 // The bunny's shell at 2% of its diagonal, built once.
 const StretchProblem& bunny_shell() {

@@ -16,9 +16,7 @@
 namespace mq {
 namespace {
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53;
-}
+using test::uniform;
 
 // A sub-patch made of the swatch's own vertices (every stride-th one), moved by shift and
 // optionally jittered by `noise` (positions) and 0.1 * noise / h (normals); offsets form a
