@@ -14,9 +14,12 @@ if [ "${MESHQUILT_SKIP_BLENDER:-0}" != 1 ]; then
 fi
 if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   # -O1 with line tables only: sanitizer reports keep file:line, and the build takes far less
-  # time than -O2 -g (CI has 30 minutes for everything).
+  # time than -O2 -g (CI has 30 minutes for everything). A unity build (8 sources per
+  # compilation): 339 s instead of 504 s on 2 cores; the Release build above compiles every
+  # source on its own, so a missing include still fails there.
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
-        -DMESHQUILT_SANITIZE=ON -DMESHQUILT_BUILD_BENCH=OFF -DMESHQUILT_BUILD_SLOW_TESTS=OFF
+        -DMESHQUILT_SANITIZE=ON -DMESHQUILT_BUILD_BENCH=OFF -DMESHQUILT_BUILD_SLOW_TESTS=OFF \
+        -DCMAKE_UNITY_BUILD=ON
   cmake --build build-asan -j"$jobs"
   # PoCL's compiler and the ICD loader keep allocations alive past exit; leaks are not checked.
   # Left out under the sanitizers (they run in Release above): the brute-force references on
