@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """How the cost of a local patch grows with the base's resolution (issue 14's 1M-face base).
 
+A base of over 200,000 faces is simplified first (the `surface` default); with --no-proxy every
+base is used as given, to see what the tessellation alone costs.
+
 The shared 70k-face Stanford bunny is split 1-to-4 once and twice (the same surface with 278k
 and 1.1M faces) and each is covered with the sample apples at the same scale through local
 patches (`surface --method patches --embedding normal`, so that the shell map's whole-base cost
@@ -68,6 +71,7 @@ def main():
     ap.add_argument("--levels", type=int, nargs="+", default=[0, 1, 2])
     ap.add_argument("--meshquilt", default=os.path.join(ROOT, "build", "meshquilt"))
     ap.add_argument("--out")
+    ap.add_argument("--no-proxy", action="store_true", help="keep every base as given")
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -83,13 +87,16 @@ def main():
                     stats = os.path.join(tmp, "stats.json")
                     subprocess.run([args.meshquilt, "surface", "--base", base, "--swatch", swatch,
                                     "--method", "patches", "--embedding", "normal", "--quiet",
-                                    "-o", os.path.join(tmp, "out.ply"), "--stats", stats],
+                                    "-o", os.path.join(tmp, "out.ply"), "--stats", stats] +
+                                   (["--no-proxy"] if args.no_proxy else []),
                                    check=True)
                     with open(stats) as f:
                         runs.append(json.load(f))
                 s = runs[0]
                 param = statistics.median(r["stage_seconds"]["parameterization"] for r in runs)
                 row = {
+                    "input_faces": len(F),
+                    "proxy_faces": s.get("proxy_faces", 0),
                     "base_faces": s["base_faces"],
                     "patches": s["iterations"],
                     "faces_per_patch": s["patch_faces"] / max(1, s["iterations"]),
@@ -101,9 +108,11 @@ def main():
                     "runs": args.runs,
                 }
                 rows.append(row)
-                print("%9d faces: %4d patches of %7.0f faces, parameterisation %7.2f s "
-                      "(%6.1f ms a patch, %.2f us a patch face), wall %.1f s, %d elements" % (
-                          row["base_faces"], row["patches"], row["faces_per_patch"], param,
+                print("%9d faces (proxy %d, refined %d): %4d patches of %7.0f faces, "
+                      "parameterisation %7.2f s (%6.1f ms a patch, %.2f us a patch face), "
+                      "wall %.1f s, %d elements" % (
+                          row["input_faces"], row["proxy_faces"], row["base_faces"],
+                          row["patches"], row["faces_per_patch"], param,
                           row["ms_per_patch"], row["us_per_patch_face"], row["wall_seconds"],
                           row["elements"]), flush=True)
             V, F = split_1_to_4(V, F)

@@ -40,6 +40,8 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("welded_vertices", s.welded_vertices)
       .value("duplicate_faces", s.duplicate_faces)
       .value("flipped_components", s.flipped_components)
+      .value("proxy_faces", s.proxy_faces)
+      .value("proxy_error", s.proxy_error)
       .value("swatch_scale", s.swatch_scale)
       .value("shell_height", s.shell_height)
       .value("cell_size", s.cell_size)
@@ -133,6 +135,9 @@ int run_surface(int argc, char** argv, int first) {
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
   cl.flag("keep-orientation",
           "grow the texture along the base's normals as given, even where they face inward");
+  cl.flag("no-proxy",
+          "use a base of over 200,000 faces as given (by default it is first simplified to the "
+          "texture's scale, within 5% of the shell height)");
   cl.option("method", "auto|global|patches",
             "global: one field-aligned parameterisation, seamless for a periodic swatch (keeps "
             "chain mail linked); patches: local conformal patches (the paper's); auto: global "
@@ -159,6 +164,7 @@ int run_surface(int argc, char** argv, int first) {
   options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
   options.patch.deform = !cl.has("no-deform");
   options.orient_outward = !cl.has("keep-orientation");
+  if (cl.has("no-proxy")) options.proxy_min_faces = 0;
   QuiltEmbeddingOptions embedding;
   const std::string embedding_name = cl.get("embedding");
   if (embedding_name != "shell" && embedding_name != "normal")
@@ -242,6 +248,10 @@ int run_surface(int argc, char** argv, int first) {
       std::printf("base: %d components faced inward and were turned outward "
                   "(--keep-orientation keeps them)\n",
                   stats.flipped_components);
+    if (stats.proxy_faces > 0)
+      std::printf("base: simplified to %d faces, within %.3g of the surface given "
+                  "(--no-proxy keeps it)\n",
+                  stats.proxy_faces, stats.proxy_error);
     if (!embedding_stats.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
                   embedding_stats.shell_map_failure.c_str());

@@ -459,12 +459,9 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
     }
   }
   if (used_global) *used_global = false;
-  const StageTimes choice = stats.times;
-  SurfaceQuilt quilt = quilt_surface(base_in, swatch_mesh, options, evaluator, stats_out, progress);
-  if (stats_out)
-    for (const auto& [stage, seconds] : choice.stages())
-      if (stage != "prepare") stats_out->times.add(stage, seconds);
-  return quilt;
+  // The job prepared once (a large base is simplified in the preparation).
+  return quilt_prepared_surface(std::move(job), std::move(stats), options, evaluator, stats_out,
+                                progress);
 }
 
 }  // namespace mq

@@ -16,6 +16,7 @@
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/planar_quilting.h"
+#include "core/quadric_simplification.h"
 #include "core/quilt_elements.h"
 #include "core/tangent_field.h"
 #include "core/weld_vertices.h"
@@ -404,6 +405,10 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
            options.base_edge_fraction);
   MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", options.scale);
+  MQ_CHECK(options.proxy_min_faces >= 0 && std::isfinite(options.proxy_error) &&
+               options.proxy_error >= 0,
+           InvalidInput, "the base simplification needs a face count >= 0 and an error >= 0, got ",
+           options.proxy_min_faces, " and ", options.proxy_error);
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
            "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
            " base faces");
@@ -419,10 +424,9 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   if (options.orient_outward) stats.flipped_components = orient_outward(job.cleaned);
   // The output estimated before any work: the swatch's faces per unit of footprint area at its
   // scale on the surface, over the base's area (issue 14: --scale 1e-6 ran out of memory).
+  Vector3d e = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
+  std::sort(e.data(), e.data() + 3);
   {
-    const BoundingBox sb = bounding_box(swatch_mesh.V, swatch_mesh.F);
-    Vector3d e = sb.extent();
-    std::sort(e.data(), e.data() + 3);
     // The refined base below has the same bounding box, so this is the scale used throughout.
     job.swatch_scale = swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
     const double k = job.swatch_scale;
@@ -437,9 +441,25 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
   // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
   const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-  job.base =
-      bisect_longest_edges(job.cleaned, options.scale * diagonal * options.base_edge_fraction,
-                           2'000'000, &job.refinement);
+  const double max_edge = options.scale * diagonal * options.base_edge_fraction;
+  // A base far finer than the texture costs the patches and the shell map in proportion to
+  // its faces, not to its surface (issue 14: 354 s for a 1.1M-face bunny that is the 70k one
+  // split twice): simplified to the refinement's edge length within a twentieth of the shell
+  // height, the texture lies on a surface no farther from the one given than that.
+  if (options.proxy_min_faces > 0 && job.cleaned.num_faces() > options.proxy_min_faces) {
+    QuadricSimplificationOptions so;
+    so.max_error = options.proxy_error * e(0) * job.swatch_scale;
+    so.max_edge_length = max_edge;
+    QuadricSimplification proxy = simplify_by_quadrics(job.cleaned, so);
+    if (proxy.mesh.num_faces() < job.cleaned.num_faces()) {
+      for (int& f : proxy.origin_face) f = input_face[static_cast<size_t>(f)];
+      input_face = std::move(proxy.origin_face);
+      job.cleaned = std::move(proxy.mesh);
+      stats.proxy_faces = job.cleaned.num_faces();
+      stats.proxy_error = proxy.max_error;
+    }
+  }
+  job.base = bisect_longest_edges(job.cleaned, max_edge, 2'000'000, &job.refinement);
   stats.base_faces = job.base.num_faces();
   // The field is per input face.
   if (options.field.rows()) {
@@ -464,8 +484,16 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
                            TranslationCostEvaluator& evaluator, SurfaceQuiltingStats* stats_out,
                            ProgressSink* progress) {
   SurfaceQuiltingStats stats;
-  StageTimes& times = stats.times;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
+  return quilt_prepared_surface(std::move(job), std::move(stats), options, evaluator, stats_out,
+                                progress);
+}
+
+SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
+                                    const SurfaceQuiltingOptions& options,
+                                    TranslationCostEvaluator& evaluator,
+                                    SurfaceQuiltingStats* stats_out, ProgressSink* progress) {
+  StageTimes& times = stats.times;
   TriMesh& cleaned = job.cleaned;
   const TriMesh& base = job.base;
   Refinement& refinement = job.refinement;

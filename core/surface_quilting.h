@@ -35,7 +35,7 @@ struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
   TriMesh base;           // the (refined) base mesh the local coordinates refer to
-  TriMesh input_base;     // the base as given, coincident vertices welded
+  TriMesh input_base;     // the base as given, coincident vertices welded (or its proxy)
   Refinement refinement;  // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
 };
@@ -74,6 +74,12 @@ struct SurfaceQuiltingOptions {
   double max_faces = 2e7;
   // Turn base components whose faces point inward to face outward (orient_outward) first.
   bool orient_outward = true;
+  // A base of more faces than this is simplified first (simplify_by_quadrics, issue 14): to
+  // edges no longer than the refinement's (base_edge_fraction of the swatch's side), within
+  // proxy_error shell heights of the surface given. The texture is then laid over that proxy.
+  // 0: never.
+  int proxy_min_faces = 200'000;
+  double proxy_error = 0.05;
   // The global-parameterisation method (core/global_quilting).
   struct Global {
     // Weight of the guidance field against the line field's smoothness: small lets the
@@ -98,6 +104,8 @@ struct SurfaceQuiltingStats {
   int welded_vertices = 0;  // base vertices merged with another at the same position
   int duplicate_faces = 0;  // base faces that repeated another, removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
+  int proxy_faces = 0;          // faces of the simplified base (0: the base was not simplified)
+  double proxy_error = 0;       // the simplification's largest quadric error (mesh units)
   int patches_shrunk = 0;
   long long patch_faces = 0;  // faces of every local patch used (after shrinking), summed
   double swatch_scale = 0;  // factor applied to the swatch
@@ -114,7 +122,7 @@ struct SurfaceQuiltingStats {
 // vertices welded and refined, the guidance field on the refined faces (the smooth default when
 // none is given), the swatch scaled to its size on the surface.
 struct SurfaceJob {
-  TriMesh cleaned;        // the base as given, coincident vertices welded
+  TriMesh cleaned;        // the base as given, coincident vertices welded (or its proxy)
   TriMesh base;           // cleaned, refined by longest-edge bisection
   Refinement refinement;  // base faces in cleaned faces
   MatrixX3d field;        // #F(base) by 3 unit tangents
@@ -144,6 +152,14 @@ SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
                            const SurfaceQuiltingOptions& options,
                            TranslationCostEvaluator& evaluator,
                            SurfaceQuiltingStats* stats = nullptr, ProgressSink* progress = nullptr);
+
+// quilt_surface on a job prepare_surface_job made with the same options (`stats`: the figures
+// and times so far), for a caller that has prepared it already. Throws like quilt_surface.
+SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
+                                    const SurfaceQuiltingOptions& options,
+                                    TranslationCostEvaluator& evaluator,
+                                    SurfaceQuiltingStats* stats_out = nullptr,
+                                    ProgressSink* progress = nullptr);
 
 // 3D positions of local coordinates by plain normal displacement: the base point plus height
 // times the interpolated unit vertex normal.
