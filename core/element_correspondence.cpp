@@ -68,6 +68,9 @@ Correspondences find_correspondences(const std::vector<Element>& output,
     const int o = candidates[i];
     const Element& e = output[o];
     auto& pairs = per_element[i];
+    // The previous vertex's face starts each search (a hint: it changes no minimum, and the
+    // vertices of an element are visited in order, so ties resolve the same way every run).
+    int hint = -1;
     for (int v = 0; v < e.V.rows(); ++v) {
       const Vector3d p = e.V.row(v).transpose();
       if (!region.contains(p)) continue;
@@ -79,8 +82,9 @@ Correspondences find_correspondences(const std::vector<Element>& output,
       // geometry matching, so pairs rank faces exactly as the matched cost did).
       const Vector3d q = p - t;
       int entry = -1;
-      swatch_faces.min_face_cost(q, n, options.lambda, &entry, max_distance);
+      swatch_faces.min_face_cost(q, n, options.lambda, &entry, max_distance, hint);
       if (entry < 0) continue;
+      hint = entry;
       if (n.dot(swatch_faces.entry_normal(entry)) < options.min_normal_dot) continue;
       const SwatchFaceTree::FacePoint closest = swatch_faces.entry_closest_point(entry, q);
       const int face = swatch_faces.entry_faces()[static_cast<size_t>(entry)];

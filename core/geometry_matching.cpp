@@ -85,9 +85,11 @@ struct Assignment {
 };
 
 // E(t) of Eq. (3) on the points P (normals NP), recording the assignment. Points in parallel;
-// the sum in point order (deterministic).
+// the sum in point order (deterministic). hints (optional): an earlier assignment of the same
+// points at a nearby t, whose entries start each search (see SwatchFaceTree::min_face_cost).
 double assigned_cost(const SwatchFaceTree& swatch, const MatrixX3d& P, const MatrixX3d& NP,
-                     const Vector3d& t, double lambda, Assignment& assignment) {
+                     const Vector3d& t, double lambda, Assignment& assignment,
+                     const Assignment* hints = nullptr) {
   const Eigen::Index n = P.rows();
   assignment.entry.assign(static_cast<size_t>(n), -1);
   assignment.normal_factor.assign(static_cast<size_t>(n), 0.0);
@@ -96,8 +98,9 @@ double assigned_cost(const SwatchFaceTree& swatch, const MatrixX3d& P, const Mat
       tbb::blocked_range<Eigen::Index>(0, n, 16), [&](const tbb::blocked_range<Eigen::Index>& r) {
         for (Eigen::Index i = r.begin(); i != r.end(); ++i) {
           const size_t k = static_cast<size_t>(i);
-          minima[k] = swatch.min_face_cost(P.row(i).transpose() - t, NP.row(i).transpose(), lambda,
-                                           &assignment.entry[k]);
+          minima[k] =
+              swatch.min_face_cost(P.row(i).transpose() - t, NP.row(i).transpose(), lambda,
+                                   &assignment.entry[k], kInf, hints ? hints->entry[k] : -1);
           if (assignment.entry[k] >= 0)
             assignment.normal_factor[k] =
                 swatch.entry_normal_factor(assignment.entry[k], NP.row(i).transpose());
@@ -183,7 +186,8 @@ RefinedOffset refine_offset(const SwatchFaceTree& swatch, const MatrixX3d& P, co
     if (u == t) break;
     const double moved_by = (u - t).cwiseAbs().maxCoeff();
     first_step = std::min(0.5 * cell_size, std::max(2.0 * moved_by, options.refine_to * cell_size));
-    const double moved = assigned_cost(swatch, P, NP, u, options.lambda, next_assignment);
+    const double moved =
+        assigned_cost(swatch, P, NP, u, options.lambda, next_assignment, &assignment);
     ++result.evaluations;
     if (!(moved < cost * (1 - 1e-9))) break;
     const bool converged = moved > cost * (1 - options.refine_tolerance);
@@ -218,19 +222,15 @@ OffsetChoice choose_offset(const SwatchFaceTree& swatch, TranslationCostEvaluato
       candidates.rows() > options.screen_keep && P.rows() > options.screen_points) {
     strided_subset(P, NP, options.screen_points, problem.points, problem.point_normals);
     problem.offsets = candidates;
-    const Eigen::VectorXd screen = evaluator.evaluate(swatch, problem);
-    choice.evaluations += static_cast<int>(screen.size());
-    choice.point_offsets += static_cast<long long>(screen.size()) * problem.points.rows();
-    std::vector<int> order(static_cast<size_t>(screen.size()));
-    for (int i = 0; i < screen.size(); ++i) order[static_cast<size_t>(i)] = i;
-    // Ties go to the lower index, so the finalists do not depend on the sort's internals.
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return screen(a) < screen(b); });
-    order.resize(static_cast<size_t>(options.screen_keep));
-    std::sort(order.begin(), order.end());  // candidate order, so ties resolve as without it
-    finalists.resize(options.screen_keep, 3);
-    for (int i = 0; i < options.screen_keep; ++i)
-      finalists.row(i) = candidates.row(order[static_cast<size_t>(i)]);
+    // Ties go to the lower index, and the finalists stay in candidate order, so ties among
+    // them resolve as without screening.
+    const TranslationCostEvaluator::LeastCostOffsets screened =
+        evaluator.least_cost_offsets(swatch, problem, options.screen_keep);
+    choice.evaluations += static_cast<int>(candidates.rows());
+    choice.point_offsets += screened.point_offsets;
+    finalists.resize(static_cast<Eigen::Index>(screened.kept.size()), 3);
+    for (size_t i = 0; i < screened.kept.size(); ++i)
+      finalists.row(static_cast<Eigen::Index>(i)) = candidates.row(screened.kept[i]);
   }
   // The finalists are scored on the points the refinement polishes with: the offset it returns
   // minimises that subset's cost, so the start is chosen by the same measure. Without

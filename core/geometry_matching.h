@@ -36,8 +36,9 @@ struct MatchingOptions {
   Eigen::Index refine_points = 128;
   // Screening: when there are more than screen_keep candidates and more than screen_points
   // sub-patch points, every candidate is first scored on an evenly strided subset of
-  // screen_points points and only the screen_keep best are scored on more (the refinement's
-  // points, or all of them without refinement) (0 disables).
+  // screen_points points (the CPU path stops summing a candidate once it cannot be among the
+  // best: TranslationCostCpu::least_cost_offsets) and only the screen_keep best are scored on
+  // more (the refinement's points, or all of them without refinement) (0 disables).
   // A few dozen points rank whole-cell offsets almost as the full set does, at a fraction of
   // the cost; the final choice is still made with the exact cost over all points. Measured
   // against scoring every candidate on every point: with 32 screening points and 3 finalists

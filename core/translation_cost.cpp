@@ -214,7 +214,7 @@ double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& 
 }
 
 double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
-                                     int* entry, double max_distance) const {
+                                     int* entry, double max_distance, int hint) const {
   if (entry) *entry = -1;
   MQ_ASSERT(max_distance >= 0);
   const double slack = slack_;
@@ -241,6 +241,16 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
       reach2 = std::min(cap2, reach * reach * (1.0 + 1e-12));
     }
   };
+  if (hint >= 0) {
+    MQ_ASSERT(hint < num_faces());
+    const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(hint)]);
+    if (dist2 <= max_dist2) {
+      // entry_cost's arithmetic, so that the leaf scan meeting the hint again cannot improve it.
+      best = (1.0 + lambda * std::sqrt(dist2)) * entry_normal_factor(hint, n);
+      if (entry) *entry = hint;
+      update_reach();
+    }
+  }
   int stack[kMaxDepth + 2];
   double stack_d2[kMaxDepth + 2];
   int sp = 0;
@@ -292,10 +302,15 @@ double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, doubl
           if (dn2 >= r2) continue;
           const int j = b0 + k;
           const double nfac = 1.0 + std::sqrt(dn2);
+          // The entry can beat best only if its distance (at least |q - centre| - radius, less
+          // the slack) stays below reach = (best / nfac - 1) / lambda, and within the cap.
+          // Compared squared with a margin, so no square root: a skip is only ever taken when
+          // the cost bound really is >= best (the minimum and its entry are unchanged).
           const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
           const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
-          const double sphere_lb = std::sqrt(sx * sx + sy * sy + sz * sz) - sp4[3];
-          if ((1.0 + lambda * (sphere_lb - slack)) * nfac >= best || sphere_lb - slack > cap)
+          const double reach = lambda > 0 ? std::min(cap, (best / nfac - 1.0) / lambda) : cap;
+          const double bound = reach + slack + sp4[3];
+          if (!(bound > 0) || sx * sx + sy * sy + sz * sz >= bound * bound * (1.0 + 1e-12))
             continue;
           const double dist2 =
               triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
@@ -343,6 +358,80 @@ Eigen::VectorXd TranslationCostCpu::evaluate(const SwatchFaceTree& tree,
         }
       });
   return sum_per_offset(minima, P, T);
+}
+
+namespace {
+
+// The first `keep` indices of a stable sort of costs, ascending.
+std::vector<int> least_indices(const Eigen::VectorXd& costs, int keep) {
+  std::vector<int> order(static_cast<std::size_t>(costs.size()));
+  for (int i = 0; i < costs.size(); ++i) order[static_cast<std::size_t>(i)] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return costs(a) < costs(b); });
+  order.resize(std::min(order.size(), static_cast<std::size_t>(keep)));
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+}  // namespace
+
+TranslationCostEvaluator::LeastCostOffsets TranslationCostEvaluator::least_cost_offsets(
+    const SwatchFaceTree& tree, const TranslationCostProblem& problem, int keep) {
+  MQ_CHECK(keep >= 1, InvalidInput, "translation cost: keep must be >= 1, got ", keep);
+  validate_translation_cost_problem(problem);
+  LeastCostOffsets result;
+  if (problem.offsets.rows() <= keep) {
+    result.kept = least_indices(Eigen::VectorXd::Zero(problem.offsets.rows()), keep);
+    return result;
+  }
+  result.kept = least_indices(evaluate(tree, problem), keep);
+  result.point_offsets = static_cast<long long>(problem.points.rows()) *
+                         static_cast<long long>(problem.offsets.rows());
+  return result;
+}
+
+TranslationCostEvaluator::LeastCostOffsets TranslationCostCpu::least_cost_offsets(
+    const SwatchFaceTree& tree, const TranslationCostProblem& problem, int keep) {
+  MQ_CHECK(keep >= 1, InvalidInput, "translation cost: keep must be >= 1, got ", keep);
+  validate_translation_cost_problem(problem);
+  const Eigen::Index P = problem.points.rows(), T = problem.offsets.rows();
+  LeastCostOffsets result;
+  if (T <= keep) {
+    result.kept = least_indices(Eigen::VectorXd::Zero(T), keep);
+    return result;
+  }
+  // Exact sums (in point order, as sum_per_offset adds them) or +inf for a dropped offset.
+  Eigen::VectorXd sums = Eigen::VectorXd::Constant(T, kInf);
+  std::vector<long long> evaluated(static_cast<std::size_t>(T), 0);
+  // The keep least sums so far by (sum, index); its last is the bound an offset must beat.
+  std::vector<std::pair<double, int>> best;
+  constexpr Eigen::Index kBatch = 16;
+  for (Eigen::Index b0 = 0; b0 < T;) {
+    // The first batch is the first `keep` offsets, so that a bound exists from the second on.
+    const Eigen::Index b1 = std::min(T, b0 == 0 ? static_cast<Eigen::Index>(keep) : b0 + kBatch);
+    const double bound = static_cast<int>(best.size()) == keep ? best.back().first : kInf;
+    tbb::parallel_for(b0, b1, [&](Eigen::Index t) {
+      double s = 0.0;
+      // The previous point's entry as the hint (see min_face_cost): it changes no sum.
+      int hint = -1;
+      for (Eigen::Index p = 0; p < P; ++p) {
+        const Vector3d q = problem.points.row(p) - problem.offsets.row(t);
+        s += tree.min_face_cost(q, problem.point_normals.row(p), problem.lambda, &hint, kInf, hint);
+        ++evaluated[static_cast<std::size_t>(t)];
+        // A margin of 1e-12 covers the rounding of the remaining additions (each adds >= 1).
+        if ((s + static_cast<double>(P - 1 - p)) * (1.0 - 1e-12) > bound) return;
+      }
+      sums(t) = s;
+    });
+    for (Eigen::Index t = b0; t < b1; ++t)
+      if (sums(t) < kInf) best.emplace_back(sums(t), static_cast<int>(t));
+    std::sort(best.begin(), best.end());
+    if (static_cast<int>(best.size()) > keep) best.resize(static_cast<std::size_t>(keep));
+    b0 = b1;
+  }
+  for (const auto& [sum, t] : best) result.kept.push_back(t);
+  std::sort(result.kept.begin(), result.kept.end());
+  for (const long long n : evaluated) result.point_offsets += n;
+  return result;
 }
 
 Eigen::VectorXd translation_cost_brute_force(const MatrixX3d& V, const MatrixX3i& F,

@@ -63,8 +63,14 @@ class SwatchFaceTree {
   // the minimum, -1 when there is none.
   // max_distance (>= 0): only faces within this distance of q compete (infinity, and -1 in
   // entry, when there is none); the cap also bounds the search, so a small one makes it cheap.
+  // hint (optional, -1 = none): an entry likely to be near the minimum (the one a nearby point
+  // or an earlier, slightly different query attained). Its cost starts the search as the best
+  // so far, so the bounds prune from the first node on. The minimum returned is the same with
+  // or without it; only among faces of exactly equal cost may the entry differ (the hint wins
+  // such a tie).
   double min_face_cost(const Vector3d& q, const Vector3d& n, double lambda, int* entry = nullptr,
-                       double max_distance = std::numeric_limits<double>::infinity()) const;
+                       double max_distance = std::numeric_limits<double>::infinity(),
+                       int hint = -1) const;
   // The Eq. (1) cost of one entry's face for query point q, bitwise the value min_face_cost
   // computes for it (so a sum of entry costs bounds a sum of minima exactly).
   // Precondition: 0 <= entry < num_faces() (InternalError otherwise).
@@ -137,6 +143,18 @@ class TranslationCostEvaluator {
   // device failures.
   virtual Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                                    const TranslationCostProblem& problem) = 0;
+  // The `keep` offsets of least E(t), as indices into problem.offsets in ascending order: those
+  // a stable sort of evaluate()'s costs puts first (ties to the lower index); every offset when
+  // there are no more than `keep`. point_offsets: (point, offset) pairs actually evaluated.
+  // This default evaluates every pair; a path may stop summing an offset once its partial sum
+  // shows it cannot be kept (the choice is the same). Throws InvalidInput for keep < 1 or a
+  // problem evaluate() refuses.
+  struct LeastCostOffsets {
+    std::vector<int> kept;
+    long long point_offsets = 0;
+  };
+  virtual LeastCostOffsets least_cost_offsets(const SwatchFaceTree& tree,
+                                              const TranslationCostProblem& problem, int keep);
   virtual std::string name() const = 0;
 };
 
@@ -146,6 +164,12 @@ class TranslationCostCpu final : public TranslationCostEvaluator {
  public:
   Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                            const TranslationCostProblem& problem) override;
+  // Offsets in fixed batches, each batch's offsets in parallel and each offset's points in
+  // order; an offset is dropped as soon as its partial sum plus 1 per remaining point (every
+  // minimum of Eq. (2) is at least 1) exceeds the keep-th least sum of the batches before.
+  // The batches and the bound do not depend on the thread count, so neither does the result.
+  LeastCostOffsets least_cost_offsets(const SwatchFaceTree& tree,
+                                      const TranslationCostProblem& problem, int keep) override;
   std::string name() const override { return "cpu"; }
 };
 

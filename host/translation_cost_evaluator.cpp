@@ -20,6 +20,25 @@ class TranslationCostAuto final : public TranslationCostEvaluator {
   Eigen::VectorXd evaluate(const SwatchFaceTree& tree,
                            const TranslationCostProblem& problem) override {
     if (!TranslationCostOpenCL::Options().on_device(problem)) return host_.evaluate(tree, problem);
+    TranslationCostEvaluator* device = device_path();
+    return device ? device->evaluate(tree, problem) : host_.evaluate(tree, problem);
+  }
+
+  LeastCostOffsets least_cost_offsets(const SwatchFaceTree& tree,
+                                      const TranslationCostProblem& problem, int keep) override {
+    if (!TranslationCostOpenCL::Options().on_device(problem))
+      return host_.least_cost_offsets(tree, problem, keep);
+    TranslationCostEvaluator* device = device_path();
+    return device ? device->least_cost_offsets(tree, problem, keep)
+                  : host_.least_cost_offsets(tree, problem, keep);
+  }
+
+  // What has answered so far: "opencl" once the device took a problem, else "cpu".
+  std::string name() const override { return device_ ? device_->name() : host_.name(); }
+
+ private:
+  // The device evaluator, created on first use; null when there is no usable device.
+  TranslationCostEvaluator* device_path() {
     if (!tried_device_) {
       tried_device_ = true;
       try {
@@ -31,13 +50,9 @@ class TranslationCostAuto final : public TranslationCostEvaluator {
         device_.reset();  // no usable device: the host path is the answer
       }
     }
-    return device_ ? device_->evaluate(tree, problem) : host_.evaluate(tree, problem);
+    return device_.get();
   }
 
-  // What has answered so far: "opencl" once the device took a problem, else "cpu".
-  std::string name() const override { return device_ ? device_->name() : host_.name(); }
-
- private:
   cl::RuntimeOptions options_;
   TranslationCostCpu host_;
   std::unique_ptr<TranslationCostOpenCL> device_;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numeric>
 #include <random>
 
 #include "core/errors.h"
@@ -251,6 +252,84 @@ TEST(TranslationCost, CpuIsIndependentOfThreadCount) {
   for (int i = 0; i < 9; ++i) EXPECT_EQ(one(i), brute(i)) << "offset " << i;
   // Zero offset puts every point on the swatch: the smallest cost.
   EXPECT_EQ(best_offset(one), 0);
+}
+
+// A hint only starts the search: the minimum is bitwise the one found without it, and the
+// entry reported attains it, whatever entry is hinted (near, far, or the minimiser itself).
+TEST(TranslationCost, TreeQueryHintChangesNoMinimum) {
+  const TriMesh torus = test::torus(2.0, 0.5, 24, 12);
+  std::mt19937_64 rng(17);
+  int hinted_minimiser = 0;
+  for (int leaf : {1, 64}) {
+    const SwatchFaceTree tree(torus.V, torus.F, leaf);
+    for (double lambda : {0.0, 1.0, 3.0}) {
+      for (int i = 0; i < 60; ++i) {
+        const Vector3d q(uniform(rng, -3, 3), uniform(rng, -3, 3), uniform(rng, -1.5, 1.5));
+        const Vector3d n = Vector3d(uniform(rng, -1, 1), uniform(rng, -1, 1), 0.3).normalized();
+        const double cap = i % 3 == 0 ? uniform(rng, 0.0, 0.8) : kInf;
+        int plain_entry = -2;
+        const double plain = tree.min_face_cost(q, n, lambda, &plain_entry, cap);
+        const int hints[] = {static_cast<int>(rng() % static_cast<unsigned>(tree.num_faces())),
+                             std::max(plain_entry, 0), tree.num_faces() - 1};
+        for (const int hint : hints) {
+          hinted_minimiser += hint == plain_entry;
+          int entry = -2;
+          const double hinted = tree.min_face_cost(q, n, lambda, &entry, cap, hint);
+          EXPECT_EQ(hinted, plain) << "hint " << hint;
+          if (std::isinf(plain)) {
+            EXPECT_EQ(entry, -1);
+          } else {
+            ASSERT_GE(entry, 0);
+            EXPECT_EQ(tree.entry_cost(entry, q, n, lambda), plain);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(hinted_minimiser, 100);
+}
+
+// The screening shortcut keeps exactly the offsets a stable sort of every cost keeps, on any
+// thread count, and it does skip work when some offsets are clearly worse.
+TEST(TranslationCost, CpuLeastCostOffsetsAreThoseOfSortingEveryCost) {
+  const TriMesh torus = test::torus(2.0, 0.5, 32, 16);
+  const MatrixX3d N = vertex_normals(torus.V, torus.F);
+  TranslationCostProblem pb;
+  pb.points = torus.V.topRows(40);
+  pb.point_normals = N.topRows(40);
+  // 7 x 7 offsets around zero, the last rows repeating earlier ones: exact ties.
+  pb.offsets.resize(56, 3);
+  for (int i = 0; i < 49; ++i) pb.offsets.row(i) << 0.3 * (i % 7 - 3), 0.3 * (i / 7 - 3), 0.0;
+  for (int i = 49; i < 56; ++i) pb.offsets.row(i) = pb.offsets.row((i - 49) * 7 + 3);
+  const SwatchFaceTree tree(torus.V, torus.F);
+  TranslationCostCpu cpu;
+  const Eigen::VectorXd costs = cpu.evaluate(tree, pb);
+  for (const int keep : {1, 3, 7, 20}) {
+    SCOPED_TRACE(keep);
+    std::vector<int> expected(56);
+    std::iota(expected.begin(), expected.end(), 0);
+    std::stable_sort(expected.begin(), expected.end(),
+                     [&](int a, int b) { return costs(a) < costs(b); });
+    expected.resize(static_cast<size_t>(keep));
+    std::sort(expected.begin(), expected.end());
+    TranslationCostEvaluator::LeastCostOffsets one, two;
+    tbb::task_arena(1).execute([&] { one = cpu.least_cost_offsets(tree, pb, keep); });
+    tbb::task_arena(2).execute([&] { two = cpu.least_cost_offsets(tree, pb, keep); });
+    EXPECT_EQ(one.kept, expected);
+    EXPECT_EQ(two.kept, expected);
+    EXPECT_EQ(one.point_offsets, two.point_offsets);
+    EXPECT_GT(one.point_offsets, 0);
+    EXPECT_LT(one.point_offsets, 40 * 56);  // far offsets were dropped part-way
+    // The shared default (evaluate every pair, then sort) keeps the same offsets.
+    EXPECT_EQ(cpu.TranslationCostEvaluator::least_cost_offsets(tree, pb, keep).kept, expected);
+  }
+  // No more offsets than kept: all of them, nothing evaluated.
+  TranslationCostProblem few = pb;
+  few.offsets = pb.offsets.topRows(3);
+  const auto all = cpu.least_cost_offsets(tree, few, 3);
+  EXPECT_EQ(all.kept, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(all.point_offsets, 0);
+  EXPECT_THROW(cpu.least_cost_offsets(tree, pb, 0), InvalidInput);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "core/errors.h"
@@ -135,6 +136,25 @@ TEST_P(TranslationCostPaths, RepeatedEvaluationIsIdentical) {
   const Eigen::VectorXd a = evaluator_->evaluate(tree, pb);
   const Eigen::VectorXd b = evaluator_->evaluate(tree, pb);
   for (Eigen::Index t = 0; t < a.size(); ++t) EXPECT_EQ(a(t), b(t)) << "offset " << t;
+}
+
+// Each path's screening keeps the offsets a stable sort of its own costs keeps.
+TEST_P(TranslationCostPaths, LeastCostOffsetsAreThoseOfItsCosts) {
+  const TriMesh m = read_mesh(test::shared_data("swatch/torus_576.off"));
+  const double h = mean_edge_length(m.V, m.F);
+  const TranslationCostProblem pb =
+      self_subpatch(m, 3, Vector3d(0.5 * h, 0.2 * h, 0), 0.5 * h, 0.2 * h, 1.0, 6);
+  const SwatchFaceTree tree(m.V, m.F);
+  const Eigen::VectorXd costs = evaluator_->evaluate(tree, pb);
+  for (const int keep : {1, 3, 10}) {
+    std::vector<int> expected(static_cast<size_t>(costs.size()));
+    std::iota(expected.begin(), expected.end(), 0);
+    std::stable_sort(expected.begin(), expected.end(),
+                     [&](int a, int b) { return costs(a) < costs(b); });
+    expected.resize(static_cast<size_t>(keep));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(evaluator_->least_cost_offsets(tree, pb, keep).kept, expected) << "keep " << keep;
+  }
 }
 
 TEST_P(TranslationCostPaths, EmptyProblem) {
