@@ -1,6 +1,7 @@
 #include "core/mesh_io.h"
 
 #include <sys/stat.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,9 +21,9 @@
 #include "core/atomic_file.h"
 #include "core/corner_normals.h"
 #include "core/element_kinds.h"
-#include "core/gltf_writer.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
+#include "core/gltf_writer.h"
 #include "core/input_file.h"
 
 namespace mq {
@@ -839,6 +840,38 @@ void write_mtl(AtomicOutputFile& out, const std::vector<std::string>& kinds) {
   }
 }
 
+// Appends rows [0, n) to out, row i being what format(i, p) writes at p (at most max_row
+// bytes; it returns the end). Chunks of rows are formatted in parallel into their own buffers
+// and appended in row order, so the bytes are those of a sequential loop whatever the thread
+// count. (Number formatting is most of the writing time: 0.2 s for the 28 MB of plane +
+// apple's output on one core.)
+template <class Format>
+void append_rows(AtomicOutputFile& out, Eigen::Index n, size_t max_row, const Format& format) {
+  constexpr Eigen::Index kRowsPerChunk = 8192;
+  constexpr Eigen::Index kChunksPerWindow = 8;  // bounds the buffers held at once (~8 MB)
+  const Eigen::Index chunks = (n + kRowsPerChunk - 1) / kRowsPerChunk;
+  std::vector<std::vector<char>> buffers(static_cast<size_t>(std::min(chunks, kChunksPerWindow)));
+  std::vector<size_t> used(buffers.size());
+  for (Eigen::Index w0 = 0; w0 < chunks; w0 += kChunksPerWindow) {
+    const Eigen::Index w1 = std::min(chunks, w0 + kChunksPerWindow);
+    tbb::parallel_for(w0, w1, [&](Eigen::Index c) {
+      const size_t slot = static_cast<size_t>(c - w0);
+      const Eigen::Index r0 = c * kRowsPerChunk, r1 = std::min(n, r0 + kRowsPerChunk);
+      std::vector<char>& buffer = buffers[slot];
+      buffer.resize(static_cast<size_t>(r1 - r0) * max_row);
+      char* p = buffer.data();
+      for (Eigen::Index i = r0; i < r1; ++i) p = format(i, p);
+      used[slot] = static_cast<size_t>(p - buffer.data());
+    });
+    for (Eigen::Index c = w0; c < w1; ++c)
+      out.append(buffers[static_cast<size_t>(c - w0)].data(), used[static_cast<size_t>(c - w0)]);
+  }
+}
+
+// The longest line put_row's callers below write: a tag, three numbers of at most 32
+// characters (to_chars of a double) or three "i//j" indices of at most 24 + 2 + 24.
+constexpr size_t kMaxObjLine = 4 + 3 * (1 + 2 * 24 + 2) + 1;
+
 void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normals, int precision,
                const ElementLabels* labels, ElementGroups groups, const std::string& mtl_name) {
   if (labels) {
@@ -846,23 +879,21 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
                std::to_string(labels->kinds.size()) + " kinds\n");
     out.append("mtllib " + mtl_name + "\n");
   }
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
-    char* p = out.cursor();
+  append_rows(out, m.V.rows(), kMaxObjLine, [&](Eigen::Index i, char* p) {
     *p++ = 'v';
     p = put_row(p, m.V, i, precision);
     *p++ = '\n';
-    out.commit_bytes(p);
-  }
+    return p;
+  });
   const MatrixX3d* N = normals.C ? &normals.C->N : normals.Nv;
   if (N)
-    for (Eigen::Index i = 0; i < N->rows(); ++i) {
-      char* p = out.cursor();
+    append_rows(out, N->rows(), kMaxObjLine, [&](Eigen::Index i, char* p) {
       *p++ = 'v';
       *p++ = 'n';
       p = put_row(p, *N, i, precision);
       *p++ = '\n';
-      out.commit_bytes(p);
-    }
+      return p;
+    });
   // Faces grouped by element or by kind (stable), so each group is one run.
   std::vector<int> order(static_cast<size_t>(m.F.rows()));
   std::iota(order.begin(), order.end(), 0);
@@ -875,22 +906,47 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
   }
   const int width = labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size())
                            : 0;
-  int last_element = -1, last_kind = -1;
-  for (const int f : order) {
+  // A face line may follow an "o" and a "usemtl" line naming its kind.
+  size_t longest_kind = 0;
+  if (labels)
+    for (const std::string& kind : labels->kinds)
+      longest_kind = std::max(longest_kind, kind.size());
+  const size_t max_row = kMaxObjLine + 2 * (longest_kind + static_cast<size_t>(width) + 16);
+  // Row i of the face block: the group lines when face order[i] starts a new group (decided by
+  // the face before it, so each chunk needs nothing but i), then the face.
+  append_rows(out, static_cast<Eigen::Index>(order.size()), max_row, [&](Eigen::Index i, char* p) {
+    const int f = order[static_cast<size_t>(i)];
     if (labels) {
-      const int e = labels->face_element[static_cast<size_t>(f)];
+      const auto element_of = [&](Eigen::Index r) {
+        return r < 0 ? -1
+                     : labels->face_element[static_cast<size_t>(order[static_cast<size_t>(r)])];
+      };
+      const int e = element_of(i), last_element = element_of(i - 1);
       const int k = labels->element_kind[static_cast<size_t>(e)];
+      const int last_kind =
+          last_element < 0 ? -1 : labels->element_kind[static_cast<size_t>(last_element)];
       const std::string& kind = labels->kinds[static_cast<size_t>(k)];
-      if (groups == ElementGroups::Element && e != last_element)
-        out.append("o " + kind + "_" + padded(e, width) + "\n");
-      else if (groups == ElementGroups::Kind && k != last_kind)
-        out.append("o " + kind + "\n");
-      if (k != last_kind || (groups == ElementGroups::Element && e != last_element))
-        out.append("usemtl " + kind + "\n");
-      last_element = e;
-      last_kind = k;
+      const auto put = [&](std::string_view text) {
+        std::memcpy(p, text.data(), text.size());
+        p += text.size();
+      };
+      if (groups == ElementGroups::Element && e != last_element) {
+        put("o ");
+        put(kind);
+        put("_");
+        put(padded(e, width));
+        put("\n");
+      } else if (groups == ElementGroups::Kind && k != last_kind) {
+        put("o ");
+        put(kind);
+        put("\n");
+      }
+      if (k != last_kind || (groups == ElementGroups::Element && e != last_element)) {
+        put("usemtl ");
+        put(kind);
+        put("\n");
+      }
     }
-    char* p = out.cursor();
     *p++ = 'f';
     for (int k = 0; k < 3; ++k) {
       *p++ = ' ';
@@ -902,8 +958,8 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
       }
     }
     *p++ = '\n';
-    out.commit_bytes(p);
-  }
+    return p;
+  });
 }
 
 void write_off(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, int precision) {

@@ -1,6 +1,7 @@
 // Element kinds (core/element_kinds.h) from files and generators, through the writers and the
 // quilting, and the OBJ/PLY element labels an artist's tools read (issue 15).
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <filesystem>
 #include <map>
@@ -124,6 +125,48 @@ TEST(ElementKinds, ObjGroupsByElementKindOrNoneRoundTrip) {
     EXPECT_EQ(back.num_faces(), mesh.num_faces());
     EXPECT_EQ(faces_per_kind(back), faces_per_kind(mesh));
     EXPECT_EQ(elements_per_kind(back), elements_per_kind(mesh));
+  }
+}
+
+// The OBJ rows are formatted in parallel chunks (8,192 rows, windows of 8): an element whose
+// faces straddle a chunk boundary still gets one "o" line, and the bytes do not depend on the
+// thread count.
+TEST(ElementKinds, ObjWrittenInChunksIsTheSameOnAnyThreadCount) {
+  const std::string dir = test::temp_dir();
+  ChainMailOptions cm;
+  cm.rows = 16;
+  cm.cols = 16;
+  cm.ring_segments = 24;
+  cm.wire_segments = 8;
+  const TriMesh mesh = chainmail_4in1(cm);  // 256 rings of 384 faces: 12 chunks of faces
+  ASSERT_GT(mesh.num_faces(), 8 * 8192);
+  WriteOptions o;
+  o.write_elements = true;
+  o.write_normals = true;
+  std::string first;
+  for (const int threads : {1, 2, 4}) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] { write_mesh(dir + "/mail.obj", mesh, o); });
+    const std::string text = test::slurp(dir + "/mail.obj");
+    if (threads == 1) {
+      first = text;
+      std::set<std::string> names;
+      int objects = 0;
+      std::istringstream lines(text);
+      std::string line;
+      while (std::getline(lines, line))
+        if (line.rfind("o ", 0) == 0) {
+          ++objects;
+          names.insert(line.substr(2));
+        }
+      EXPECT_EQ(objects, 256);
+      EXPECT_EQ(names.size(), 256u);
+      const TriMesh back = read_mesh(dir + "/mail.obj");
+      EXPECT_EQ(back.num_faces(), mesh.num_faces());
+      EXPECT_EQ(elements_per_kind(back), elements_per_kind(mesh));
+    } else {
+      EXPECT_TRUE(text == first) << threads << " threads wrote different bytes";
+    }
   }
 }
 
