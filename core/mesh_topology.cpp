@@ -160,19 +160,45 @@ std::vector<std::vector<int>> component_faces(const std::vector<int>& face_compo
 
 TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces,
                       std::vector<int>* vertex_map) {
-  std::vector<int> new_index(mesh.V.rows(), -1);
   std::vector<int> old_index;
   TriMesh out;
   out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t i = 0; i < faces.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      const int v = mesh.F(faces[i], k);
-      if (new_index[v] < 0) {
-        new_index[v] = static_cast<int>(old_index.size());
-        old_index.push_back(v);
+  const size_t corners = 3 * faces.size();
+  if (8 * corners >= static_cast<size_t>(mesh.V.rows())) {
+    // A large share of the mesh: a table over all its vertices.
+    std::vector<int> new_index(static_cast<size_t>(mesh.V.rows()), -1);
+    for (size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int v = mesh.F(faces[i], k);
+        if (new_index[static_cast<size_t>(v)] < 0) {
+          new_index[static_cast<size_t>(v)] = static_cast<int>(old_index.size());
+          old_index.push_back(v);
+        }
+        out.F(static_cast<Eigen::Index>(i), k) = new_index[static_cast<size_t>(v)];
       }
-      out.F(i, k) = new_index[v];
+  } else {
+    // A small part (one element of a layer of thousands): the corners sorted by vertex, so the
+    // cost follows the part and not the mesh (a table per element made placing and measuring
+    // every element of a layer quadratic). Same numbering: by first use.
+    std::vector<std::pair<int, int>> use(corners);  // (vertex, corner)
+    for (size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        use[3 * i + static_cast<size_t>(k)] = {mesh.F(faces[i], k), static_cast<int>(3 * i) + k};
+    std::sort(use.begin(), use.end());
+    std::vector<std::pair<int, int>> first_use;  // (first corner, run start in use)
+    for (size_t r = 0; r < use.size(); ++r)
+      if (r == 0 || use[r].first != use[r - 1].first)
+        first_use.emplace_back(use[r].second, static_cast<int>(r));
+    std::sort(first_use.begin(), first_use.end());
+    old_index.resize(first_use.size());
+    for (size_t j = 0; j < first_use.size(); ++j) {
+      const int v = use[static_cast<size_t>(first_use[j].second)].first;
+      old_index[j] = v;
+      for (size_t r = static_cast<size_t>(first_use[j].second); r < use.size() && use[r].first == v;
+           ++r)
+        out.F(use[r].second / 3, use[r].second % 3) = static_cast<int>(j);
     }
+  }
   out.V.resize(static_cast<Eigen::Index>(old_index.size()), 3);
   for (size_t i = 0; i < old_index.size(); ++i) out.V.row(i) = mesh.V.row(old_index[i]);
   if (mesh.N.rows() == mesh.V.rows() && mesh.N.rows() > 0) {

@@ -72,6 +72,40 @@ TEST(MeshTopology, ComponentsExtractAndAppend) {
   EXPECT_TRUE(torus_report.manifold());
 }
 
+// A part far smaller than the mesh is renumbered without a table over the whole mesh; the
+// result (vertices in order of first use, the map back) is the table's, face order arbitrary.
+TEST(MeshTopology, ExtractingASmallPartNumbersAsTheTableDoes) {
+  const TriMesh grid = test::plane_grid(1.0, 1.0, 60, 60);  // 7,200 faces
+  std::vector<int> small = {4000, 17, 3999, 18, 4001, 17 + 120, 4000 + 1};
+  // The reference: the same renumbering written out by first use.
+  std::vector<int> first_use;
+  for (const int f : small)
+    for (int k = 0; k < 3; ++k)
+      if (std::find(first_use.begin(), first_use.end(), grid.F(f, k)) == first_use.end())
+        first_use.push_back(grid.F(f, k));
+  std::vector<int> map;
+  const TriMesh part = extract_faces(grid, small, &map);  // 21 corners: the sorted path
+  EXPECT_EQ(map, first_use);
+  ASSERT_EQ(part.num_faces(), static_cast<int>(small.size()));
+  for (size_t i = 0; i < small.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(map[static_cast<size_t>(part.F(static_cast<Eigen::Index>(i), k))],
+                grid.F(small[i], k));
+      EXPECT_EQ(part.V.row(part.F(static_cast<Eigen::Index>(i), k)),
+                grid.V.row(grid.F(small[i], k)));
+    }
+  // Half of the mesh takes the table: the same numbering rule.
+  std::vector<int> half;
+  for (int f = 7199; f >= 3600; --f) half.push_back(f);
+  std::vector<int> half_map;
+  const TriMesh h = extract_faces(grid, half, &half_map);
+  EXPECT_EQ(half_map[0], grid.F(7199, 0));
+  for (size_t i = 0; i < half.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(half_map[static_cast<size_t>(h.F(static_cast<Eigen::Index>(i), k))],
+                grid.F(half[i], k));
+}
+
 TEST(MeshTopology, NonManifoldEdgeAndVertexDetected) {
   TriMesh m;
   m.V.resize(7, 3);
