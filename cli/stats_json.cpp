@@ -89,7 +89,10 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
     j.value("share_with_swatch_links", comparison->share_matching)
         .value("density_ratio",
                comparison->density_ratio > 0 ? comparison->density_ratio : std::nan(""))
-        .value("linear_scale", comparison->linear_scale);
+        .value("linear_scale", comparison->linear_scale)
+        .value("stretched_elements", comparison->stretched)
+        .value("largest_size_ratio",
+               comparison->largest_size > 0 ? comparison->largest_size : std::nan(""));
   j.end_object();
 }
 
@@ -128,6 +131,11 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
     if (comparison->density_ratio > 0)
       std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",
                   100 * comparison->density_ratio, comparison->linear_scale);
+    if (comparison->largest_size > 0)
+      std::printf(
+          "stretched:         %d elements over %.3gx the swatch's element size "
+          "(largest %.2fx)\n",
+          comparison->stretched, StructureComparison::kStretchedSize, comparison->largest_size);
   }
 }
 

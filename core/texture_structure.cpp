@@ -529,6 +529,14 @@ StructureComparison compare_structure(const StructureReport& output, const Swatc
       2 * swatch.report.long_elements > static_cast<int>(swatch.report.elements.size());
   if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0 && !long_swatch)
     c.density_ratio = output.density / (swatch.density / (c.linear_scale * c.linear_scale));
+  const double reference = swatch.report.median_size * c.linear_scale;
+  if (reference > 0 && !long_swatch)
+    for (const ElementStructure& e : output.elements) {
+      if (e.long_element) continue;
+      const double ratio = e.size / reference;
+      c.largest_size = std::max(c.largest_size, ratio);
+      c.stretched += ratio > StructureComparison::kStretchedSize ? 1 : 0;
+    }
   return c;
 }
 

@@ -119,6 +119,13 @@ struct StructureComparison {
   // (threads join across seams, so their count per area says nothing; see interior ends).
   double density_ratio = 0;
   double linear_scale = 0;    // output length units per swatch unit
+  // Distortion of compact elements (rings, apples; not threads or vines, which seams cut):
+  // sizes (ElementStructure::size) over the swatch's median size at the output's scale. The
+  // map stretches an element where it is as wide as the feature under it (a spike, a hoof).
+  // 0 when most swatch elements are long.
+  int stretched = 0;        // compact output elements over kStretchedSize times that size
+  double largest_size = 0;  // the largest such ratio
+  static constexpr double kStretchedSize = 1.5;
 };
 
 // linear_scale: output length per swatch length; 0 estimates it from the median element

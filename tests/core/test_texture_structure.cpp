@@ -115,6 +115,47 @@ TEST(TextureStructure, RingsMissingFromASheetLowerTheShareAndTheDensity) {
   EXPECT_NEAR(ch.linear_scale, 1.0, 1e-9);
 }
 
+// A ring the map stretched is counted against the swatch's element size at the output's
+// scale: one ring of a sheet stretched 2x along x, the sheet itself scaled by 3.
+TEST(TextureStructure, StretchedElementsAreCountedAgainstTheSwatchSize) {
+  ChainMailOptions o;
+  o.rows = 6;
+  o.cols = 6;
+  const TriMesh sheet = chainmail_4in1(o);
+  const SwatchStructure s = measure_swatch_structure(sheet);
+  TriMesh out = moved(sheet, 3.0 * Eigen::Matrix3d::Identity(), Vector3d::Zero());
+  const StructureComparison plain = compare_structure(measure_structure(out), s, 3.0);
+  EXPECT_EQ(plain.stretched, 0);
+  EXPECT_NEAR(plain.largest_size, 1.0, 0.02);  // every ring has the swatch's size
+  std::vector<int> fc;
+  connected_components(out.F, out.num_vertices(), fc);
+  std::vector<char> in_ring(static_cast<size_t>(out.num_vertices()), 0);
+  for (int f = 0; f < out.num_faces(); ++f)
+    if (fc[static_cast<size_t>(f)] == 14)
+      for (int k = 0; k < 3; ++k) in_ring[static_cast<size_t>(out.F(f, k))] = 1;
+  Vector3d centre = Vector3d::Zero();
+  int count = 0;
+  for (int v = 0; v < out.num_vertices(); ++v)
+    if (in_ring[static_cast<size_t>(v)]) {
+      centre += out.V.row(v).transpose();
+      ++count;
+    }
+  centre /= count;
+  for (int v = 0; v < out.num_vertices(); ++v)
+    if (in_ring[static_cast<size_t>(v)])
+      out.V(v, 0) = centre.x() + 2.0 * (out.V(v, 0) - centre.x());
+  const StructureComparison one = compare_structure(measure_structure(out), s, 3.0);
+  EXPECT_EQ(one.stretched, 1);
+  EXPECT_GT(one.largest_size, 1.7);
+  EXPECT_LT(one.largest_size, 2.05);
+  // Threads are not compact elements: a weave reports no stretch.
+  const TriMesh weave = plain_weave();
+  const StructureComparison w =
+      compare_structure(measure_structure(weave), measure_swatch_structure(weave), 1.0);
+  EXPECT_EQ(w.stretched, 0);
+  EXPECT_EQ(w.largest_size, 0.0);
+}
+
 TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
   WeaveOptions o;
   o.threads_x = 8;
