@@ -249,9 +249,10 @@ int run_surface(int argc, char** argv, int first) {
                   "(--keep-orientation keeps them)\n",
                   stats.flipped_components);
     if (stats.proxy_faces > 0)
-      std::printf("base: simplified to %d faces, within %.3g of the surface given "
-                  "(--no-proxy keeps it)\n",
-                  stats.proxy_faces, stats.proxy_error);
+      std::printf(
+          "base: simplified to %d faces, within %.3g of the surface given "
+          "(--no-proxy keeps it)\n",
+          stats.proxy_faces, stats.proxy_error);
     if (!embedding_stats.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
                   embedding_stats.shell_map_failure.c_str());

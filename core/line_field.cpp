@@ -11,7 +11,6 @@ namespace mq {
 
 namespace {
 
-
 // Angle of the edge e's vector (E(e,0) -> E(e,1)) in face f's frame.
 double edge_angle(const MatrixX3d& V, const EdgeTopology& topo, const FaceFrames& fr, int e,
                   int f) {

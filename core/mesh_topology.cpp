@@ -262,6 +262,38 @@ void remove_unreferenced_vertices(TriMesh& mesh) {
   mesh.N = std::move(N);
 }
 
+std::vector<char> multi_fan_vertices(const MatrixX3i& F, int num_vertices,
+                                     const EdgeTopology& topo) {
+  // Each fan is walked across the manifold edges at the vertex (TT is -1 across the others).
+  const Adjacency vf = vertex_faces(F, num_vertices);
+  const MatrixX3i TT = face_adjacency(topo);
+  std::vector<char> multi(static_cast<size_t>(num_vertices), 0);
+  std::vector<int> mark(static_cast<size_t>(F.rows()), -1);
+  std::vector<int> stack;
+  for (int v = 0; v < num_vertices; ++v) {
+    int fans = 0;
+    for (const int* it = vf.begin(v); it != vf.end(v); ++it) {
+      if (mark[*it] == v) continue;
+      ++fans;
+      stack.assign(1, *it);
+      mark[*it] = v;
+      while (!stack.empty()) {
+        const int f = stack.back();
+        stack.pop_back();
+        for (int k = 0; k < 3; ++k) {
+          const int g = TT(f, k);
+          if (g < 0 || mark[g] == v) continue;
+          if (F(f, k) != v && F(f, (k + 1) % 3) != v) continue;
+          mark[g] = v;
+          stack.push_back(g);
+        }
+      }
+    }
+    multi[static_cast<size_t>(v)] = fans > 1;
+  }
+  return multi;
+}
+
 TopologyReport topology_report(const TriMesh& mesh) {
   TopologyReport r;
   const int nv = mesh.num_vertices();
@@ -278,34 +310,8 @@ TopologyReport topology_report(const TriMesh& mesh) {
     const Vector3d n = (mesh.V.row(b) - mesh.V.row(a)).cross(mesh.V.row(c) - mesh.V.row(a));
     if (repeated || n.squaredNorm() == 0.0) ++r.num_degenerate_faces;
   }
-  // A vertex is manifold when its incident faces, linked through shared manifold edges that
-  // contain the vertex, form a single fan.
-  const Adjacency vf = vertex_faces(mesh.F, nv);
-  const MatrixX3i TT = face_adjacency(topo);
-  std::vector<int> mark(mesh.F.rows(), -1);
-  std::vector<int> stack;
-  for (int v = 0; v < nv; ++v) {
-    if (vf.degree(v) == 0) continue;
-    int fans = 0;
-    for (const int* it = vf.begin(v); it != vf.end(v); ++it) {
-      if (mark[*it] == v) continue;
-      ++fans;
-      stack.assign(1, *it);
-      mark[*it] = v;
-      while (!stack.empty()) {
-        const int f = stack.back();
-        stack.pop_back();
-        for (int k = 0; k < 3; ++k) {
-          const int g = TT(f, k);
-          if (g < 0 || mark[g] == v) continue;
-          if (mesh.F(f, k) != v && mesh.F(f, (k + 1) % 3) != v) continue;
-          mark[g] = v;
-          stack.push_back(g);
-        }
-      }
-    }
-    if (fans > 1) ++r.num_non_manifold_vertices;
-  }
+  for (const char multi : multi_fan_vertices(mesh.F, nv, topo))
+    r.num_non_manifold_vertices += multi;
   return r;
 }
 

@@ -43,6 +43,12 @@ Adjacency vertex_faces(const MatrixX3i& F, int num_vertices);
 // -1 across a boundary or a non-manifold edge.
 MatrixX3i face_adjacency(const EdgeTopology& topo);
 
+// Per vertex (#V entries), whether its incident faces, linked through the manifold edges they
+// share at it, form more than one fan: a vertex where pieces of surface touch (a bow tie), or
+// on a non-manifold edge. 0 for a vertex no face uses.
+std::vector<char> multi_fan_vertices(const MatrixX3i& F, int num_vertices,
+                                     const EdgeTopology& topo);
+
 // Per-face component id of the vertex-connected pieces (the paper's geometry elements), in
 // order of each component's first face; returns the number of components.
 //   face_component  output, #F

@@ -7,7 +7,6 @@
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
-#include "core/union_find.h"
 
 namespace mq {
 
@@ -29,8 +28,8 @@ struct Quadric {
   double at(const Vector3d& p) const {
     const double x = p.x(), y = p.y(), z = p.z();
     const double e = q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x +
-                     q[4] * y * y + 2 * q[5] * y * z + 2 * q[6] * y + q[7] * z * z +
-                     2 * q[8] * z + q[9];
+                     q[4] * y * y + 2 * q[5] * y * z + 2 * q[6] * y + q[7] * z * z + 2 * q[8] * z +
+                     q[9];
     return std::max(e, 0.0);
   }
 };
@@ -85,8 +84,8 @@ class CandidateQueue {
 // degenerate one.
 double quality(const Vector3d c[3]) {
   const double area2 = (c[1] - c[0]).cross(c[2] - c[0]).norm();  // twice the area
-  const double edges = (c[1] - c[0]).squaredNorm() + (c[2] - c[1]).squaredNorm() +
-                       (c[0] - c[2]).squaredNorm();
+  const double edges =
+      (c[1] - c[0]).squaredNorm() + (c[2] - c[1]).squaredNorm() + (c[0] - c[2]).squaredNorm();
   return edges > 0 ? 2 * std::sqrt(3.0) * area2 / edges : 0;
 }
 
@@ -102,7 +101,8 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
   MQ_CHECK(options.min_quality >= 0 && options.min_quality <= 1, InvalidInput,
            "simplification: the lowest face quality must be in [0, 1], got ", options.min_quality);
   MQ_CHECK(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180,
-           InvalidInput, "simplification: the largest normal turn must be in (0, 180) degrees, got ",
+           InvalidInput,
+           "simplification: the largest normal turn must be in (0, 180) degrees, got ",
            options.max_normal_turn_degrees);
   const int nv = mesh.num_vertices(), nf = mesh.num_faces();
   MQ_CHECK(nf == 0 || (mesh.F.minCoeff() >= 0 && mesh.F.maxCoeff() < nv), InvalidInput,
@@ -116,7 +116,8 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
   const auto P = [&](int v) -> Vector3d { return mesh.V.row(v).transpose() - centre; };
 
   MatrixX3i F = mesh.F;
-  std::vector<char> face_alive(static_cast<size_t>(nf), 1), vertex_alive(static_cast<size_t>(nv), 1);
+  std::vector<char> face_alive(static_cast<size_t>(nf), 1),
+      vertex_alive(static_cast<size_t>(nv), 1);
   std::vector<std::vector<int>> faces_of(static_cast<size_t>(nv));
   for (int f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) faces_of[F(f, k)].push_back(f);
@@ -128,28 +129,12 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
     n.normalize();
     for (int k = 0; k < 3; ++k) Q[F(f, k)].add_plane(n, -n.dot(a));
   }
-  // Vertices that stay: on a boundary or non-manifold edge, or where faces meet at a single
-  // vertex without sharing an edge (two fans: the disk condition fails).
-  std::vector<char> locked(static_cast<size_t>(nv), 0);
+  // Vertices that stay: on a boundary or non-manifold edge, or where pieces of surface touch
+  // (more than one fan: the disk condition fails).
   const EdgeTopology topo = edge_topology(mesh.F, nv);
-  {
-    for (int e = 0; e < topo.num_edges(); ++e)
-      if (topo.edge_faces.degree(e) != 2) locked[topo.E(e, 0)] = locked[topo.E(e, 1)] = 1;
-    for (int v = 0; v < nv; ++v) {
-      const std::vector<int>& fs = faces_of[v];
-      if (locked[v] || fs.size() < 2) continue;
-      UnionFind fans(static_cast<int>(fs.size()));
-      for (size_t i = 0; i < fs.size(); ++i)
-        for (size_t j = i + 1; j < fs.size(); ++j) {
-          int shared = 0;
-          for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b) shared += F(fs[i], a) == F(fs[j], b);
-          if (shared == 2) fans.unite(static_cast<int>(i), static_cast<int>(j));
-        }
-      for (size_t i = 1; i < fs.size(); ++i)
-        if (fans.find(static_cast<int>(i)) != fans.find(0)) locked[v] = 1;
-    }
-  }
+  std::vector<char> locked = multi_fan_vertices(mesh.F, nv, topo);
+  for (int e = 0; e < topo.num_edges(); ++e)
+    if (topo.edge_faces.degree(e) != 2) locked[topo.E(e, 0)] = locked[topo.E(e, 1)] = 1;
 
   const auto neighbours = [&](int v) {
     std::vector<int> n;
@@ -204,8 +189,7 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
     std::sort(opposite.begin(), opposite.end());
     const std::vector<int> nf_ = neighbours(from), nt = neighbours(to);
     std::vector<int> common;
-    std::set_intersection(nf_.begin(), nf_.end(), nt.begin(), nt.end(),
-                          std::back_inserter(common));
+    std::set_intersection(nf_.begin(), nf_.end(), nt.begin(), nt.end(), std::back_inserter(common));
     if (common != opposite) return false;
     const Vector3d pt = P(to);
     for (const int f : faces_of[from]) {
@@ -244,8 +228,9 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
     if (c.stamp_a != stamp[c.a] || c.stamp_b != stamp[c.b]) continue;
     // The cheaper direction first (ties: the lower index goes), then the other.
     const double ab = cost_of(c.a, c.b), ba = cost_of(c.b, c.a);
-    const std::pair<int, int> order[2] = {ab <= ba ? std::make_pair(c.a, c.b) : std::make_pair(c.b, c.a),
-                                          ab <= ba ? std::make_pair(c.b, c.a) : std::make_pair(c.a, c.b)};
+    const std::pair<int, int> order[2] = {
+        ab <= ba ? std::make_pair(c.a, c.b) : std::make_pair(c.b, c.a),
+        ab <= ba ? std::make_pair(c.b, c.a) : std::make_pair(c.a, c.b)};
     int from = -1, to = -1, shared[2] = {-1, -1};
     double cost = 0;
     for (const auto& [f, t] : order) {

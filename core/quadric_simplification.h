@@ -41,9 +41,9 @@ struct QuadricSimplification {
 // Simplifies `mesh` by collapsing edges in order of quadric error while the error stays within
 // max_error. Vertices on boundary or non-manifold edges are never removed; a collapse is made
 // only where the surface stays a manifold (the link condition), no face flips or turns by more
-// than max_normal_turn_degrees, no face falls below min_quality, and no face repeats another. Collapses are made cheapest first,
-// up to a factor sqrt(2) in error (bucketed), in the order they are found within that:
-// deterministic, O(F) work for the queue.
+// than max_normal_turn_degrees, no face falls below min_quality, and no face repeats another.
+// Collapses are made cheapest first, up to a factor sqrt(2) in error (bucketed), in the order
+// they are found within that: deterministic, O(F) work for the queue.
 //   mesh  #V by 3, #F by 3, consistently oriented
 // Throws InvalidInput for out-of-range indices, non-finite coordinates or options outside their
 // ranges.

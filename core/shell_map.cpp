@@ -16,7 +16,6 @@ namespace mq {
 
 namespace {
 
-
 // SplitMix64 finaliser: decorrelates (seed, sweep, vertex) before seeding mt19937_64.
 std::uint64_t mix(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;

@@ -10,11 +10,11 @@
 
 #include "core/closest_point_query.h"
 #include "core/errors.h"
-#include "core/outward_orientation.h"
 #include "core/geometry_measures.h"
 #include "core/local_patch.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
+#include "core/outward_orientation.h"
 #include "core/planar_quilting.h"
 #include "core/quadric_simplification.h"
 #include "core/quilt_elements.h"
@@ -424,13 +424,14 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   if (options.orient_outward) stats.flipped_components = orient_outward(job.cleaned);
   // The output estimated before any work: the swatch's faces per unit of footprint area at its
   // scale on the surface, over the base's area (issue 14: --scale 1e-6 ran out of memory).
-  Vector3d e = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
-  std::sort(e.data(), e.data() + 3);
+  // The swatch's box sides, thinnest (its thickness: the shell height at scale 1) first.
+  Vector3d swatch_sides = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
+  std::sort(swatch_sides.data(), swatch_sides.data() + 3);
   {
     // The refined base below has the same bounding box, so this is the scale used throughout.
     job.swatch_scale = swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
     const double k = job.swatch_scale;
-    const double footprint = std::max(e(1) * e(2), 1e-300) * k * k;
+    const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
     const double faces = static_cast<double>(swatch_mesh.num_faces()) *
                          face_areas(base_in.V, base_in.F).sum() / footprint;
     MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
@@ -448,7 +449,7 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   // height, the texture lies on a surface no farther from the one given than that.
   if (options.proxy_min_faces > 0 && job.cleaned.num_faces() > options.proxy_min_faces) {
     QuadricSimplificationOptions so;
-    so.max_error = options.proxy_error * e(0) * job.swatch_scale;
+    so.max_error = options.proxy_error * swatch_sides(0) * job.swatch_scale;
     so.max_edge_length = max_edge;
     QuadricSimplification proxy = simplify_by_quadrics(job.cleaned, so);
     if (proxy.mesh.num_faces() < job.cleaned.num_faces()) {

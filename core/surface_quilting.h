@@ -104,8 +104,8 @@ struct SurfaceQuiltingStats {
   int welded_vertices = 0;  // base vertices merged with another at the same position
   int duplicate_faces = 0;  // base faces that repeated another, removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
-  int proxy_faces = 0;          // faces of the simplified base (0: the base was not simplified)
-  double proxy_error = 0;       // the simplification's largest quadric error (mesh units)
+  int proxy_faces = 0;         // faces of the simplified base (0: the base was not simplified)
+  double proxy_error = 0;      // the simplification's largest quadric error (mesh units)
   int patches_shrunk = 0;
   long long patch_faces = 0;  // faces of every local patch used (after shrinking), summed
   double swatch_scale = 0;  // factor applied to the swatch

@@ -12,7 +12,6 @@ namespace mq {
 
 namespace {
 
-
 // Eq. (8) for one tet, closed form; mirrored operation for operation in kernels/tet_stretch.cl.
 // J = S Tt^-1 = S adj(Tt) / det(Tt), with S and Tt holding the edges from corner 0 as columns.
 // adj(Tt) rows are the cross products of Tt's columns, so column k of J is

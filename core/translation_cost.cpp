@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 
 #include "core/errors.h"
 #include "core/fnv1a.h"
@@ -16,7 +17,6 @@
 namespace mq {
 
 namespace {
-
 
 // Eq. (1) for one point-face pair, given the squared distance. Kept in one place (and mirrored
 // in kernels/translation_cost.cl) so that every path evaluates it identically.
@@ -365,24 +365,31 @@ namespace {
 // The first `keep` indices of a stable sort of costs, ascending.
 std::vector<int> least_indices(const Eigen::VectorXd& costs, int keep) {
   std::vector<int> order(static_cast<std::size_t>(costs.size()));
-  for (int i = 0; i < costs.size(); ++i) order[static_cast<std::size_t>(i)] = i;
+  std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return costs(a) < costs(b); });
   order.resize(std::min(order.size(), static_cast<std::size_t>(keep)));
   std::sort(order.begin(), order.end());
   return order;
 }
 
+// The checks every least_cost_offsets makes, and its answer when there is nothing to choose
+// (no more offsets than kept: all of them, nothing evaluated). True when that answer is given.
+bool every_offset_kept(const TranslationCostProblem& problem, int keep,
+                       TranslationCostEvaluator::LeastCostOffsets& result) {
+  MQ_CHECK(keep >= 1, InvalidInput, "translation cost: keep must be >= 1, got ", keep);
+  validate_translation_cost_problem(problem);
+  if (problem.offsets.rows() > keep) return false;
+  result.kept.resize(static_cast<std::size_t>(problem.offsets.rows()));
+  std::iota(result.kept.begin(), result.kept.end(), 0);
+  return true;
+}
+
 }  // namespace
 
 TranslationCostEvaluator::LeastCostOffsets TranslationCostEvaluator::least_cost_offsets(
     const SwatchFaceTree& tree, const TranslationCostProblem& problem, int keep) {
-  MQ_CHECK(keep >= 1, InvalidInput, "translation cost: keep must be >= 1, got ", keep);
-  validate_translation_cost_problem(problem);
   LeastCostOffsets result;
-  if (problem.offsets.rows() <= keep) {
-    result.kept = least_indices(Eigen::VectorXd::Zero(problem.offsets.rows()), keep);
-    return result;
-  }
+  if (every_offset_kept(problem, keep, result)) return result;
   result.kept = least_indices(evaluate(tree, problem), keep);
   result.point_offsets = static_cast<long long>(problem.points.rows()) *
                          static_cast<long long>(problem.offsets.rows());
@@ -391,14 +398,9 @@ TranslationCostEvaluator::LeastCostOffsets TranslationCostEvaluator::least_cost_
 
 TranslationCostEvaluator::LeastCostOffsets TranslationCostCpu::least_cost_offsets(
     const SwatchFaceTree& tree, const TranslationCostProblem& problem, int keep) {
-  MQ_CHECK(keep >= 1, InvalidInput, "translation cost: keep must be >= 1, got ", keep);
-  validate_translation_cost_problem(problem);
-  const Eigen::Index P = problem.points.rows(), T = problem.offsets.rows();
   LeastCostOffsets result;
-  if (T <= keep) {
-    result.kept = least_indices(Eigen::VectorXd::Zero(T), keep);
-    return result;
-  }
+  if (every_offset_kept(problem, keep, result)) return result;
+  const Eigen::Index P = problem.points.rows(), T = problem.offsets.rows();
   // Exact sums (in point order, as sum_per_offset adds them) or +inf for a dropped offset.
   Eigen::VectorXd sums = Eigen::VectorXd::Constant(T, kInf);
   std::vector<long long> evaluated(static_cast<std::size_t>(T), 0);

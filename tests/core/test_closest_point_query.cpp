@@ -14,7 +14,6 @@
 namespace mq {
 namespace {
 
-
 // Uniform in [0, 1) from the raw engine output (portable across standard libraries).
 using test::uniform;
 using test::uniform01;

@@ -43,7 +43,8 @@ void expect_manifold(const TriMesh& m, bool closed) {
 double enclosed_volume(const TriMesh& m) {
   double v = 0;
   for (int f = 0; f < m.num_faces(); ++f)
-    v += Vector3d(m.V.row(m.F(f, 0))).dot(Vector3d(m.V.row(m.F(f, 1))).cross(m.V.row(m.F(f, 2)))) / 6;
+    v += Vector3d(m.V.row(m.F(f, 0))).dot(Vector3d(m.V.row(m.F(f, 1))).cross(m.V.row(m.F(f, 2)))) /
+         6;
   return v;
 }
 
@@ -138,7 +139,7 @@ TEST(QuadricSimplification, ATorusKeepsItsGenus) {
   EXPECT_EQ(euler_characteristic(s.mesh), 0);
 }
 
-TEST(QuadricSimplification, NothingToDoAtZeroErrorOnACurvedSurface) {
+TEST(QuadricSimplification, NoCollapseAtZeroErrorOnACurvedSurface) {
   const TriMesh sphere = test::icosphere(2);
   QuadricSimplificationOptions o;
   o.max_error = 0;

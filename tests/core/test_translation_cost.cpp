@@ -232,12 +232,18 @@ TEST(TranslationCost, InvalidTreeInputThrows) {
   EXPECT_THROW(SwatchFaceTree(cube.V, cube.F, 0), InvalidInput);
 }
 
+// The first n vertices of a torus, with their normals, as the points of a problem (offsets to
+// be set).
+TranslationCostProblem torus_vertex_problem(const TriMesh& torus, int n) {
+  TranslationCostProblem pb;
+  pb.points = torus.V.topRows(n);
+  pb.point_normals = vertex_normals(torus.V, torus.F).topRows(n);
+  return pb;
+}
+
 TEST(TranslationCost, CpuIsIndependentOfThreadCount) {
   const TriMesh torus = test::torus(2.0, 0.5, 32, 16);
-  const MatrixX3d N = vertex_normals(torus.V, torus.F);
-  TranslationCostProblem pb;
-  pb.points = torus.V.topRows(100);
-  pb.point_normals = N.topRows(100);
+  TranslationCostProblem pb = torus_vertex_problem(torus, 100);
   pb.offsets.resize(9, 3);
   for (int i = 0; i < 9; ++i) pb.offsets.row(i) << 0.1 * (i % 3), 0.1 * (i / 3), 0.0;
   const SwatchFaceTree tree(torus.V, torus.F);
@@ -293,10 +299,7 @@ TEST(TranslationCost, TreeQueryHintChangesNoMinimum) {
 // thread count, and it does skip work when some offsets are clearly worse.
 TEST(TranslationCost, CpuLeastCostOffsetsAreThoseOfSortingEveryCost) {
   const TriMesh torus = test::torus(2.0, 0.5, 32, 16);
-  const MatrixX3d N = vertex_normals(torus.V, torus.F);
-  TranslationCostProblem pb;
-  pb.points = torus.V.topRows(40);
-  pb.point_normals = N.topRows(40);
+  TranslationCostProblem pb = torus_vertex_problem(torus, 40);
   // 7 x 7 offsets around zero, the last rows repeating earlier ones: exact ties.
   pb.offsets.resize(56, 3);
   for (int i = 0; i < 49; ++i) pb.offsets.row(i) << 0.3 * (i % 7 - 3), 0.3 * (i / 7 - 3), 0.0;

@@ -30,11 +30,11 @@ TEST(LargeBase, ASplitBunnyCostsPerPatchWhatTheBunnyCosts) {
       "[ measure  ] bunny %d faces: %d patches of %.0f faces; split %d faces -> proxy of %d "
       "faces (error %.2e, shell height %.2e): %d patches of %.0f faces; elements %d / %d, "
       "coverage %.3f / %.3f\n",
-      bunny.num_faces(), coarse_run.stats.iterations, per_patch(coarse_run.stats),
-      fine.num_faces(), fine_run.stats.proxy_faces, fine_run.stats.proxy_error,
-      fine_run.quilt.shell_height, fine_run.stats.iterations, per_patch(fine_run.stats),
-      coarse_run.embedding_stats.elements, fine_run.embedding_stats.elements,
-      coarse_run.embedding_stats.coverage, fine_run.embedding_stats.coverage);
+      bunny.num_faces(), coarse_run.stats.iterations, per_patch(coarse_run.stats), fine.num_faces(),
+      fine_run.stats.proxy_faces, fine_run.stats.proxy_error, fine_run.quilt.shell_height,
+      fine_run.stats.iterations, per_patch(fine_run.stats), coarse_run.embedding_stats.elements,
+      fine_run.embedding_stats.elements, coarse_run.embedding_stats.coverage,
+      fine_run.embedding_stats.coverage);
   EXPECT_EQ(coarse_run.stats.proxy_faces, 0) << "70k faces: kept as given";
   EXPECT_GT(fine_run.stats.proxy_faces, 0);
   EXPECT_LT(fine_run.stats.proxy_faces, fine.num_faces() / 10);
