@@ -5,18 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 engine=$(realpath "${1:-build/meshquilt}")
-# Blender runs on the system Python; the add-on moves meshes with numpy.
-missing=()
-for p in blender python3-numpy; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  echo "test_blender: installing ${missing[*]}"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+bash scripts/install_blender.sh
 bash scripts/blender_addon.sh build/meshquilt_blender.zip
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

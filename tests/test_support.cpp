@@ -9,6 +9,10 @@
 
 namespace mq::test {
 
+std::string blender_base(const std::string& name) {
+  return std::string(MESHQUILT_BLENDER_BASES) + "/" + name;
+}
+
 std::string shared_data(const std::string& relative) {
   return std::string(MESHQUILT_SHARED_DATA) + "/" + relative;
 }

@@ -20,6 +20,10 @@ inline double uniform(std::mt19937_64& rng, double lo, double hi) {
 // Absolute path of a file in ../shared/data (e.g. "base/bunny_igl_7k.off").
 std::string shared_data(const std::string& relative);
 
+// Absolute path of a base exported by headless Blender (tests/data/export_blender_bases.py, the
+// build's `blender_bases` target), e.g. "uv_sphere_32x16.obj".
+std::string blender_base(const std::string& name);
+
 // The bytes of a file (empty when it cannot be read), and a file written with `text`.
 std::string slurp(const std::string& path);
 void spit(const std::string& path, const std::string& text);
