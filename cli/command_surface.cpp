@@ -91,6 +91,10 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("orbits", global->orbits)
         .value("singular_vertices", global->singular_vertices)
         .value("cancelled_cone_pairs", global->cancelled_cone_pairs)
+        .value("split_poles", global->split_poles)
+        .value("cone_moves", global->cone_moves)
+        .value("scale_energy_before", global->scale_energy_before)
+        .value("scale_energy", global->scale_energy)
         .value("pinned_cones", global->pinned_cones)
         .value("cut_edges", global->cut_edges)
         .value("cut_paths", global->cut_paths)
@@ -99,6 +103,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("parameter_area", global->parameter_area)
         .value("placed", global->placed)
         .value("off_surface", global->off_surface)
+        .value("copied_elements", global->copied_elements)
         .end_object();
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
   j.begin_object("stage_seconds");

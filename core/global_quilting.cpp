@@ -8,6 +8,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "core/cone_placement.h"
 #include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
@@ -17,7 +18,9 @@
 #include "core/planar_quilting.h"
 #include "core/quilt_elements.h"
 #include "core/swatch_symmetry.h"
+#include "core/straightest_geodesic.h"
 #include "core/tangent_field.h"
+#include "core/trivial_connection.h"
 #include "core/weld_vertices.h"
 
 namespace mq {
@@ -77,6 +80,235 @@ bool share_wedge(const GlobalParameterization& gp, int f, int g) {
     for (int j = 0; j < 3; ++j)
       if (gp.corner_wedge(f, i) == gp.corner_wedge(g, j)) return true;
   return false;
+}
+
+// The element with plane coordinates P (#V by 3: x, y in f0's chart, z the height) carried onto
+// the base from face f0, vertex by vertex, each walk starting where the previous one ended.
+// False when a vertex lies beyond a boundary or around a singular vertex. turn (optional)
+// receives per vertex the sign of the chart transition from f0's chart to its face's (+1, or -1
+// across a half turn).
+bool place_from(const GlobalParameterization& gp, const SurfaceJob& job, const MatrixX3d& P,
+                int f0, double shell_height, SurfaceElement& s,
+                std::vector<signed char>* turn = nullptr) {
+  s.face.resize(P.rows());
+  s.barycentric.resize(P.rows(), 3);
+  s.height.resize(P.rows());
+  int face = f0;
+  ChartTransform to_current;  // from f0's chart to the walk's current face's
+  for (Eigen::Index v = 0; v < P.rows(); ++v) {
+    Vector2d x = to_current(P.row(v).head<2>().transpose());
+    Vector3d b;
+    if (!locate_in_charts(gp, job.topo, job.TT, job.base.F, face, x, b, 256, &to_current))
+      return false;
+    s.face[v] = face;
+    s.barycentric.row(v) = b.transpose();
+    s.height(v) = std::clamp(P(v, 2), 0.0, shell_height);
+    if (turn) turn->push_back(static_cast<signed char>(to_current.sigma));
+  }
+  s.flat = P;
+  return true;
+}
+
+// The layout's differential on each face of the base: the 2 by 3 map taking a tangent vector
+// of the face to the plane (plane units per surface unit), rows in the face's plane; zero where
+// the face or its chart triangle is degenerate or flipped. #F by 6 (row 0, then row 1).
+Eigen::MatrixXd layout_differential(const GlobalParameterization& gp, const TriMesh& base) {
+  const FaceFrames fr = face_frames(base.V, base.F);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(base.num_faces(), 6);
+  for (int f = 0; f < base.num_faces(); ++f) {
+    const Vector3d x0 = base.V.row(base.F(f, 0)), x1 = base.V.row(base.F(f, 1)),
+                   x2 = base.V.row(base.F(f, 2));
+    const Vector3d b1 = fr.b1.row(f).transpose(), b2 = fr.b2.row(f).transpose();
+    Eigen::Matrix2d E3, Q;
+    E3 << (x1 - x0).dot(b1), (x2 - x0).dot(b1), (x1 - x0).dot(b2), (x2 - x0).dot(b2);
+    Q.col(0) = gp.uv(f, 1) - gp.uv(f, 0);
+    Q.col(1) = gp.uv(f, 2) - gp.uv(f, 0);
+    if (!(std::abs(E3.determinant()) > 0)) continue;
+    const Eigen::Matrix2d J = Q * E3.inverse();
+    if (!(J.determinant() > 0)) continue;
+    out.row(f).head<3>() = (J(0, 0) * b1 + J(0, 1) * b2).transpose();
+    out.row(f).tail<3>() = (J(1, 0) * b1 + J(1, 1) * b2).transpose();
+  }
+  return out;
+}
+
+// Whether an element carried through the layout keeps the swatch element's shape: the
+// layout's differential averaged over the faces its vertices lie on is nearly a similarity
+// (singular values s1 / s2 at most max_element_aspect) not much larger than the texture (element
+// scale 1 / sqrt(s1 s2) at most max_element_scale), and the same one
+// across it (the scales of the element's two halves, split across its longest footprint axis,
+// within max_element_variation of each other: no teardrop), each face's differential taken into
+// the element's chart (turn: place_from's). Intrinsic: the surface's bending
+// of the element is not distortion; averaged: the layout's per-triangle noise is not either.
+// Smaller elements pass: they lie where the layout gathers curvature (around + cones), are
+// linked as densely as the lattice there, and an even copy of full size would collide.
+bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P,
+                         const SurfaceElement& s, const std::vector<signed char>& turn,
+                         const SurfaceQuiltingOptions::Global& options,
+                         Eigen::Matrix<double, 2, 3>& mean) {
+  if (s.face.empty()) return true;
+  // The halves: either side of the centre along the footprint's x or y, whichever is longer.
+  const Eigen::RowVector2d lo = P.leftCols<2>().colwise().minCoeff(),
+                           hi = P.leftCols<2>().colwise().maxCoeff();
+  const int axis = (hi - lo)(0) >= (hi - lo)(1) ? 0 : 1;
+  const double mid = 0.5 * (lo(axis) + hi(axis));
+  Eigen::Matrix<double, 2, 3> sum[2] = {Eigen::Matrix<double, 2, 3>::Zero(),
+                                        Eigen::Matrix<double, 2, 3>::Zero()};
+  int count[2] = {0, 0};
+  for (size_t v = 0; v < s.face.size(); ++v) {
+    // In the element's own chart: across a half-turn transition the differential is negated.
+    const Eigen::RowVectorXd d = turn[v] * differential.row(s.face[v]);
+    if (d.squaredNorm() == 0) return false;
+    const int half = P(static_cast<Eigen::Index>(v), axis) < mid ? 0 : 1;
+    sum[half].row(0) += d.head<3>();
+    sum[half].row(1) += d.tail<3>();
+    ++count[half];
+  }
+  auto scale_of = [](const Eigen::Matrix<double, 2, 3>& m, double* aspect) {
+    const Eigen::JacobiSVD<Eigen::Matrix<double, 2, 3>> svd(m);
+    const double s1 = svd.singularValues()(0), s2 = svd.singularValues()(1);
+    if (aspect) *aspect = s2 > 0 ? s1 / s2 : std::numeric_limits<double>::infinity();
+    return std::sqrt(s1 * s2);
+  };
+  double aspect = 1;
+  mean = (sum[0] + sum[1]) / static_cast<double>(count[0] + count[1]);
+  const double all = scale_of(mean, &aspect);
+  if (!(all > 0)) return false;
+  const double element_scale = 1 / all;
+  bool even = true;
+  if (count[0] > 0 && count[1] > 0) {
+    const double a = scale_of(sum[0] / count[0], nullptr), b = scale_of(sum[1] / count[1], nullptr);
+    even = std::max(a, b) <= options.max_element_variation * std::min(a, b);
+  }
+  return element_scale <= options.max_element_scale && aspect <= options.max_element_aspect &&
+         even;
+}
+
+// The element as the layout's first-order image at its centre, bent only by the surface: its
+// centre is located through the layout, and every vertex's offset from the centre, taken
+// through the inverse of the layout's differential M (2 by 3, plane per surface unit), is walked
+// along the surface as a straightest geodesic. Where M is far from a similarity (aspect over
+// max_element_aspect) only its rotation and mean scale are kept; the scale makes the element
+// 1 / sqrt(s1 s2) times the swatch's, clamped to [1 / max_element_scale, max_element_scale]. So
+// an element keeps its place among neighbours laid out through the layout to first order (its
+// links), and loses only the layout's variation across it (a teardrop's) and extreme sizes.
+bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
+                  const Eigen::Matrix<double, 2, 3>& M, const MatrixX3d& P,
+                  const Vector2d& centre, int f, double shell_height, bool similarity,
+                  const SurfaceQuiltingOptions::Global& options, SurfaceElement& s) {
+  const MatrixX3i& F = job.base.F;
+  const Eigen::JacobiSVD<Eigen::Matrix<double, 2, 3>> svd(M, Eigen::ComputeFullU |
+                                                                Eigen::ComputeThinV);
+  Vector2d sv = svd.singularValues();
+  if (!(sv(1) > 0)) return false;
+  const double sigma = std::sqrt(sv(0) * sv(1));
+  if (similarity || sv(0) > options.max_element_aspect * sv(1)) sv.setConstant(sigma);
+  const double k = std::clamp(1.0 / sigma, 1.0 / options.max_element_scale,
+                              options.max_element_scale);
+  // Plane offset -> surface offset: V diag(1 / sv) U^T, rescaled to the clamped size.
+  const Eigen::Matrix<double, 3, 2> inverse =
+      (k * sigma) * svd.matrixV() * sv.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
+  // The centre's barycentric coordinates in f's chart triangle.
+  const Vector2d u0 = gp.uv(f, 0);
+  Eigen::Matrix2d Q;
+  Q.col(0) = gp.uv(f, 1) - u0;
+  Q.col(1) = gp.uv(f, 2) - u0;
+  if (!(std::abs(Q.determinant()) > 0)) return false;
+  const Vector2d w = Q.inverse() * (centre - u0);
+  Vector3d bc(1 - w.x() - w.y(), w.x(), w.y());
+  bc = bc.cwiseMax(0.0);
+  bc /= bc.sum();
+  s.face.resize(P.rows());
+  s.barycentric.resize(P.rows(), 3);
+  s.height.resize(P.rows());
+  for (Eigen::Index v = 0; v < P.rows(); ++v) {
+    const Vector3d offset = inverse * (P.row(v).head<2>().transpose() - centre);
+    int face = f;
+    Vector3d b = bc;
+    if (!straightest_walk(job.base.V, F, job.TT, face, b, offset)) return false;
+    s.face[v] = face;
+    s.barycentric.row(v) = b.transpose();
+    // A copy made smaller keeps its proportions; a larger one keeps its height (the shell's).
+    s.height(v) = std::clamp(std::min(k, 1.0) * P(v, 2), 0.0, shell_height);
+  }
+  // The flat shape the fold repair falls back to: the copy at the size it was placed at.
+  s.flat = P;
+  for (Eigen::Index v = 0; v < P.rows(); ++v)
+    s.flat.row(v).head<2>() = (centre + k * (P.row(v).head<2>().transpose() - centre)).transpose();
+  return true;
+}
+
+// One lattice copy of an orbit representative whose centre lies in a chart triangle.
+struct LatticeCopy {
+  int rep = 0;                            // index into the representatives
+  Eigen::Vector2i k = Eigen::Vector2i::Zero();  // lattice coordinates of its translation
+  int face = 0;                           // a base face whose chart triangle holds its centre
+  bool operator<(const LatticeCopy& o) const {
+    if (rep != o.rep) return rep < o.rep;
+    if (k.y() != o.k.y()) return k.y() < o.k.y();
+    if (k.x() != o.k.x()) return k.x() < o.k.x();
+    return face < o.face;
+  }
+};
+
+// Every copy of every representative (centre c_r + lattice, in plane coordinates) that lies in
+// the chart triangle of some face, one per place on the surface: faces of one chart around a
+// centre on their common edge or vertex are the same place. Only the lattice points over the
+// triangles are visited, so the work and memory follow the surface's parameter area, not the
+// box around the charts (Blender's UV sphere, whose charts spread over a plane 60 times their
+// area, ran out of memory when the box was tiled). Sorted by representative, then lattice row
+// and column: deterministic.
+std::vector<LatticeCopy> lattice_copies(const GlobalParameterization& gp, int num_faces,
+                                        const SwatchSymmetry& sym,
+                                        const std::vector<Vector2d>& centres) {
+  Eigen::Matrix2d basis;
+  basis.col(0) = sym.a;
+  basis.col(1) = sym.b;
+  const Eigen::Matrix2d inv = basis.inverse();
+  std::vector<std::vector<LatticeCopy>> per(static_cast<size_t>(num_faces));
+  tbb::parallel_for(0, num_faces, [&](int f) {
+    const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
+    const Vector2d e0 = b - a, e1 = c - a;
+    const double den = e0.x() * e1.y() - e1.x() * e0.y();
+    if (!(std::abs(den) > 0)) return;
+    for (size_t r = 0; r < centres.size(); ++r) {
+      Vector2d kmin = Vector2d::Constant(std::numeric_limits<double>::infinity()), kmax = -kmin;
+      for (const Vector2d& q : {a, b, c}) {
+        const Vector2d k = inv * (q - centres[r]);
+        kmin = kmin.cwiseMin(k);
+        kmax = kmax.cwiseMax(k);
+      }
+      for (long j = static_cast<long>(std::ceil(kmin.y() - 1e-9));
+           j <= static_cast<long>(std::floor(kmax.y() + 1e-9)); ++j)
+        for (long i = static_cast<long>(std::ceil(kmin.x() - 1e-9));
+             i <= static_cast<long>(std::floor(kmax.x() + 1e-9)); ++i) {
+          const Vector2d d =
+              centres[r] + basis * Vector2d(static_cast<double>(i), static_cast<double>(j)) - a;
+          const double v = (d.x() * e1.y() - e1.x() * d.y()) / den;
+          const double w = (e0.x() * d.y() - d.x() * e0.y()) / den;
+          if (v >= 0 && w >= 0 && v + w <= 1)
+            per[static_cast<size_t>(f)].push_back(
+                {static_cast<int>(r), Eigen::Vector2i(static_cast<int>(i), static_cast<int>(j)), f});
+        }
+    }
+  });
+  std::vector<LatticeCopy> all;
+  for (auto& p : per) all.insert(all.end(), p.begin(), p.end());
+  std::sort(all.begin(), all.end());
+  // One per place: a copy found in several faces of one chart that share a corner group.
+  std::vector<LatticeCopy> out;
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j].rep == all[i].rep && all[j].k == all[i].k) ++j;
+    const size_t first = out.size();
+    for (size_t q = i; q < j; ++q) {
+      bool same = false;
+      for (size_t o = first; o < out.size() && !same; ++o) same = share_wedge(gp, all[q].face, out[o].face);
+      if (!same) out.push_back(all[q]);
+    }
+    i = j;
+  }
+  return out;
 }
 
 }  // namespace
@@ -155,9 +387,11 @@ Vector2d nearest_symmetry(const SwatchSymmetry& sym, const Vector2d& x, const Ve
 // more solve of the same size.
 GlobalParameterization seamless_parameterization(const MatrixX3d& V, const TriMesh& base,
                                                  const SurfaceJob& job, const DirectionField& df,
+                                                 const Eigen::VectorXd& face_scale,
                                                  const SwatchSymmetry& sym, bool seamless,
                                                  Vector2d& anchor, GlobalQuiltingStats& stats) {
   GlobalParameterizationOptions go;
+  go.face_scale = face_scale;
   GlobalParameterization gp = global_parameterization(V, base.F, job.topo, job.TT, df, go);
   const double sigma = median_scale(gp, base);
   gp.wedge_uv /= sigma;
@@ -236,6 +470,177 @@ GlobalParameterization seamless_parameterization(const MatrixX3d& V, const TriMe
 
 namespace {
 
+// The lattice of a tileable swatch carried onto the base (section 2's quilt of such a swatch is
+// its lattice tiling, core/swatch_symmetry): every copy whose centre lies on the parameterised
+// surface, placed from the face holding its centre. The output is counted before anything is
+// built, and refused over max_faces.
+std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, const SurfaceJob& job,
+                                          const PreparedSwatch& swatch,
+                                          const SwatchSymmetry& sym, const Vector2d& lo,
+                                          const SurfaceQuiltingOptions& options,
+                                          GlobalQuiltingStats& gstats, StageTimes& times,
+                                          ProgressSink* progress) {
+  const double max_faces = options.max_faces;
+  std::vector<int> reps;
+  std::vector<Vector2d> centres;
+  std::vector<LatticeCopy> copies;
+  {
+    ScopedStageTimer timer(times, "tiling");
+    ScopedStageProgress shown(progress, "tiling");
+    reps = orbit_representatives(swatch, sym);
+    gstats.orbits = static_cast<int>(reps.size());
+    for (const int r : reps) centres.push_back(element_centre(swatch.elements[r]) + lo);
+    copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
+    double faces = 0;
+    for (const LatticeCopy& c : copies)
+      faces += static_cast<double>(swatch.elements[reps[c.rep]].F.rows());
+    MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", copies.size(),
+             " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
+             " (--max-faces); use a larger --scale");
+    for (int f = 0; f < job.base.num_faces(); ++f) {
+      const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
+      gstats.parameter_area += 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    }
+  }
+  ScopedStageTimer timer(times, "placement");
+  ScopedStageProgress shown(progress, "placement");
+  Eigen::Matrix2d basis;
+  basis.col(0) = sym.a;
+  basis.col(1) = sym.b;
+  const Eigen::MatrixXd differential = layout_differential(gp, job.base);
+  const int n = static_cast<int>(copies.size());
+  std::vector<SurfaceElement> out(copies.size());
+  std::vector<char> ok(copies.size(), 0), copied(copies.size(), 0);
+  // In blocks, so that progress is reported from this thread between them (each copy's
+  // placement depends only on it: the result is the same whatever the blocks).
+  const int block = std::max(64, n / 50);
+  for (int first = 0; first < n; first += block) {
+    report_progress(progress, "placement", first, n);
+    tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
+      const LatticeCopy& c = copies[static_cast<size_t>(i)];
+      const Element& e = swatch.elements[static_cast<size_t>(reps[c.rep])];
+      const Vector2d t = lo + basis * c.k.cast<double>();
+      MatrixX3d P = e.V;
+      P.col(0).array() += t.x();
+      P.col(1).array() += t.y();
+      SurfaceElement& s = out[static_cast<size_t>(i)];
+      s.F = e.F;
+      s.kind = e.kind;
+      const Vector2d centre = centres[static_cast<size_t>(c.rep)] + basis * c.k.cast<double>();
+      using Placement = SurfaceQuiltingOptions::Global::Placement;
+      const Placement mode = options.global.placement;
+      // The layout's differential at the centre's face, or averaged over the element.
+      Eigen::Matrix<double, 2, 3> M;
+      M.row(0) = differential.row(c.face).head<3>();
+      M.row(1) = differential.row(c.face).tail<3>();
+      bool placed_ok = false;
+      if (mode != Placement::kRigid) {
+        std::vector<signed char> turn;
+        placed_ok = place_from(gp, job, P, c.face, swatch.size.z(), s, &turn);
+        if (placed_ok && mode == Placement::kAdaptive &&
+            !within_shape_limits(differential, P, s, turn, options.global, M))
+          placed_ok = false;
+      }
+      if (!placed_ok && mode != Placement::kLayout) {
+        placed_ok = place_linear(gp, job, M, P, centre, c.face, swatch.size.z(),
+                                 mode == Placement::kRigid, options.global, s);
+        copied[static_cast<size_t>(i)] = placed_ok;
+      }
+      ok[static_cast<size_t>(i)] = placed_ok;
+    });
+  }
+  std::vector<SurfaceElement> placed;
+  placed.reserve(copies.size());
+  for (size_t i = 0; i < copies.size(); ++i) {
+    if (ok[i])
+      placed.push_back(std::move(out[i]));
+    else
+      ++gstats.off_surface;
+    gstats.copied_elements += copied[i];
+  }
+  return placed;
+}
+
+// A quilted plane texture (a swatch that is not a lattice of separate elements) carried onto
+// the base: every element from each face whose chart contains its centre.
+std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const SurfaceJob& job,
+                                        const TriMesh& plane, double shell_height,
+                                        GlobalQuiltingStats& gstats, StageTimes& times,
+                                        ProgressSink* progress) {
+  ScopedStageTimer timer(times, "placement");
+  ScopedStageProgress shown(progress, "placement");
+  const ChartGrid grid(gp, job.base.num_faces());
+  std::vector<int> fc;
+  const int n = connected_components(plane.F, plane.num_vertices(), fc);
+  const std::vector<std::vector<int>> groups = component_faces(fc, n);
+  std::vector<std::vector<SurfaceElement>> per(static_cast<size_t>(n));
+  std::vector<int> off(static_cast<size_t>(n), 0);
+  const int block = std::max(64, n / 50);
+  for (int first = 0; first < n; first += block) {
+    report_progress(progress, "placement", first, n);
+    tbb::parallel_for(first, std::min(n, first + block), [&](int c) {
+      const TriMesh part = extract_faces(plane, groups[c]);
+      const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
+      // One placement per place on the surface: faces of one chart around the centre (it lies
+      // on their common edge or vertex) are the same place.
+      std::vector<int> starts;
+      for (const int f : grid.containing(centre)) {
+        bool same = false;
+        for (const int g : starts) same = same || share_wedge(gp, f, g);
+        if (!same) starts.push_back(f);
+      }
+      for (const int f0 : starts) {
+        SurfaceElement s;
+        s.F = part.F;
+        s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
+        if (place_from(gp, job, part.V, f0, shell_height, s))
+          per[c].push_back(std::move(s));
+        else
+          ++off[c];
+      }
+    });
+  }
+  std::vector<SurfaceElement> placed;
+  for (int c = 0; c < n; ++c) {
+    gstats.off_surface += off[c];
+    for (SurfaceElement& s : per[c]) placed.push_back(std::move(s));
+  }
+  return placed;
+}
+
+// The line field whose singularities are the layout's first cones, on the smoothed copy V of
+// the base. The guidance (the user's field, or the smooth default along the longest box axis)
+// is followed weakly; when that leaves a pole (an index-1 singularity), the smoothest line
+// field, turned towards the guidance. Always the smoothest field measured worse on the shipped
+// bases (interior rings with 4 links, weighted / smoothest: knight 87.9 / 72.1%, bunny 96.5 /
+// 94.3%, Spot 95.3 / 94.0%, cup 98.4 / 97.8%); the weighted fit left poles on a smoothed
+// icosphere. A pole left even so (Blender's UV sphere: both poles, where 32 thin triangles
+// meet) is split by the cone placement.
+DirectionField layout_line_field(const MatrixX3d& V, const SurfaceJob& job,
+                                 const SurfaceQuiltingOptions::Global& options,
+                                 GlobalQuiltingStats& gstats) {
+  const MatrixX3i& F = job.base.F;
+  LineFieldOptions lo;
+  lo.N = 2;
+  lo.guidance_weight = options.guidance_weight;
+  DirectionField df = smooth_direction_field(V, F, job.topo, job.TT, job.field, lo);
+  const auto has_pole = [](const DirectionField& f) {
+    for (const int i : f.index)
+      if (i != 0 && i % f.N == 0) return true;
+    return false;
+  };
+  if (has_pole(df)) {
+    lo.smoothest = true;
+    df = smooth_direction_field(V, F, job.topo, job.TT, job.field, lo);
+  }
+  // A + and a - cone side by side (the tip and the foot of a spike one ring across) serve no
+  // ring and each wrecks the rings around it (knight: 8 such pairs of 42 cones; rings off the
+  // surface 63 -> 17; with ring separation, interior rings with 4 links 89.5 -> 91.3%).
+  if (options.cancel_cone_pairs)
+    gstats.cancelled_cone_pairs = cancel_singular_pairs(V, F, job.topo, df);
+  return df;
+}
+
 // The global method from a prepared job and the swatch's symmetry (found on job.swatch).
 SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch,
                                    const SwatchSymmetry& symmetry,
@@ -249,44 +654,50 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   stats.shell_height = swatch.size.z();
   gstats.periodic = symmetry.periodic;
 
-  // The line field and the parameterisation, on a smoothed copy of the base (same
-  // connectivity): detail of an edge's size would otherwise put a cone at every sharp corner of
-  // a coarse model. Measured, interior rings with the swatch's 4 links, without / with one step:
-  // Spot 93.8 / 95.5%, knight 82.3 / 87.3%, bunny 95.7 / 96.8%, cup 97.9 / 98.6%.
+  // The line field on a smoothed copy of the base (same connectivity): detail of an edge's size
+  // would otherwise put a cone at every sharp corner of a coarse model. Measured, interior rings
+  // with the swatch's 4 links, without / with one step: Spot 93.8 / 95.5%, knight 82.3 / 87.3%,
+  // bunny 95.7 / 96.8%, cup 97.9 / 98.6% (before the conformal layout, which keeps the field's
+  // cones but moves them and lays the texture out on the base itself: the layout computed on
+  // the smoothed copy and carried back to the base by barycentric coordinates took on the
+  // smoothing's tangential drift, median element aspect 1.12 against 1.05 on Spot).
   GlobalParameterization gp;
   Vector2d anchor = Vector2d::Zero();
   {
     ScopedStageTimer timer(times, "parameterization");
     ScopedStageProgress shown(progress, "parameterization");
-    const MatrixX3d V = options.global.smoothing > 0
-                            ? smoothed_positions(base, job.topo, options.global.smoothing)
-                            : base.V;
-    // The guidance (the user's field, or the smooth default along the longest box axis) is
-    // followed weakly; when that leaves a pole (an index-1 singularity: no cut can end there,
-    // the charts would fold around it), the smoothest line field, turned towards the guidance.
-    // Always the smoothest field measured worse on the shipped bases (interior rings with 4
-    // links, weighted / smoothest: knight 87.9 / 72.1%, bunny 96.5 / 94.3%, Spot 95.3 / 94.0%,
-    // cup 98.4 / 97.8%); the weighted fit left poles on a smoothed icosphere.
-    LineFieldOptions lo;
-    lo.N = 2;
-    lo.guidance_weight = options.global.guidance_weight;
-    DirectionField df = smooth_direction_field(V, base.F, job.topo, job.TT, job.field, lo);
-    const auto has_pole = [](const DirectionField& f) {
-      for (const int i : f.index)
-        if (i != 0 && i % f.N == 0) return true;
-      return false;
-    };
-    if (!lo.smoothest && has_pole(df)) {
-      lo.smoothest = true;
-      df = smooth_direction_field(V, base.F, job.topo, job.TT, job.field, lo);
+    const MatrixX3d smoothed = options.global.smoothing > 0
+                                   ? smoothed_positions(base, job.topo, options.global.smoothing)
+                                   : base.V;
+    DirectionField df = layout_line_field(smoothed, job, options.global, gstats);
+    // The cones moved to where they flatten the surface with the least change of scale, and
+    // the field made parallel in their flat metric, whose scale e^u the layout then follows:
+    // the map is conformal, elements keep their shape (issue 23: rings on a sphere were
+    // 1.14x by 0.75x the swatch's, median aspect 1.9).
+    Eigen::VectorXd face_scale;
+    const MatrixX3d* layout_V = &smoothed;
+    if (options.global.conformal) {
+      const TrivialConnection connection(base.V, base.F, job.topo, job.TT, df.N);
+      if (connection.unbalanced_component(df.index) < 0) {
+        ConePlacementReport report;
+        const std::vector<int> cones =
+            place_cones(connection, df.index, vertex_adjacency(base.F, base.num_vertices()),
+                        {}, &report);
+        gstats.split_poles = report.split_poles;
+        gstats.cone_moves = report.moves;
+        gstats.scale_energy_before = report.energy_before;
+        gstats.scale_energy = report.energy_after;
+        const ConeMetric metric = connection.solve(cones, job.field);
+        df = metric.field;
+        face_scale.resize(base.num_faces());
+        for (int f = 0; f < base.num_faces(); ++f)
+          face_scale(f) = std::exp(
+              (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) + metric.u(base.F(f, 2))) / 3);
+        layout_V = &base.V;
+      }
     }
-    // A + and a - cone side by side (the tip and the foot of a spike one ring across) serve no
-    // ring and each wrecks the rings around it (knight: 8 such pairs of 42 cones; rings off the
-    // surface 63 -> 17; with ring separation, interior rings with 4 links 89.5 -> 91.3%).
-    if (options.global.cancel_cone_pairs)
-      gstats.cancelled_cone_pairs = cancel_singular_pairs(V, base.F, job.topo, df);
-    gp = seamless_parameterization(V, base, job, df, symmetry, options.global.seamless, anchor,
-                                   gstats);
+    gp = seamless_parameterization(*layout_V, base, job, df, face_scale, symmetry,
+                                   options.global.seamless, anchor, gstats);
   }
   gstats.singular_vertices = gp.num_singular;
   gstats.cut_edges = gp.num_cut_edges;
@@ -304,28 +715,26 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
                                Vector2d::Zero());
     lo = anchor - shift;
   }
-  PlanarQuiltingOptions po;
-  po.length = std::max(hi.x() - lo.x(), swatch.size.x());
-  po.width = std::max(hi.y() - lo.y(), swatch.size.y());
-  po.matching = options.matching;
-  po.matching.refine_to = PlanarQuiltingOptions().matching.refine_to;
-  po.correspondence = options.patch.correspondence;
-  po.merging = options.patch.merging;
-  po.deform = options.patch.deform;
-  po.seed = options.seed;
-  gstats.parameter_area = po.length * po.width;
-  TriMesh plane;
+  std::vector<SurfaceElement> placed;
   if (options.global.tile && tileable(swatch, symmetry)) {
-    ScopedStageTimer timer(times, "tiling");
-    ScopedStageProgress shown(progress, "tiling");
-    plane = tile_lattice(swatch, symmetry, Vector2d::Zero(), Vector2d(po.length, po.width),
-                         &gstats.orbits);
     gstats.tiled = true;
     stats.iterations = 1;
     stats.cell_size = matching_cell_size(swatch);
+    placed = place_lattice(gp, job, swatch, symmetry, lo, options, gstats, times, progress);
   } else {
+    PlanarQuiltingOptions po;
+    po.length = std::max(hi.x() - lo.x(), swatch.size.x());
+    po.width = std::max(hi.y() - lo.y(), swatch.size.y());
+    po.matching = options.matching;
+    po.matching.refine_to = PlanarQuiltingOptions().matching.refine_to;
+    po.correspondence = options.patch.correspondence;
+    po.merging = options.patch.merging;
+    po.deform = options.patch.deform;
+    po.seed = options.seed;
+    po.max_faces = options.max_faces;
+    gstats.parameter_area = po.length * po.width;
     PlanarQuiltingStats ps;
-    plane = quilt_plane(job.swatch, po, evaluator, &ps, progress);
+    TriMesh plane = quilt_plane(job.swatch, po, evaluator, &ps, progress);
     stats.iterations = ps.iterations;
     stats.cell_size = ps.cell_size;
     stats.matched_point_offsets = ps.matched_point_offsets;
@@ -333,67 +742,9 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     for (const auto& [stage, seconds] : ps.times.stages()) times.add(stage, seconds);
     // Back into the synthesis frame (thickness along z).
     plane.V = (plane.V * swatch.rotation.transpose()).eval();
-  }
-  plane.V.col(0).array() += lo.x();
-  plane.V.col(1).array() += lo.y();
-
-  // Every element onto the base, from each face whose chart contains its centre.
-  std::vector<SurfaceElement> placed;
-  {
-    ScopedStageTimer timer(times, "placement");
-    ScopedStageProgress shown(progress, "placement");
-    const ChartGrid grid(gp, base.num_faces());
-    std::vector<int> fc;
-    const int n = connected_components(plane.F, plane.num_vertices(), fc);
-    const std::vector<std::vector<int>> groups = component_faces(fc, n);
-    std::vector<std::vector<SurfaceElement>> per(static_cast<size_t>(n));
-    std::vector<int> off(static_cast<size_t>(n), 0);
-    // In blocks, so that progress is reported from this thread between them (each element's
-    // placement depends only on it: the result is the same whatever the blocks).
-    const int block = std::max(64, n / 50);
-    for (int first = 0; first < n; first += block) {
-      report_progress(progress, "placement", first, n);
-      tbb::parallel_for(first, std::min(n, first + block), [&](int c) {
-        const TriMesh part = extract_faces(plane, groups[c]);
-        const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
-        // One placement per place on the surface: faces of one chart around the centre (it lies
-        // on their common edge or vertex) are the same place.
-        std::vector<int> starts;
-        for (const int f : grid.containing(centre)) {
-          bool same = false;
-          for (const int g : starts) same = same || share_wedge(gp, f, g);
-          if (!same) starts.push_back(f);
-        }
-        for (const int f0 : starts) {
-          SurfaceElement s;
-          s.F = part.F;
-          s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
-          s.face.resize(part.V.rows());
-          s.barycentric.resize(part.V.rows(), 3);
-          s.height.resize(part.V.rows());
-          int face = f0;
-          ChartTransform to_current;  // from f0's chart to the walk's current face's
-          bool ok = true;
-          for (Eigen::Index v = 0; v < part.V.rows() && ok; ++v) {
-            Vector2d x = to_current(part.V.row(v).head<2>().transpose());
-            Vector3d b;
-            ok = locate_in_charts(gp, job.topo, job.TT, base.F, face, x, b, 256, &to_current);
-            s.face[v] = face;
-            s.barycentric.row(v) = b.transpose();
-            s.height(v) = std::clamp(part.V(v, 2), 0.0, swatch.size.z());
-          }
-          if (ok) {
-            s.flat = part.V;
-            per[c].push_back(std::move(s));
-          } else
-            ++off[c];
-        }
-      });
-    }
-    for (int c = 0; c < n; ++c) {
-      gstats.off_surface += off[c];
-      for (SurfaceElement& s : per[c]) placed.push_back(std::move(s));
-    }
+    plane.V.col(0).array() += lo.x();
+    plane.V.col(1).array() += lo.y();
+    placed = place_plane(gp, job, plane, swatch.size.z(), gstats, times, progress);
   }
   gstats.placed = static_cast<int>(placed.size());
 

@@ -22,6 +22,10 @@ struct GlobalQuiltingStats {
   int orbits = 0;             // elements per lattice cell, when tiled
   int singular_vertices = 0;  // of the line field, after cancelling adjacent pairs
   int cancelled_cone_pairs = 0;
+  // Cone placement (core/cone_placement): poles split, moves, and the mean squared log scale
+  // of the flat cone metric before and after.
+  int split_poles = 0, cone_moves = 0;
+  double scale_energy_before = 0, scale_energy = 0;
   int pinned_cones = 0;
   int cut_edges = 0, cut_paths = 0;
   // Largest distance of a transition from the texture's nearest symmetry, in lattice periods
@@ -31,6 +35,9 @@ struct GlobalQuiltingStats {
   double parameter_area = 0;    // of the parameter plane textured
   int placed = 0;               // elements carried onto the base
   int off_surface = 0;          // left out: a vertex beyond a boundary or around a singular vertex
+  // Placed as copies of the layout's first-order image at their centre (the layout itself
+  // would have distorted them; SurfaceQuiltingOptions::Global::placement).
+  int copied_elements = 0;
 };
 
 // Like quilt_surface (same options, same result), through a global parameterisation.

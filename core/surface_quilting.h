@@ -92,6 +92,24 @@ struct SurfaceQuiltingOptions {
     bool seamless = true;
     // Cancel + and - cones at the two ends of one edge (cancel_singular_pairs).
     bool cancel_cone_pairs = true;
+    // Move the cones for the least change of scale (core/cone_placement) and lay the texture
+    // out conformally, by the field parallel in their flat metric scaled by e^u
+    // (core/trivial_connection); false: unit frames of the smooth line field.
+    bool conformal = true;
+    // How a lattice element is carried onto the base: through the layout vertex by vertex
+    // (kLayout: it keeps its place among its neighbours exactly, and takes the layout's
+    // distortion across it); as a copy of the layout's first-order image at its centre whose
+    // offsets are walked along the surface, a similarity (kRigid: bent by the surface only);
+    // or through the layout where that keeps its shape and as a first-order copy elsewhere
+    // (kAdaptive). The shape is kept when the layout there is nearly a similarity (aspect at
+    // most max_element_aspect), the same one across the element (its halves' scales within
+    // max_element_variation) and the element at most max_element_scale times the swatch's. A
+    // copy's size is clamped to [1 / max_element_scale, max_element_scale] times the swatch's.
+    enum class Placement { kLayout, kRigid, kAdaptive };
+    Placement placement = Placement::kAdaptive;
+    double max_element_scale = 1.3;
+    double max_element_aspect = 1.3;
+    double max_element_variation = 1.3;
     // A periodic swatch of compact elements is tiled over the parameter plane (the planar
     // quilt it would give); else the plane is quilted.
     bool tile = true;

@@ -87,6 +87,38 @@ TriMesh plane_grid(double w, double h, int nx, int ny) {
   return g;
 }
 
+TriMesh uv_sphere(double r, int segments, int rings) {
+  TriMesh m;
+  const int rows = rings - 1;  // vertex rows between the poles
+  m.V.resize(rows * segments + 2, 3);
+  for (int i = 0; i < rows; ++i) {
+    const double phi = M_PI * (i + 1) / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double theta = 2 * M_PI * j / segments;
+      m.V.row(i * segments + j) << r * std::sin(phi) * std::cos(theta),
+          r * std::sin(phi) * std::sin(theta), r * std::cos(phi);
+    }
+  }
+  const int north = rows * segments, south = north + 1;
+  m.V.row(north) << 0, 0, r;
+  m.V.row(south) << 0, 0, -r;
+  std::vector<Eigen::Vector3i> f;
+  for (int j = 0; j < segments; ++j) {
+    const int k = (j + 1) % segments;
+    f.emplace_back(north, j, k);
+    f.emplace_back(south, (rows - 1) * segments + k, (rows - 1) * segments + j);
+    for (int i = 0; i + 1 < rows; ++i) {
+      const int a = i * segments + j, b = i * segments + k, c = (i + 1) * segments + j,
+                d = (i + 1) * segments + k;
+      f.emplace_back(a, c, d);
+      f.emplace_back(a, d, b);
+    }
+  }
+  m.F.resize(static_cast<Eigen::Index>(f.size()), 3);
+  for (size_t i = 0; i < f.size(); ++i) m.F.row(static_cast<Eigen::Index>(i)) = f[i].transpose();
+  return m;
+}
+
 TriMesh open_cylinder(double r, double h, int n, int m) {
   TriMesh c;
   c.V.resize(n * (m + 1), 3);
