@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -370,6 +371,35 @@ TEST(TextureStructure, TwoRingKindsAreJudgedEachByItsOwnCount) {
     EXPECT_EQ(r.share_with_links(4),
               static_cast<double>(c.kinds[0].interior_rings) / r.interior_rings);
     EXPECT_NEAR(c.shape.size_max, 1.0, 1e-9);
+  }
+}
+
+// Every figure is the same whatever the thread count.
+TEST(TextureStructure, SameFiguresWhateverTheThreadCount) {
+  SquareMailOptions o;
+  o.rows = o.cols = 4;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  const TriMesh sheet = chainmail_square(o);
+  const SwatchStructure s = measure_swatch_structure(sheet);
+  TriMesh out = test::mapped(sheet, [](const Vector3d& p) { return test::over_cylinder(p, 6); });
+  StructureOptions so;
+  so.swatch = &s;
+  std::vector<StructureReport> r;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    r.push_back(measure_structure(out, so));
+  }
+  ASSERT_EQ(r[0].elements.size(), r[1].elements.size());
+  EXPECT_EQ(r[0].linked_pairs, r[1].linked_pairs);
+  for (size_t e = 0; e < r[0].elements.size(); ++e) {
+    const ElementStructure &a = r[0].elements[e], &b = r[1].elements[e];
+    EXPECT_EQ(a.links, b.links);
+    EXPECT_EQ(a.defect, b.defect);
+    EXPECT_EQ(a.opening, b.opening);
+    EXPECT_EQ(a.fold, b.fold);
+    EXPECT_EQ(a.size_ratio, b.size_ratio);
+    EXPECT_EQ(a.aspect, b.aspect);
   }
 }
 
