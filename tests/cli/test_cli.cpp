@@ -372,7 +372,8 @@ TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
   EXPECT_NEAR(std::stod(json_value(i.out, "density_ratio")), 1.0, 0.08);
   const std::string csv = slurp(dir + "/e.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends");
+            "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends,kind,defect,"
+            "loop_links,wire,opening,fold_degrees,size_ratio,aspect,stretch,by_correspondence");
   EXPECT_EQ(static_cast<int>(std::count(csv.begin(), csv.end(), '\n')) - 1,
             std::stoi(json_value(i.out, "rings")));
   EXPECT_EQ(meshquilt(dir, "info a.obj --links --swatch sw.obj --scale 0.07").status, 2);
@@ -389,6 +390,66 @@ TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
   EXPECT_EQ(c.status, 1);
   EXPECT_EQ(c.err_lines().size(), 1u);
   EXPECT_FALSE(fs::exists(dir + "/none.png"));
+}
+
+// Issue 23's honest measure as a user runs it, on the square 4-in-1 sheet quilted on a plane:
+// each ring judged against its own kind's count (flat rings 4, connectors 2) keeps 100%, no ring
+// is degenerate, every element is a copy of its swatch element's size and shape; the figures
+// are in the text, the JSON and the elements CSV, and render --color shape draws them.
+TEST(Cli, InfoLinksJudgesEachKindAndMeasuresShapes) {
+  const std::string dir = test::temp_dir();
+  const CliRun h = meshquilt(dir, "swatch --help");
+  EXPECT_NE(h.out.find("chainmail-square"), std::string::npos) << h.out;
+  ASSERT_EQ(
+      meshquilt(dir, "swatch chainmail-square --rows 4 --cols 4 --detail 16 -o sw.obj --quiet")
+          .status,
+      0);
+  ASSERT_EQ(meshquilt(dir, "plane --swatch sw.obj --size 20 20 -o p.obj --quiet").status, 0);
+  const CliRun t = meshquilt(dir, "info p.obj --links --swatch sw.obj --elements e.csv");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("interior link count per ring kind: ring 4, connector 2"), std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("structure kept:    100.00% of interior rings link as many others as their "
+                       "kind in the swatch"),
+            std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("ring:            100.00% of"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("connector:       100.00% of"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("degenerate rings:  0 (none)"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("size ratio:      median 1.000, 90th 1.000, 99th 1.000, largest 1.000"),
+            std::string::npos)
+      << t.out;
+  const CliRun j = meshquilt(dir, "info p.obj --links --swatch sw.obj --json");
+  ASSERT_EQ(j.status, 0) << j.err;
+  EXPECT_EQ(std::stod(json_value(j.out, "share_with_swatch_links")), 1.0);
+  EXPECT_EQ(json_value(j.out, "kind"), "\"ring\"");
+  EXPECT_EQ(std::stod(json_value(j.out, "share")), 1.0);
+  EXPECT_EQ(json_value(j.out, "degenerate_rings"), "0");
+  EXPECT_NEAR(std::stod(json_value(j.out, "p99")), 1.0, 1e-6);
+  EXPECT_EQ(json_value(j.out, "stretched_elements"), "0");
+  // One CSV line per element, each a copy of a swatch element of its kind.
+  const std::string csv = slurp(dir + "/e.csv");
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  int rows = 0, connectors = 0;
+  while (std::getline(lines, line)) {
+    ++rows;
+    connectors += line.find(",connector,none,") != std::string::npos;
+    EXPECT_EQ(line.substr(line.size() - 2), ",1") << line;  // by correspondence
+  }
+  EXPECT_EQ(rows, std::stoi(json_value(j.out, "rings")));
+  EXPECT_GT(connectors, rows / 2);
+  // render --color shape needs the swatch; with it, a picture.
+  EXPECT_EQ(meshquilt(dir, "render p.obj --color shape -o s.png").status, 2);
+  EXPECT_FALSE(fs::exists(dir + "/s.png"));
+  const CliRun r = meshquilt(
+      dir, "render p.obj --color shape --swatch sw.obj -o s.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir + "/s.png").substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const CliRun l = meshquilt(
+      dir, "render p.obj --color links --swatch sw.obj -o l.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(l.status, 0) << l.err;
 }
 
 TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
