@@ -68,6 +68,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("removed_self_intersecting", em.removed_self_intersecting)
       .value("rigid_repairs", em.rigid_repairs)
       .value("shrunk_to_fit", em.shrunk_to_fit)
+      .value("layout_versions", em.layout_versions)
       .value("separated_rings", em.separated_rings)
       .value("separation_reverted", em.separation_reverted)
       .value("separation_left_shell", em.separation_left_shell)
@@ -148,6 +149,12 @@ int run_surface(int argc, char** argv, int first) {
             "chain mail linked); patches: local conformal patches (the paper's); auto: global "
             "for a lattice of compact elements",
             "auto");
+  cl.option("element-placement", "adaptive|layout|rigid",
+            "global layout: how a lattice element reaches the surface. layout: through the "
+            "layout (keeps every link, takes its distortion); rigid: an even copy bent only by "
+            "the surface; adaptive: through the layout where that keeps the element's shape, an "
+            "even copy elsewhere",
+            "adaptive");
   add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
@@ -180,6 +187,14 @@ int run_surface(int argc, char** argv, int first) {
   embedding.seed = options.seed;
   options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
+  const std::string placement = cl.get("element-placement");
+  if (placement == "layout")
+    options.global.placement = SurfaceQuiltingOptions::Global::Placement::kLayout;
+  else if (placement == "rigid")
+    options.global.placement = SurfaceQuiltingOptions::Global::Placement::kRigid;
+  else if (placement != "adaptive")
+    throw UsageError("--element-placement expects adaptive, layout or rigid, got '" + placement +
+                     "'");
   const std::string method = cl.get("method");
   if (method != "auto" && method != "global" && method != "patches")
     throw UsageError("--method expects auto, global or patches, got '" + method + "'");

@@ -166,6 +166,49 @@ std::vector<std::pair<int, int>> updated_pairs(const SurfaceQuilt& quilt, const 
   return pairs;
 }
 
+// Elements dropped for touching a neighbour that have a version placed through the layout
+// (alternative rows first[k]..first[k + 1] of A) take it when it clears every kept element and
+// does not fold: an even copy of an element pressed into its neighbours (around a cone, where
+// the layout's spacing is smaller than the element) gives way to the layout's own, distorted
+// but threaded through its neighbours as the lattice is. Returns how many came back.
+int try_alternatives(const SurfaceQuilt& quilt, const std::vector<char>& folded,
+                     const MatrixX3d& A, const std::vector<Eigen::Index>& alternative_first,
+                     MatrixX3d& V, std::vector<char>& drop) {
+  if (A.rows() == 0) return 0;
+  const size_t ne = quilt.elements.size();
+  const std::vector<Eigen::Index> first = vertex_offsets(quilt);
+  ElementGrid grid(V, first, drop);
+  auto element_mesh = [&](size_t k) {
+    TriMesh m;
+    m.V = V.middleRows(first[k], first[k + 1] - first[k]);
+    m.F = quilt.elements[k].F;
+    return m;
+  };
+  int restored = 0;
+  for (size_t k = 0; k < ne; ++k) {
+    const Eigen::Index n = alternative_first[k + 1] - alternative_first[k];
+    if (!drop[k] || folded[k] || n == 0 || n != first[k + 1] - first[k]) continue;
+    TriMesh m;
+    m.V = A.middleRows(alternative_first[k], n);
+    m.F = quilt.elements[k].F;
+    if (!self_intersecting_components(m.V, m.F).empty()) continue;
+    BoundingBox b;
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v) b.extend(m.V.row(v).transpose());
+    bool clear = true;
+    for (const int j : grid.near(b))
+      if (static_cast<size_t>(j) != k && !drop[j] && meshes_intersect(m, element_mesh(j))) {
+        clear = false;
+        break;
+      }
+    if (!clear) continue;
+    V.middleRows(first[k], n) = m.V;
+    drop[k] = 0;
+    grid.insert(static_cast<int>(k), b);
+    ++restored;
+  }
+  return restored;
+}
+
 // Elements dropped for touching a neighbour are tried again a little smaller about their
 // centres (chain mail has clearance between linked rings: a ring pushed into its neighbour over
 // a crease usually clears it at 90% of its size and still threads it). `V` holds every
@@ -281,6 +324,34 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     nv += static_cast<Eigen::Index>(e.face.size());
     nf += e.F.rows();
   }
+  // The layout's versions of elements placed as even copies (SurfaceElement::through_layout),
+  // in the same local coordinates, embedded alike: tried before such a copy is removed.
+  LocalCoordinates alternative_points;
+  std::vector<Eigen::Index> alternative_first(quilt.elements.size() + 1, 0);
+  for (size_t k = 0; k < quilt.elements.size(); ++k)
+    alternative_first[k + 1] =
+        alternative_first[k] +
+        static_cast<Eigen::Index>(quilt.elements[k].through_layout.face.size());
+  {
+    const Eigen::Index na = alternative_first.back();
+    alternative_points.face.resize(na);
+    alternative_points.bary.resize(na, 3);
+    alternative_points.height.resize(na);
+    for (size_t k = 0; k < quilt.elements.size(); ++k) {
+      const SurfaceElement::Alternative& a = quilt.elements[k].through_layout;
+      for (size_t v = 0; v < a.face.size(); ++v) {
+        int face = a.face[v];
+        Vector3d b = a.barycentric.row(static_cast<Eigen::Index>(v)).transpose();
+        to_input_base(quilt, face, b);
+        const Eigen::Index i = alternative_first[k] + static_cast<Eigen::Index>(v);
+        alternative_points.face(i) = face;
+        alternative_points.bary.row(i) = b.transpose();
+        alternative_points.height(i) =
+            std::clamp(a.height(static_cast<Eigen::Index>(v)), 0.0, quilt.shell_height);
+      }
+    }
+  }
+  MatrixX3d alternative_V;
   std::unique_ptr<ShellMap> map;
   if (options.shell_map && nv > 0) {
     ShellMapOptions map_options;
@@ -331,7 +402,9 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     }
     ScopedStageTimer timer(stats.times, "embedding");
     ScopedStageProgress shown(progress, "embedding");
-    all.V = ShellEmbedding(*map).embed(points);
+    const ShellEmbedding embedding(*map);
+    all.V = embedding.embed(points);
+    if (alternative_points.size() > 0) alternative_V = embedding.embed(alternative_points);
     if (options.optimize_stretch) {
       // Pairs of faces that intersect, within an element (it folds through itself) or between
       // two: both kinds keep the unoptimised map.
@@ -356,6 +429,9 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     ScopedStageTimer timer(stats.times, "embedding");
     ScopedStageProgress shown(progress, "embedding");
     all.V = normal_displacement(quilt.input_base.V, quilt.input_base.F, points);
+    if (alternative_points.size() > 0)
+      alternative_V =
+          normal_displacement(quilt.input_base.V, quilt.input_base.F, alternative_points);
   }
 
   // Repair (issue 13): an element the map folds through itself (over a sharp crease or next
@@ -479,6 +555,8 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     for (const auto& [f, g] : pairs)
       if (element_of[f] != element_of[g]) touching.emplace_back(element_of[f], element_of[g]);
     greedy_vertex_cover(touching, drop);
+    stats.layout_versions =
+        try_alternatives(quilt, folded, alternative_V, alternative_first, all.V, drop);
     if (options.shrink_to_fit) stats.shrunk_to_fit = shrink_to_fit(quilt, folded, all.V, drop);
   }
   TriMesh out;

@@ -29,6 +29,15 @@ struct SurfaceElement {
   // rigidly, where the map folds the element through itself.
   MatrixX3d flat;
   int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds)
+  // Optional (empty face: none): the element as the layout alone places it, where the
+  // coordinates above are an even copy of it (core/global_quilting, adaptive placement). The
+  // embedding tries it before removing the copy for touching a neighbour: distorted, but in its
+  // place among its neighbours.
+  struct Alternative {
+    std::vector<int> face;   // #V
+    MatrixX3d barycentric;   // #V by 3
+    Eigen::VectorXd height;  // #V
+  } through_layout;
 };
 
 struct SurfaceQuilt {
