@@ -26,7 +26,12 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
                  const QuiltEmbeddingStats& em, const std::string& embedding,
                  const std::string& device, int threads, double wall, const std::string& base,
                  const std::string& swatch, const std::string& method,
-                 const GlobalQuiltingStats* global, const StructureSummary& structure) {
+                 const GlobalQuiltingStats* global, const StructureSummary& structure,
+                 double memory_limit_bytes) {
+  // The global layout counts its output exactly before building it; else the estimate made
+  // before any work.
+  const double estimated_faces =
+      global && global->layout_faces > 0 ? global->layout_faces : s.estimated_faces;
   JsonWriter j;
   j.begin_object()
       .value("command", "surface")
@@ -82,7 +87,13 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("max", em.element_area_max)
       .end_object()
       .value("coverage", em.coverage)
-      .value("matched_point_offsets", s.matched_point_offsets);
+      .value("matched_point_offsets", s.matched_point_offsets)
+      .begin_object("memory")
+      .value("estimated_faces", estimated_faces)
+      .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
+      .value("limit_bytes", memory_limit_bytes)
+      .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
+      .end_object();
   write_match_counts(j, s.counts);
   if (global)
     j.begin_object("global")
@@ -256,7 +267,8 @@ int run_surface(int argc, char** argv, int first) {
     }
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"),
-                global ? "global" : "patches", global ? &gstats : nullptr, structure);
+                global ? "global" : "patches", global ? &gstats : nullptr, structure,
+                memory_limit(cl));
   }
   if (!run.quiet()) {
     std::printf(

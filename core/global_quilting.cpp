@@ -515,9 +515,10 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
     double faces = 0;
     for (const LatticeCopy& c : copies)
       faces += static_cast<double>(swatch.elements[reps[c.rep]].F.rows());
+    gstats.layout_faces = faces;
     MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", copies.size(),
              " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
-             " (--max-faces); use a larger --scale");
+             " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
     for (int f = 0; f < job.base.num_faces(); ++f) {
       const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
       gstats.parameter_area += 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());

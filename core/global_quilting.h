@@ -33,6 +33,7 @@ struct GlobalQuiltingStats {
   double worst_transition_error = 0;
   double scale_correction = 1;  // the parameterisation's scale, made 1 at the median face
   double parameter_area = 0;    // of the parameter plane textured
+  double layout_faces = 0;      // faces of the lattice copies, counted before any is built
   int placed = 0;               // elements carried onto the base
   int off_surface = 0;          // left out: a vertex beyond a boundary or around a singular vertex
   // Placed as copies of the layout's first-order image at their centre (the layout itself

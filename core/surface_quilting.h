@@ -142,6 +142,9 @@ struct SurfaceQuiltingStats {
   PatchCounts counts;
   int rejected_outside_patch = 0;             // swatch elements reaching beyond the flattened patch
   int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
+  // Output faces estimated before any work (the swatch's faces per footprint area over the
+  // base's area), and, for the global layout, counted once the layout is known.
+  double estimated_faces = 0;
   StageTimes times;
 };
 
