@@ -250,8 +250,10 @@ int run_surface(int argc, char** argv, int first) {
            " (is the swatch larger than the base?); "
            "nothing written");
   MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
-           " elements placed intersect others or themselves after embedding and were removed "
-           "(try a smaller --scale, or --keep-intersecting); nothing written");
+           " elements placed were removed after embedding (",
+           embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+           " intersecting others or themselves, ", embedding_stats.removed_below,
+           " inside the base; try a smaller --scale, or --keep-intersecting); nothing written");
   // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
   // likely cause. Judged against what the swatch covers of its own footprint: a sparse swatch
   // (vines) cannot cover more of the base than of itself.
@@ -262,16 +264,18 @@ int run_surface(int argc, char** argv, int first) {
     const int placed = static_cast<int>(quilt.elements.size());
     const int removed = e.removed_intersecting + e.removed_self_intersecting + e.removed_below;
     std::string cause;
+    if (removed > placed / 10)
+      cause = std::to_string(removed) + " of " + std::to_string(placed) +
+              " elements were removed (" +
+              std::to_string(e.removed_intersecting + e.removed_self_intersecting) +
+              " intersecting, " + std::to_string(e.removed_below) +
+              " inside the base: parts of it closer than the shell height?); try a smaller "
+              "--scale";
     if (e.fallback_area_share > 0.5)
-      cause = "the shell map was not built over " +
-              std::to_string(static_cast<int>(std::lround(100 * e.fallback_area_share))) +
-              "% of the base (" + e.fallback_reason + ")";
-    else if (removed > placed / 10)
-      cause =
-          std::to_string(removed) + " of " + std::to_string(placed) + " elements were removed (" +
-          std::to_string(e.removed_intersecting + e.removed_self_intersecting) + " intersecting, " +
-          std::to_string(e.removed_below) + " under the base): try a smaller --scale";
-    else
+      cause += std::string(cause.empty() ? "" : "; ") + "the shell map was not built over " +
+               std::to_string(static_cast<int>(std::lround(100 * e.fallback_area_share))) +
+               "% of the base (" + e.fallback_reason + ")";
+    if (cause.empty())
       cause = std::to_string(placed) +
               " elements leave the rest bare: the swatch may be too large for the base's parts "
               "(try a smaller --scale)";
