@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
+#include "core/offset_surface.h"
 #include "core/signed_height.h"
 
 namespace mq {
@@ -45,7 +46,22 @@ FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F, const FoldRepair
   FoldRepair out;
   out.V = V;
   out.folded_faces = folded_faces(V, F);
-  if (out.folded_faces.empty()) return out;
+  // What is relaxed and judged: the corners of folded faces, or offset_surface's fold vertices.
+  const auto folded = [&](const MatrixX3d& X) {
+    std::vector<int> corners;
+    if (options.offset_criterion) {
+      corners = fold_vertices(X, F);
+    } else {
+      for (const int f : folded_faces(X, F))
+        for (int k = 0; k < 3; ++k) corners.push_back(F(f, k));
+    }
+    return corners;
+  };
+  std::vector<int> remaining = options.offset_criterion ? fold_vertices(V, F) : std::vector<int>();
+  if (!options.offset_criterion)
+    for (const int f : out.folded_faces)
+      for (int k = 0; k < 3; ++k) remaining.push_back(F(f, k));
+  if (remaining.empty()) return out;
   const bool bounded = std::isfinite(options.max_above) || std::isfinite(options.max_below);
   const bool shift_bounded = std::isfinite(options.max_shift);
   std::optional<SignedHeight> base;
@@ -61,9 +77,7 @@ FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F, const FoldRepair
   };
   const Adjacency vv = vertex_adjacency(F, n);
   std::vector<char> relax(n, 0);
-  for (int f : out.folded_faces)
-    for (int k = 0; k < 3; ++k) relax[F(f, k)] = 1;
-  std::vector<int> remaining = out.folded_faces;
+  for (const int v : remaining) relax[v] = 1;
   for (int round = 0; round < options.max_rounds && !remaining.empty(); ++round) {
     if (round > 0) {  // grow by one ring
       std::vector<char> grown = relax;
@@ -71,8 +85,7 @@ FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F, const FoldRepair
         if (relax[i])
           for (const int* j = vv.begin(i); j != vv.end(i); ++j) grown[*j] = 1;
       relax.swap(grown);
-      for (int f : remaining)
-        for (int k = 0; k < 3; ++k) relax[F(f, k)] = 1;
+      for (const int v : remaining) relax[v] = 1;
     }
     std::vector<int> active;
     for (int i = 0; i < n; ++i)
@@ -95,9 +108,19 @@ FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F, const FoldRepair
       });
       out.V.swap(next);
     }
-    remaining = folded_faces(out.V, F);
+    remaining = folded(out.V);
   }
-  out.unrepaired_faces = remaining;
+  if (options.offset_criterion) {
+    const Adjacency vf = vertex_faces(F, n);
+    for (const int v : remaining)
+      out.unrepaired_faces.insert(out.unrepaired_faces.end(), vf.begin(v), vf.end(v));
+    std::sort(out.unrepaired_faces.begin(), out.unrepaired_faces.end());
+    out.unrepaired_faces.erase(
+        std::unique(out.unrepaired_faces.begin(), out.unrepaired_faces.end()),
+        out.unrepaired_faces.end());
+  } else {
+    out.unrepaired_faces = folded_faces(out.V, F);
+  }
   for (int i = 0; i < n; ++i) {
     const double d = (out.V.row(i) - V.row(i)).norm();
     if (d > 0.0) {

@@ -29,6 +29,11 @@ struct FoldRepairOptions {
   // How far a vertex may move in all (>= 0, infinity: unbounded): sliding along the base moves
   // the texture placed over it, so the repair stays local.
   double max_shift = std::numeric_limits<double>::infinity();
+  // Judge folds by offset_surface's own test (fold_vertices: a vertex with no direction above
+  // all its faces) instead of folded_faces: only what keeps the shell from being built is
+  // relaxed. folded_faces also flags sharp rims that the shell can cover (Blender's Suzanne: 74
+  // faces, against none for the shell), and relaxing them all moved half of its vertices.
+  bool offset_criterion = false;
 };
 
 //   V                #V by 3 repaired positions (equal to the input except at moved vertices)
@@ -57,7 +62,8 @@ std::vector<int> folded_faces(const MatrixX3d& V, const MatrixX3i& F);
 // Relaxes the vertices of folded faces (Jacobi steps towards the 1-ring centroid, in fixed
 // order, each kept within the bounds: deterministic), growing the relaxed set by one ring per
 // round until folded_faces is empty or max_rounds have run; faces still folded are returned in
-// unrepaired_faces. A base without folds is returned unchanged.
+// unrepaired_faces. With offset_criterion, the fold vertices instead, until there are none
+// (unrepaired_faces: the faces of those left). A base without folds is returned unchanged.
 //   V #V by 3 finite, F #F by 3 consistently oriented
 // Throws InvalidInput for bad options, an index out of range or non-finite coordinates.
 FoldRepair repair_folds(const MatrixX3d& V, const MatrixX3i& F,

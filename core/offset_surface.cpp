@@ -137,6 +137,15 @@ int diffusion_steps(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions&
 
 }  // namespace
 
+std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F) {
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "fold vertices: face index out of range");
+  std::vector<int> bad;
+  std::string message;
+  smoothed_directions(V, F, 0, bad, message);
+  return bad;
+}
+
 MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                             int* steps_out) {
   const int steps = diffusion_steps(V, F, options);

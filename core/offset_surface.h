@@ -62,6 +62,11 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
 // shell stays invalid with every offending vertex at the height floor (or after max_rounds).
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options);
 
+// The vertices where the base folds for the shell: no normal, or no direction above all their
+// faces (offset_surface's first test; no valid prism exists there at any height). Ascending.
+//   V #V by 3 finite, F #F by 3. Throws InvalidInput for an index out of range.
+std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F);
+
 // Why no valid shell was found, and where: the message offset_surface throws; the offending
 // vertices (ascending): those with no normal or no direction above their faces, or those still
 // offending at the height floor (every offending one when max_rounds ran out); and, for the

@@ -52,8 +52,9 @@ ShellMap::ShellMap(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions
     // Section 3.2 needs a valid shell; a folded base has none, so the shell is built over a
     // relaxed copy, which may slide a little along the base but not leave it (see
     // base_fold_repair.h). What the bounded repair leaves is judged by offset_surface itself.
-    if (options.repair_folds) {
+    if (options.repair_folds && failure.fold) {
       FoldRepairOptions fo = options.fold_repair;
+      fo.offset_criterion = true;
       fo.max_above = options.repair_max_above * height_;
       fo.max_below = options.repair_max_below * height_;
       fo.max_shift = options.repair_max_shift * height_;
