@@ -102,7 +102,7 @@ PlacementFigures placement_figures(const std::vector<ElementHeights>& heights,
                                    const std::vector<char>& keep) {
   PlacementFigures f;
   for (size_t k = 0; k < heights.size(); ++k) {
-    if (!keep.empty() && !keep[k]) continue;
+    if (k < keep.size() && !keep[k]) continue;
     f.vertices += heights[k].vertices;
     f.below += heights[k].below;
     f.above += heights[k].above;

@@ -67,6 +67,7 @@ struct PlacementFigures {
   double below_share() const { return vertices ? static_cast<double>(below) / vertices : 0.0; }
   double above_share() const { return vertices ? static_cast<double>(above) / vertices : 0.0; }
 };
+// keep: empty or as many flags as heights (missing flags count as set). Throws nothing.
 PlacementFigures placement_figures(const std::vector<ElementHeights>& heights,
                                    const std::vector<char>& keep = {});
 

@@ -80,8 +80,9 @@ struct ShellOptimizeReport {
 
 // The shell map. Vertices of the chart-split tet mesh: UV row j of the atlas is vertex j (its
 // base corner, texture (u, v, 0)) and vertex m + j (its offset corner, texture (u, v, H)),
-// m = #UV. Face f's prism gives tets 3f, 3f + 1, 3f + 2, split like shell_tet_indices, so the
-// shell tets are exactly those of shell_tetrahedra and texture tets of different charts are
+// m = #UV. Shell face f's prism (a row of faces(): the input's faces but those left out, see
+// exclusion()) gives tets 3f, 3f + 1, 3f + 2, split like shell_tet_indices, so the shell tets
+// are exactly those of shell_tetrahedra over faces() and texture tets of different charts are
 // disjoint.
 class ShellMap {
  public:
