@@ -1,6 +1,8 @@
 // meshquilt surface: mesh quilting over a base mesh (paper section 3.1).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -12,6 +14,7 @@
 #include "core/global_quilting.h"
 #include "core/mesh_io.h"
 #include "core/quilt_embedding.h"
+#include "core/surface_coverage.h"
 #include "core/surface_quilting.h"
 #include "core/tangent_field.h"
 #include "core/texture_structure.h"
@@ -27,7 +30,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
                  const std::string& device, int threads, double wall, const std::string& base,
                  const std::string& swatch, const std::string& method,
                  const GlobalQuiltingStats* global, const StructureSummary& structure,
-                 double memory_limit_bytes) {
+                 double memory_limit_bytes, double min_coverage, double swatch_cover) {
   // The global layout counts its output exactly before building it; else the estimate made
   // before any work.
   const double estimated_faces =
@@ -87,13 +90,37 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("max", em.element_area_max)
       .end_object()
       .value("coverage", em.coverage)
-      .value("matched_point_offsets", s.matched_point_offsets)
       .begin_object("memory")
       .value("estimated_faces", estimated_faces)
       .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
       .value("limit_bytes", memory_limit_bytes)
       .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
+      .end_object()
+      .value("swatch_coverage", swatch_cover)
+      .value("min_coverage", min_coverage);
+  // The embedding's check of its own result (issue 23): where the shell map was not built,
+  // and the output's signed heights over the base as given.
+  j.begin_object("placement")
+      .value("shell_map", embedding != "shell"            ? "not asked"
+                          : !em.shell_map_failure.empty() ? "failed"
+                          : em.fallback_faces > 0         ? "partial"
+                                                          : "whole base")
+      .value("fallback_faces", em.fallback_faces)
+      .value("fallback_area_share", em.fallback_area_share)
+      .value("fallback_fold_faces", em.fallback_fold_faces)
+      .value("fallback_reason", em.fallback_reason)
+      .value("fallback_elements", em.fallback_elements)
+      .value("tolerance", em.placement_tolerance)
+      .value("below_base_embedded", em.below_base_embedded)
+      .value("replaced_below", em.replaced_below)
+      .value("lifted_below", em.lifted_below)
+      .value("removed_below", em.removed_below)
+      .value("vertices", em.checked_vertices)
+      .value("below_base", em.below_base)
+      .value("above_shell", em.above_shell)
+      .value("lowest_height", em.lowest_height)
       .end_object();
+  j.value("matched_point_offsets", s.matched_point_offsets);
   write_match_counts(j, s.counts);
   if (global)
     j.begin_object("global")
@@ -150,6 +177,11 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("embedding", "shell|normal",
             "place the texture through the shell map or by plain normal displacement", "shell");
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
+  cl.option("min-coverage", "F",
+            "fail (exit 1, nothing written) when the base is covered less than this fraction of "
+            "what the swatch covers of its own footprint (covered: texture within 1.5 shell "
+            "heights on the base's outer side); 0 accepts any result",
+            "0.9");
   cl.flag("keep-orientation",
           "grow the texture along the base's normals as given, even where they face inward");
   cl.flag("no-proxy",
@@ -196,6 +228,7 @@ int run_surface(int argc, char** argv, int first) {
   embedding.optimize_stretch = !cl.has("no-stretch-opt");
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
+  const double min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
   options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
   const std::string placement = cl.get("element-placement");
@@ -247,8 +280,39 @@ int run_surface(int argc, char** argv, int first) {
            " (is the swatch larger than the base?); "
            "nothing written");
   MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
-           " elements placed intersect others or themselves after embedding and were removed "
-           "(try a smaller --scale, or --keep-intersecting); nothing written");
+           " elements placed were removed after embedding (",
+           embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+           " intersecting others or themselves, ", embedding_stats.removed_below,
+           " inside the base; try a smaller --scale, or --keep-intersecting); nothing written");
+  // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
+  // likely cause. Judged against what the swatch covers of its own footprint: a sparse swatch
+  // (vines) cannot cover more of the base than of itself.
+  const double own_coverage = swatch_coverage(swatch);
+  const double needed = min_coverage * own_coverage;
+  if (embedding_stats.coverage < needed) {
+    const QuiltEmbeddingStats& e = embedding_stats;
+    const int placed = static_cast<int>(quilt.elements.size());
+    const int removed = e.removed_intersecting + e.removed_self_intersecting + e.removed_below;
+    std::string cause;
+    if (removed > placed / 10)
+      cause = std::to_string(removed) + " of " + std::to_string(placed) +
+              " elements were removed (" +
+              std::to_string(e.removed_intersecting + e.removed_self_intersecting) +
+              " intersecting, " + std::to_string(e.removed_below) +
+              " inside the base: parts of it closer than the shell height?); try a smaller "
+              "--scale";
+    if (e.fallback_area_share > 0.5)
+      cause += std::string(cause.empty() ? "" : "; ") + "the shell map was not built over " +
+               std::to_string(static_cast<int>(std::lround(100 * e.fallback_area_share))) +
+               "% of the base (" + e.fallback_reason + ")";
+    if (cause.empty())
+      cause = std::to_string(placed) +
+              " elements leave the rest bare: the swatch may be too large for the base's parts "
+              "(try a smaller --scale)";
+    MQ_THROW(InvalidInput, "only ", 100 * e.coverage, "% of the base is covered, below ",
+             100 * needed, "% (--min-coverage ", min_coverage, " of the ", 100 * own_coverage,
+             "% the swatch covers of itself): ", cause, "; nothing written");
+  }
   {
     ScopedStageTimer timer(stats.times, "write");
     ScopedStageProgress shown(run.progress(), "writing");
@@ -268,7 +332,7 @@ int run_surface(int argc, char** argv, int first) {
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"),
                 global ? "global" : "patches", global ? &gstats : nullptr, structure,
-                memory_limit(cl));
+                memory_limit(cl), min_coverage, own_coverage);
   }
   if (!run.quiet()) {
     std::printf(
@@ -285,13 +349,25 @@ int run_surface(int argc, char** argv, int first) {
           "base: simplified to %d faces, within %.3g of the surface given "
           "(--no-proxy keeps it)\n",
           stats.proxy_faces, stats.proxy_error);
-    if (!embedding_stats.shell_map_failure.empty())
+    const QuiltEmbeddingStats& e = embedding_stats;
+    if (!e.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
-                  embedding_stats.shell_map_failure.c_str());
+                  e.shell_map_failure.c_str());
     else if (embedding.shell_map)
-      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n",
-                  embedding_stats.stretch_before, embedding_stats.stretch_after,
-                  embedding_stats.atlas_charts);
+      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n", e.stretch_before,
+                  e.stretch_after, e.atlas_charts);
+    if (e.shell_map_failure.empty() && e.fallback_faces > 0)
+      std::printf(
+          "shell map left out %d base faces (%.1f%% of the area; %s): %d elements "
+          "placed over them by normal displacement\n",
+          e.fallback_faces, 100 * e.fallback_area_share, e.fallback_reason.c_str(),
+          e.fallback_elements);
+    std::printf(
+        "placement: %.2f%% of vertices under the base (%.2f%% as embedded; elements "
+        "under it: %d placed again by normal displacement, %d lifted, %d removed), "
+        "%.2f%% above the shell\n",
+        100 * e.below_base, 100 * e.below_base_embedded, e.replaced_below, e.lifted_below,
+        e.removed_below, 100 * e.above_shell);
     if (global)
       std::printf(
           "global parameterisation: %d cones, %d cut edges%s; %s plane texture, %d elements "

@@ -108,7 +108,8 @@ TEST(GlobalQuilting, SphereWithItsFourCones) {
   TriMesh base = test::icosphere(4);
   base.V *= 3.0;
   const GlobalRun r = run(base, 0.6);
-  expect_mail(r, {}, "sphere, rings a fifth of the radius");
+  // Rings a fifth of the radius: about 5% of them lie around the four cones.
+  expect_mail(r, {0.93}, "sphere, rings a fifth of the radius");
   EXPECT_EQ(r.global.singular_vertices, 4);
   EXPECT_EQ(r.global.pinned_cones, 3);  // the fourth is where the other three put it
   EXPECT_TRUE(r.global.seamless);

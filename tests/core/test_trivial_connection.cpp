@@ -36,7 +36,7 @@ int nearest_vertex(const TriMesh& m, const Vector3d& d) {
 
 std::vector<int> tetrahedral_cones(const TriMesh& sphere) {
   std::vector<int> index(static_cast<size_t>(sphere.num_vertices()), 0);
-  for (const Vector3d d : {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1),
+  for (const Vector3d& d : {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1),
                            Vector3d(-1, -1, 1)})
     index[nearest_vertex(sphere, d.normalized())] = 1;
   return index;
@@ -72,8 +72,11 @@ TEST(TrivialConnection, SphereFieldHasExactlyThePrescribedCones) {
   // u peaks at the + cones (curvature gathered there) and has mean zero.
   const TrivialConnection tc(s.m.V, s.m.F, s.topo, s.TT, 2);
   EXPECT_NEAR(tc.vertex_area().dot(cm.u), 0.0, 1e-9);
-  for (int v = 0; v < s.m.num_vertices(); ++v)
-    if (cones[v]) EXPECT_GT(cm.u(v), cm.u.mean());
+  for (int v = 0; v < s.m.num_vertices(); ++v) {
+    if (cones[v]) {
+      EXPECT_GT(cm.u(v), cm.u.mean());
+    }
+  }
 }
 
 TEST(TrivialConnection, ScaledByItsMetricTheLayoutIsConformal) {
