@@ -962,13 +962,15 @@ Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
 // offset from there, along the surface. *whole is cleared when part of it would lie beyond the
 // base's boundary.
 Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& frame, double x,
-                 double phase, const Displacement& shell, bool* whole) {
+                 double phase, double push, const Displacement& shell, bool* whole) {
   Placed out;
   SurfaceElement& e = out.element;
   e.kind = leaf.kind;
   e.F = leaf.F;
   e.flat = m.pose(leaf, x, phase);  // a rigid copy of the swatch's leaf
   e.flat.col(0).array() -= x;
+  // Moved away from the vine by `push`, on its side of it.
+  e.flat.col(1).array() += leaf.P.col(1).mean() < 0 ? -push : push;
   const int nv = static_cast<int>(leaf.P.rows());
   e.face.resize(static_cast<size_t>(nv));
   e.barycentric.resize(nv, 3);
@@ -981,6 +983,11 @@ Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& fr
                shell);
   return out;
 }
+
+// Where a leaf is tried, in order: (along the stem, in leaf pitches; away from the vine, in
+// tube radii).
+constexpr std::array<std::pair<double, double>, 8> kLeafMoves = {
+    {{0, 0}, {0.15, 0}, {-0.15, 0}, {0.3, 0}, {-0.3, 0}, {0, 1}, {0.15, 1}, {-0.15, 1}}};
 
 void check_options(const VineGrowthOptions& o) {
   MQ_CHECK(o.up.allFinite() && o.up.norm() > 0, InvalidInput,
@@ -1219,12 +1226,14 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
       for (const auto& [x, i] : leaf_slots(model, S, phase)) {
         const SwatchLeaf& leaf = model.leaves[static_cast<size_t>(i)];
         ++vs.leaf_slots;
-        // Tried at its place, then a little along the stem either way.
-        for (const double shift : {0.0, 0.15, -0.15, 0.3, -0.3}) {
+        // Tried at its place, then a little along the stem either way, then as far again from
+        // the vine's axis as the tube's radius (where the surface curves, a leaf laid rigidly
+        // from the stem can meet the stem itself).
+        for (const auto& [shift, push] : kLeafMoves) {
           const double xs = x + shift * pitch;
           if (xs < 0 || xs > S) continue;
           bool whole = true;
-          Placed p = make_leaf(model, leaf, frame, xs, phase, shell, &whole);
+          Placed p = make_leaf(model, leaf, frame, xs, phase, push * model.radius, shell, &whole);
           // Whole on the base, clear of everything placed, and not folded through itself
           // (bent over a box's edge, the displacement can fold a leaf).
           if (!whole || placed.intersects(p.position, p.element.F) >= 0 ||
@@ -1233,7 +1242,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
           placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
           quilt.elements.push_back(std::move(p.element));
           ++vs.leaves;
-          vs.leaves_shifted += shift != 0 ? 1 : 0;
+          vs.leaves_shifted += shift != 0 || push != 0 ? 1 : 0;
           break;
         }
       }
