@@ -984,6 +984,19 @@ Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& fr
   return out;
 }
 
+// Whether every vertex of an element lies over one face of the base as given: displaced along
+// the normals interpolated over one triangle, a copy of an unfolded element stays unfolded
+// (across faces it can fold: where they meet at an angle, or belong to separate pieces).
+bool on_one_face(const Refinement& refinement, const SurfaceElement& e) {
+  const auto parent = [&](int f) {
+    return refinement.parent.empty() ? f : refinement.parent[static_cast<size_t>(f)];
+  };
+  const int first = parent(e.face.front());
+  for (const int f : e.face)
+    if (parent(f) != first) return false;
+  return true;
+}
+
 // Where a leaf is tried, in order: (along the stem, in leaf pitches; away from the vine, in
 // tube radii).
 constexpr std::array<std::pair<double, double>, 8> kLeafMoves = {
@@ -1237,7 +1250,8 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
           // Whole on the base, clear of everything placed, and not folded through itself
           // (bent over a box's edge, the displacement can fold a leaf).
           if (!whole || placed.intersects(p.position, p.element.F) >= 0 ||
-              !self_intersecting_components(p.position, p.element.F).empty())
+              (!on_one_face(job.refinement, p.element) &&
+               !self_intersecting_components(p.position, p.element.F).empty()))
             continue;
           placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
           quilt.elements.push_back(std::move(p.element));
