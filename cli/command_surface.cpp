@@ -18,6 +18,7 @@
 #include "core/surface_quilting.h"
 #include "core/tangent_field.h"
 #include "core/texture_structure.h"
+#include "core/vine_growth.h"
 #include "host/tet_stretch_evaluator.h"
 #include "host/translation_cost_evaluator.h"
 
@@ -187,10 +188,12 @@ int run_surface(int argc, char** argv, int first) {
   cl.flag("no-proxy",
           "use a base of over 200,000 faces as given (by default it is first simplified to the "
           "texture's scale, within 5% of the shell height)");
-  cl.option("method", "auto|global|patches",
+  cl.option("method", "auto|global|patches|vines",
             "global: one field-aligned parameterisation, seamless for a periodic swatch (keeps "
-            "chain mail linked); patches: local conformal patches (the paper's); auto: global "
-            "for a lattice of compact elements",
+            "chain mail linked); patches: local conformal patches (the paper's); vines: stems "
+            "grown along the field (up +Y without --field), evenly spaced, with the swatch's "
+            "leaves along them; auto: global for a lattice of compact elements, vines for a vine "
+            "with elements attached along it (ivy)",
             "auto");
   cl.option("element-placement", "adaptive|layout|rigid",
             "global layout: how a lattice element reaches the surface. layout: through the "
@@ -240,8 +243,8 @@ int run_surface(int argc, char** argv, int first) {
     throw UsageError("--element-placement expects adaptive, layout or rigid, got '" + placement +
                      "'");
   const std::string method = cl.get("method");
-  if (method != "auto" && method != "global" && method != "patches")
-    throw UsageError("--method expects auto, global or patches, got '" + method + "'");
+  if (method != "auto" && method != "global" && method != "patches" && method != "vines")
+    throw UsageError("--method expects auto, global, patches or vines, got '" + method + "'");
 
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
@@ -262,13 +265,15 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats gstats;
-  bool global = method == "global";
+  bool global = method == "global", vines = method == "vines";
+  VineGrowthStats vstats;
   const SurfaceQuilt quilt =
       method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
-                                            run.progress(), &global)
+                                            run.progress(), &global, &vines, &vstats)
       : global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
-          : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+      : vines ? quilt_surface_vines(base, swatch, options, {}, &stats, &vstats, run.progress())
+              : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
@@ -331,8 +336,11 @@ int run_surface(int argc, char** argv, int first) {
     }
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"),
-                global ? "global" : "patches", global ? &gstats : nullptr, structure,
-                memory_limit(cl), min_coverage, own_coverage);
+                global  ? "global"
+                : vines ? "vines"
+                        : "patches",
+                global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
+                own_coverage);
   }
   if (!run.quiet()) {
     std::printf(
@@ -374,7 +382,17 @@ int run_surface(int argc, char** argv, int first) {
           "placed (%d off the surface)\n",
           gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
           gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
-    if (global && gstats.tiled)
+    if (vines)
+      std::printf(
+          "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "
+          "intersect, %d pieces and %d short lines left out), %d of %d leaves placed (%d moved "
+          "along the stem), %.2f s on %d threads; %d removed (%d folded)\n",
+          vstats.stems, vstats.spacing, vstats.median_length, vstats.stems_cut,
+          vstats.stems_dropped, vstats.streamlines_short, vstats.leaves, vstats.leaf_slots,
+          vstats.leaves_shifted, wall, run.threads(),
+          embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+          embedding_stats.removed_self_intersecting);
+    else if (global && gstats.tiled)
       std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", wall,
                   evaluator->name().c_str(), run.threads(), embedding_stats.rigid_repairs,
                   embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting);

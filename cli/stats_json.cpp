@@ -97,7 +97,10 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
       .value("area", r.area > 0 ? r.area : std::nan(""))
       .value("density", r.density > 0 ? r.density : std::nan(""))
       .value("density_cells", r.density_cells)
-      .value("interior_ends_per_area", r.area > 0 ? r.interior_ends_per_area : std::nan(""));
+      .value("interior_ends_per_area", r.area > 0 ? r.interior_ends_per_area : std::nan(""))
+      .value("median_long_length", r.long_elements > 0 ? r.median_long_length : std::nan(""))
+      .value("long_length", r.long_length)
+      .value("compact_elements", r.compact_elements);
   if (self_intersecting >= 0) j.value("self_intersecting_elements", self_intersecting);
   if (swatch) {
     j.begin_object("swatch")
@@ -157,7 +160,9 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
     j.end_object()
         .value("stretched_elements", comparison->stretched)
         .value("largest_stretch", known(comparison->largest_stretch))
-        .value("largest_size_ratio", known(s.size_max));
+        .value("largest_size_ratio", known(s.size_max))
+        .value("long_length_ratio", known(comparison->long_length_ratio))
+        .value("compact_per_length_ratio", known(comparison->compact_per_length_ratio));
   }
   j.end_object();
 }
@@ -218,6 +223,14 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
           std::printf("  %-16s %.2f%% of %d interior link %d others (%d degenerate)\n",
                       (k.kind + ":").c_str(), 100 * k.share, k.interior_rings, k.interior_links,
                       k.degenerate);
+    }
+    if (comparison->long_length_ratio > 0) {
+      std::printf("long lengths:      median %.2f swatch long elements (%.4g)",
+                  comparison->long_length_ratio, r.median_long_length);
+      if (comparison->compact_per_length_ratio > 0)
+        std::printf(", %.3g compact elements per length, %.3f times the swatch's",
+                    r.compact_elements / r.long_length, comparison->compact_per_length_ratio);
+      std::printf("\n");
     }
     if (comparison->density_ratio > 0)
       std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",

@@ -21,6 +21,7 @@
 #include "core/straightest_geodesic.h"
 #include "core/tangent_field.h"
 #include "core/trivial_connection.h"
+#include "core/vine_growth.h"
 #include "core/weld_vertices.h"
 
 namespace mq {
@@ -817,7 +818,8 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
                                 const SurfaceQuiltingOptions& options,
                                 TranslationCostEvaluator& evaluator,
                                 SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
-                                ProgressSink* progress, bool* used_global) {
+                                ProgressSink* progress, bool* used_global, bool* used_vines,
+                                VineGrowthStats* vine_stats) {
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
@@ -836,6 +838,17 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
     }
   }
   if (used_global) *used_global = false;
+  if (used_vines) *used_vines = false;
+  bool vines = false;
+  {
+    ScopedStageTimer timer(stats.times, "method choice");
+    vines = is_vine_swatch(swatch);
+  }
+  if (vines) {
+    if (used_vines) *used_vines = true;
+    return quilt_prepared_vines(std::move(job), std::move(stats), options, VineGrowthOptions{},
+                                stats_out, vine_stats, progress);
+  }
   // The job prepared once (a large base is simplified in the preparation).
   return quilt_prepared_surface(std::move(job), std::move(stats), options, evaluator, stats_out,
                                 progress);

@@ -15,6 +15,8 @@
 
 namespace mq {
 
+struct VineGrowthStats;
+
 struct GlobalQuiltingStats {
   bool periodic = false;      // the swatch's lattice was found (core/swatch_symmetry)
   bool seamless = false;      // cones pinned and transitions fixed at the texture's symmetries
@@ -52,13 +54,16 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
 
 // --method auto: quilt_surface_global for a lattice of compact elements (periodic and
 // tileable, core/swatch_symmetry: the textures whose structure the patch method loses, decided
-// on the swatch at the job's scale), quilt_surface otherwise; the swatch's symmetry is found once.
-// *used_global (optional) says which ran. Throws like quilt_surface.
+// on the swatch at the job's scale), quilt_prepared_vines (core/vine_growth) for a vine with
+// compact elements attached along it (is_vine_swatch: the ivy section), quilt_surface
+// otherwise; the swatch's symmetry is found once. *used_global and *used_vines (optional) say
+// which ran, *vine_stats (optional) gets the vines' figures. Throws like quilt_surface.
 SurfaceQuilt quilt_surface_auto(const TriMesh& base, const TriMesh& swatch,
                                 const SurfaceQuiltingOptions& options,
                                 TranslationCostEvaluator& evaluator,
                                 SurfaceQuiltingStats* stats = nullptr,
                                 GlobalQuiltingStats* global_stats = nullptr,
-                                ProgressSink* progress = nullptr, bool* used_global = nullptr);
+                                ProgressSink* progress = nullptr, bool* used_global = nullptr,
+                                bool* used_vines = nullptr, VineGrowthStats* vine_stats = nullptr);
 
 }  // namespace mq

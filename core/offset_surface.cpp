@@ -146,6 +146,16 @@ std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F) {
   return bad;
 }
 
+MatrixX3d displacement_directions(const MatrixX3d& V, const MatrixX3i& F, double height) {
+  OffsetOptions o;
+  o.height = height;
+  try {
+    return offset_directions(V, F, o);
+  } catch (const TopologyError&) {
+    return vertex_normals(V, F);
+  }
+}
+
 MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                             int* steps_out) {
   const int steps = diffusion_steps(V, F, options);

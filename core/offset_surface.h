@@ -42,6 +42,12 @@ struct OffsetSurface {
 MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                             int* steps_out = nullptr);
 
+// The directions the texture is displaced along where no shell map places it (normal
+// displacement): offset_directions with the default smoothing for a shell of this height, or,
+// where the base folds so that none exists, the area-weighted vertex normals. #V by 3.
+// Throws InvalidInput for height <= 0 or bad input (as offset_directions).
+MatrixX3d displacement_directions(const MatrixX3d& V, const MatrixX3i& F, double height);
+
 // Offsets the base (V, F) outward.
 // Directions: area-weighted vertex normals; where one lies closer than cos = 0.1 to the plane
 // of an incident face (sharp vertices), the direction maximising the smallest cosine with the

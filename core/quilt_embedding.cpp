@@ -304,23 +304,16 @@ int keep_in_shell(const SurfaceQuilt& quilt, const std::vector<Eigen::Index>& fi
   return count;
 }
 
-// The directions normal displacement follows: the shell's smoothed offset directions over the
-// refined base. Its plain vertex normals fan out at a spike's tip (rings there pressed into
-// each other: 72 removed on the spiky sphere against 20), and those of a coarse base as given
-// shear a box's faces (a corner's is 55 degrees off each). Vertex normals where the base folds.
-MatrixX3d displacement_directions(const SurfaceQuilt& quilt) {
-  try {
-    OffsetOptions o;
-    o.height = quilt.shell_height;
-    return offset_directions(quilt.base.V, quilt.base.F, o);
-  } catch (const TopologyError&) {
-    return vertex_normals(quilt.base.V, quilt.base.F);
-  }
+// The directions normal displacement follows, over the refined base: the shell's smoothed
+// offset directions (core/offset_surface). Its plain vertex normals fan out at a spike's tip
+// (rings there pressed into each other: 72 removed on the spiky sphere against 20), and those of
+// a coarse base as given shear a box's faces (a corner's is 55 degrees off each).
+MatrixX3d shell_directions(const SurfaceQuilt& quilt) {
+  return displacement_directions(quilt.base.V, quilt.base.F, quilt.shell_height);
 }
 
-// The rows of the elements with which[k] set placed by plain normal displacement over the base
-// as given (the fallback where the shell map is not built, or where it put an element under
-// the base).
+// The rows of the elements with which[k] set placed by normal displacement (the fallback where
+// the shell map is not built, or where it put an element under the base).
 void place_by_normal(const SurfaceQuilt& quilt, const LocalCoordinates& points,
                      const std::vector<Eigen::Index>& first, const std::vector<char>& which,
                      MatrixX3d& V) {
@@ -340,7 +333,7 @@ void place_by_normal(const SurfaceQuilt& quilt, const LocalCoordinates& points,
     sub.height(i) = points.height(rows[static_cast<size_t>(i)]);
   }
   const MatrixX3d placed =
-      normal_displacement(quilt.base.V, quilt.base.F, displacement_directions(quilt), sub);
+      normal_displacement(quilt.base.V, quilt.base.F, shell_directions(quilt), sub);
   for (Eigen::Index i = 0; i < n; ++i) V.row(rows[static_cast<size_t>(i)]) = placed.row(i);
 }
 
@@ -478,7 +471,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   } else {
     ScopedStageTimer timer(stats.times, "embedding");
     ScopedStageProgress shown(progress, "embedding");
-    all.V = normal_displacement(quilt.base.V, quilt.base.F, displacement_directions(quilt), points);
+    all.V = normal_displacement(quilt.base.V, quilt.base.F, shell_directions(quilt), points);
   }
 
   // The layout's versions of elements placed as even copies (SurfaceElement::through_layout),
@@ -506,7 +499,7 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
         if (map && map->shell_face(a.face[v]) < 0) alt_normal[k] = 1;
       }
     }
-    alternative_V = normal_displacement(quilt.base.V, quilt.base.F, displacement_directions(quilt), alt);
+    alternative_V = normal_displacement(quilt.base.V, quilt.base.F, shell_directions(quilt), alt);
     if (map) {
       LocalCoordinates through = alt;
       for (size_t k = 0; k < ne; ++k)

@@ -590,11 +590,16 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
     if (e.ring) max_links = std::max(max_links, e.links);
   report.link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
   report.interior_link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
+  std::vector<double> long_lengths;
   for (const ElementStructure& e : report.elements) {
     if (e.long_element) {
       ++report.long_elements;
       report.ends += 2;
       report.interior_ends += e.interior_ends;
+      long_lengths.push_back(e.length);
+      report.long_length += e.length;
+    } else {
+      ++report.compact_elements;
     }
     if (!e.ring) continue;
     const size_t defect = static_cast<size_t>(e.defect);
@@ -607,6 +612,11 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
       ++report.interior_defects[defect];
       if (!e.degenerate()) ++report.interior_link_histogram[e.links];
     }
+  }
+
+  if (!long_lengths.empty()) {
+    std::sort(long_lengths.begin(), long_lengths.end());
+    report.median_long_length = percentile(long_lengths, 0.5);
   }
 
   // Density from the Voronoi cells of interior elements in their tangent planes.
@@ -856,6 +866,13 @@ StructureComparison compare_structure(const StructureReport& output, const Swatc
     kc.kind = swatch.kinds[static_cast<size_t>(k)].name;
     kc.share = static_cast<double>(kc.matching) / kc.interior_rings;
     c.kinds.push_back(kc);
+  }
+  const StructureReport& sr = swatch.report;
+  if (output.median_long_length > 0 && sr.median_long_length > 0 && c.linear_scale > 0) {
+    c.long_length_ratio = output.median_long_length / (sr.median_long_length * c.linear_scale);
+    if (output.long_length > 0 && sr.long_length > 0 && sr.compact_elements > 0)
+      c.compact_per_length_ratio = (output.compact_elements / output.long_length) /
+                                   (sr.compact_elements / (sr.long_length * c.linear_scale));
   }
   const bool long_swatch =
       2 * swatch.report.long_elements > static_cast<int>(swatch.report.elements.size());

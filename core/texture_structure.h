@@ -159,6 +159,10 @@ struct StructureReport {
   std::vector<int> interior_link_histogram;
   std::vector<int> link_histogram;  // the same over all rings
   int long_elements = 0, ends = 0, interior_ends = 0;
+  // The long elements' lengths (ElementStructure::length): their median and their sum; and
+  // the elements that are not long (leaves along vines; rings), for their count per length.
+  double median_long_length = 0, long_length = 0;
+  int compact_elements = 0;
   double area = 0;  // 0: unknown
   // Elements per unit area: interior elements over the total area of their Voronoi cells in
   // the tangent plane at each (neighbours within 4 spacings projected), counting the cells
@@ -267,6 +271,11 @@ struct StructureComparison {
   // spike, a hoof).
   ShapeSummary shape;
   int stretched = 0;  // compact elements stretched over kStretchedSize along some direction
+  // With long elements in both (issue 23: vines that run on): the output's median long element
+  // in swatch long elements (its median length over the swatch's at the output's scale: 1 for
+  // vines in swatch-sized pieces), and its compact elements per long length against the
+  // swatch's (1: leaves at the swatch's leaves per vine length). 0 when either has none.
+  double long_length_ratio = 0, compact_per_length_ratio = 0;
   double largest_stretch = 0;  // their largest ElementStructure::stretch
   static constexpr double kStretchedSize = 1.5;
 };

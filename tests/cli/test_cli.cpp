@@ -392,6 +392,39 @@ TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
   EXPECT_FALSE(fs::exists(dir + "/none.png"));
 }
 
+// The ivy section grows as vines (issue 23 item 4): auto takes them, the stems climb (+Y by
+// default on this upright plane) many swatch vines long with the swatch's leaves per length,
+// and nothing intersects; --method vines refuses a swatch that is not a vine.
+TEST(Cli, SurfaceGrowsIvyAsVines) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(meshquilt(dir, "swatch ivy --count 2 --length 2 -o ivy.obj --quiet").status, 0);
+  ASSERT_EQ(meshquilt(dir, "swatch apples --count 4 -o apples.obj --quiet").status, 0);
+  const TriMesh grid = test::plane_grid(2, 1.5, 20, 15);
+  std::ostringstream obj;
+  for (int v = 0; v < grid.num_vertices(); ++v)
+    obj << "v " << grid.V(v, 0) << " " << grid.V(v, 1) << " " << grid.V(v, 2) << "\n";
+  for (int f = 0; f < grid.num_faces(); ++f)
+    obj << "f " << grid.F(f, 0) + 1 << " " << grid.F(f, 1) + 1 << " " << grid.F(f, 2) + 1 << "\n";
+  spit(dir + "/grid.obj", obj.str());
+  const CliRun a = meshquilt(
+      dir, "surface --base grid.obj --swatch ivy.obj --scale 0.06 -o a.obj --stats a.json");
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_NE(a.out.find(" stems (spacing "), std::string::npos) << a.out;
+  const std::string stats = slurp(dir + "/a.json");
+  EXPECT_NE(stats.find("\"method\": \"vines\""), std::string::npos);
+  EXPECT_GE(std::stod(json_value(stats, "long_length_ratio")), 3.0);
+  EXPECT_NEAR(std::stod(json_value(stats, "compact_per_length_ratio")), 1.0, 0.15);
+  const CliRun i = meshquilt(dir, "info a.obj --intersections --links --swatch ivy.obj --json");
+  ASSERT_EQ(i.status, 0) << i.err;
+  EXPECT_EQ(json_value(i.out, "intersecting_face_pairs"), "0");
+  EXPECT_GE(std::stod(json_value(i.out, "long_length_ratio")), 3.0);
+  const CliRun v = meshquilt(
+      dir, "surface --base grid.obj --swatch apples.obj --scale 0.06 --method vines -o v.obj");
+  EXPECT_EQ(v.status, 1);
+  EXPECT_EQ(v.err_lines().size(), 1u);
+  EXPECT_FALSE(fs::exists(dir + "/v.obj"));
+}
+
 // Issue 23's honest measure as a user runs it, on the square 4-in-1 sheet quilted on a plane:
 // each ring judged against its own kind's count (flat rings 4, connectors 2) keeps 100%, no ring
 // is degenerate, every element is a copy of its swatch element's size and shape; the figures

@@ -449,6 +449,40 @@ TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
   EXPECT_EQ(apples.rings, 0);
 }
 
+// Vines in swatch-sized pieces measure 1 swatch vine; a section three times as long with three
+// times the leaves measures about 3, at the swatch's leaves per length; one of its leaves
+// taken away shows in that ratio.
+TEST(TextureStructure, VineLengthsAreMeasuredInSwatchVines) {
+  IvyOptions o;
+  o.length = 2;
+  o.leaves = 2;
+  const TriMesh swatch = ivy_section(o);
+  const SwatchStructure ref = measure_swatch_structure(swatch);
+  EXPECT_EQ(ref.report.long_elements, 1);
+  EXPECT_EQ(ref.report.compact_elements, 2);
+  EXPECT_GT(ref.report.median_long_length, 2.0);  // along its wave
+  const StructureComparison same = compare_structure(ref.report, ref, 1.0);
+  EXPECT_DOUBLE_EQ(same.long_length_ratio, 1.0);
+  EXPECT_DOUBLE_EQ(same.compact_per_length_ratio, 1.0);
+  o.length = 6;
+  o.leaves = 6;
+  const TriMesh longer = ivy_section(o);
+  const StructureComparison three = compare_structure(measure_structure(longer), ref, 1.0);
+  EXPECT_NEAR(three.long_length_ratio, 3.0, 0.3);
+  EXPECT_NEAR(three.compact_per_length_ratio, 1.0, 0.1);
+  o.leaves = 5;
+  const StructureComparison fewer = compare_structure(measure_structure(ivy_section(o)), ref, 1.0);
+  EXPECT_NEAR(fewer.compact_per_length_ratio / three.compact_per_length_ratio, 5.0 / 6, 0.02);
+  // Twice the size, measured at that scale: the same figures.
+  TriMesh big = longer;
+  big.V *= 2;
+  const StructureComparison scaled = compare_structure(measure_structure(big), ref, 2.0);
+  EXPECT_NEAR(scaled.long_length_ratio, three.long_length_ratio, 1e-9);
+  EXPECT_NEAR(scaled.compact_per_length_ratio, three.compact_per_length_ratio, 1e-9);
+  // Without long elements there is nothing to compare.
+  EXPECT_EQ(compare_structure(measure_structure(apple_layer({})), ref, 1.0).long_length_ratio, 0.0);
+}
+
 TEST(TextureStructure, BaseBoundaryDecidesTheInteriorOfACurvedResult) {
   // Rings standing on an open half cylinder: those near its straight edges are border ones.
   const TriMesh grid = test::plane_grid(10, 10, 10, 10);
