@@ -1,16 +1,25 @@
 // Threads that run on (core/thread_tiling): a plain weave cut into one-period pieces that tile
-// its lattice, and pieces welded end to end into closed, manifold, outward threads.
+// its lattice; pieces welded end to end into closed, manifold, outward threads; and the weave
+// laid over generated bases through the global layout (core/global_quilting): over a cylinder
+// its threads run its whole length or close round it and end only at its borders, over a sphere
+// they run many swatch threads long and end only at its four cones. Deterministic.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "core/global_quilting.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/planar_quilting.h"
+#include "core/quilt_embedding.h"
 #include "core/swatch_generators.h"
+#include "core/tangent_field.h"
+#include "core/texture_structure.h"
 #include "core/thread_tiling.h"
 #include "tests/core/planar_checks.h"
+#include "tests/core/shell_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -45,6 +54,20 @@ double signed_volume(const MatrixX3d& V, const MatrixX3i& F) {
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     v += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2))));
   return v / 6;
+}
+
+// Every element of the mesh a closed manifold tube enclosing positive volume.
+void expect_closed_outward_elements(const TriMesh& mesh) {
+  std::vector<int> fc;
+  const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
+  const std::vector<std::vector<int>> groups = component_faces(fc, n);
+  int bad = 0;
+  for (int c = 0; c < n; ++c) {
+    const TriMesh part = extract_faces(mesh, groups[c]);
+    const TopologyReport t = topology_report(part);
+    if (!t.closed() || !t.manifold() || !(signed_volume(part.V, part.F) > 0)) ++bad;
+  }
+  EXPECT_EQ(bad, 0) << "of " << n << " elements";
 }
 
 TEST(ThreadTiling, AWeaveIsCutIntoOnePeriodPiecesOfEachThreadKind) {
@@ -231,6 +254,138 @@ TEST(ThreadTiling, WeldedPiecesAreOneClosedManifoldThread) {
   EXPECT_EQ(stats.caps, 4);
   EXPECT_EQ(weld_threads(placed, tiling, welds, {}, &stats, nullptr, 2).size(), 1u);
   EXPECT_EQ(stats.short_threads, 1);
+}
+
+struct WeaveRun {
+  SurfaceQuiltingStats stats;
+  GlobalQuiltingStats global;
+  QuiltEmbeddingStats embedding;
+  TriMesh output;
+  StructureSummary structure;
+  bool used_global = false;
+};
+
+// The weave at `spacing` base units between threads, method auto, embedded by normal
+// displacement (the layout decides the threads; the shell map is tested on its own).
+WeaveRun run(const TriMesh& base, double spacing, const MatrixX3d& field = MatrixX3d()) {
+  WeaveRun r;
+  const TriMesh swatch = weave();
+  const double diagonal = bounding_box(base.V, base.F).extent().norm();
+  SurfaceQuiltingOptions o;
+  o.scale = spacing * bounding_box(swatch.V).extent().head<2>().maxCoeff() / diagonal;
+  o.field = field;
+  o.global.drop_folded_pieces = true;
+  TranslationCostCpu cost;
+  const SurfaceQuilt quilt =
+      quilt_surface_auto(base, swatch, o, cost, &r.stats, &r.global, nullptr, &r.used_global);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;
+  TetStretchCpu stretch;
+  r.output = embed_quilt(quilt, e, stretch, &r.embedding);
+  r.structure = summarize_structure(r.output, swatch, &base, r.stats.swatch_scale);
+  return r;
+}
+
+void report(const char* what, const WeaveRun& r) {
+  const StructureReport& s = r.structure.output;
+  std::printf(
+      "[ measure  ] %s: %d threads (%d closed), median %.1f swatch threads, %d interior ends, "
+      "%d pieces (%d off, %d distorted, %d near cones, %d intersecting), %d welds, %d cones, "
+      "coverage %.3f\n",
+      what, s.long_elements, s.closed_long_elements, r.structure.comparison.long_length_ratio,
+      s.interior_ends, r.global.thread_pieces, r.global.off_surface, r.global.pieces_distorted,
+      r.global.pieces_near_cones, r.global.pieces_intersecting, r.global.thread_welds,
+      r.global.singular_vertices, r.embedding.coverage);
+}
+
+void expect_whole_threads(const WeaveRun& r) {
+  EXPECT_TRUE(r.used_global);
+  EXPECT_TRUE(r.global.threads);
+  EXPECT_EQ(r.embedding.removed_intersecting + r.embedding.removed_self_intersecting, 0);
+  EXPECT_TRUE(intersecting_face_pairs(r.output.V, r.output.F).empty());
+  EXPECT_TRUE(self_intersecting_components(r.output.V, r.output.F).empty());
+  expect_closed_outward_elements(r.output);
+  EXPECT_GE(r.embedding.coverage, 0.95);
+}
+
+// Along the axis of an open cylinder: the warps run its whole height, the wefts close round it;
+// nothing ends but at the two border circles (within a period of them: a piece that would
+// reach beyond the border is left out whole).
+TEST(ThreadTiling, OverACylinderThreadsRunItsLengthAndCloseRoundIt) {
+  const TriMesh base = test::open_cylinder(2.0, 6.0, 64, 24);
+  const double spacing = 0.35;
+  const WeaveRun r =
+      run(base, spacing, tangent_field_from_direction(base.V, base.F, Vector3d::UnitZ()));
+  report("cylinder", r);
+  expect_whole_threads(r);
+  const StructureReport& s = r.structure.output;
+  EXPECT_EQ(r.global.singular_vertices, 0);
+  EXPECT_GT(s.interior_ends, 0);  // within 5 thread widths of the border: the measure's margin
+  StructureOptions near_border;
+  near_border.automatic_border = false;
+  near_border.border = mesh_border(base.V, base.F);
+  near_border.end_margin = 2.5 * spacing;  // a period and a little
+  EXPECT_EQ(measure_structure(r.output, near_border).interior_ends, 0);
+  EXPECT_GT(s.closed_long_elements, 10);  // wefts round it, 36 spacings long
+  // Warps: the height is 17 spacings, 3.8 swatch threads.
+  EXPECT_GE(r.structure.comparison.long_length_ratio, 3.0);
+}
+
+// A sphere's four cones: the threads end only there, and run many swatch threads long.
+TEST(ThreadTiling, OverASphereThreadsEndOnlyAtItsCones) {
+  TriMesh base = test::icosphere(4);
+  base.V *= 3.0;
+  const WeaveRun r = run(base, 0.3);
+  report("sphere", r);
+  expect_whole_threads(r);
+  EXPECT_EQ(r.global.singular_vertices, 4);
+  EXPECT_GE(r.structure.comparison.long_length_ratio, 3.0);
+  // Every end is where a piece next to a cone was left out.
+  EXPECT_LE(r.global.thread_ends, 2 * (r.global.pieces_near_cones + r.global.pieces_distorted +
+                                       r.global.pieces_intersecting));
+  EXPECT_GT(r.global.closed_threads, 0);
+}
+
+// --method auto: the global layout's thread tiling for the weave, its lattice placement for
+// chain mail, the paper's patches for apples and ivy.
+TEST(ThreadTiling, AutoTakesThreadsForTheWeaveOnly) {
+  const TriMesh base = test::plane_grid(8, 8, 16, 16);
+  const MatrixX3d field = tangent_field_from_direction(base.V, base.F, Vector3d::UnitX());
+  struct Case {
+    const char* name;
+    TriMesh swatch;
+    bool global, threads, tiled;
+  };
+  for (const Case& c : {Case{"weave", weave(), true, true, false},
+                        Case{"chain mail", test::tiny_chainmail(), true, false, true},
+                        Case{"apples", apple_layer(), false, false, false},
+                        Case{"ivy", ivy_section(), false, false, false}}) {
+    SCOPED_TRACE(c.name);
+    SurfaceQuiltingOptions o;
+    o.scale = 0.3;
+    o.field = field;
+    TranslationCostCpu cost;
+    GlobalQuiltingStats g;
+    bool global = false;
+    quilt_surface_auto(base, c.swatch, o, cost, nullptr, &g, nullptr, &global);
+    EXPECT_EQ(global, c.global);
+    if (!global) continue;
+    EXPECT_EQ(g.threads, c.threads);
+    EXPECT_EQ(g.tiled, c.tiled);
+  }
+}
+
+TEST(ThreadTiling, SameInputSameBytesWhateverTheThreadCount) {
+  TriMesh base = test::icosphere(3);
+  base.V *= 2.0;
+  std::vector<TriMesh> outs;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    outs.push_back(run(base, 0.3).output);
+  }
+  ASSERT_GT(outs[0].num_faces(), 0);
+  EXPECT_EQ(outs[0].V, outs[1].V);
+  EXPECT_EQ(outs[0].F, outs[1].F);
 }
 
 }  // namespace
