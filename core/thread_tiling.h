@@ -54,9 +54,12 @@ bool long_elements(const PreparedSwatch& swatch);
 // when the swatch is not a lattice of threads: not periodic, an element that is not long, or
 // one that is not invariant under a lattice vector along it, is too short to hold a period
 // between its ends, or has no cross-section where a plane orthogonal to it cuts it cleanly
-// along edges (a loop of vertices, as a swept tube has at every sample) with a matching loop
-// one period on. Of the clean cuts, the one farthest from other elements (between crossings):
-// an unwelded end is capped there. Deterministic. About O(#V^2 / cells) per thread.
+// along edges (a ring of vertices, as a swept tube has where it runs level: a weave's
+// crossings) with a matching ring one period on. Of the clean cuts, one that the swatch's half
+// turn maps onto a lattice copy of the piece (when any is: pieces then meet across the
+// layout's half-turn transitions), and of those the one whose centre is farthest from other
+// elements (an unwelded end is capped there). Deterministic. O(#F) per candidate cut, plus its
+// distance to the swatch's other vertices.
 ThreadTiling thread_tiling(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry);
 
 // A piece placed over the surface: the copy of tiling.pieces[piece] in local coordinates (its
