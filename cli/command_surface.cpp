@@ -144,6 +144,15 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("placed", global->placed)
         .value("off_surface", global->off_surface)
         .value("copied_elements", global->copied_elements)
+        .value("threads", global->threads)
+        .value("thread_pieces", global->thread_pieces)
+        .value("pieces_distorted", global->pieces_distorted)
+        .value("pieces_near_cones", global->pieces_near_cones)
+        .value("pieces_intersecting", global->pieces_intersecting)
+        .value("thread_welds", global->thread_welds)
+        .value("thread_ends", global->thread_ends)
+        .value("closed_threads", global->closed_threads)
+        .value("short_threads", global->short_threads)
         .end_object();
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
   j.begin_object("stage_seconds");
@@ -232,6 +241,7 @@ int run_surface(int argc, char** argv, int first) {
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
   const double min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
+  options.global.drop_folded_pieces = !embedding.shell_map;
   options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
   const std::string placement = cl.get("element-placement");

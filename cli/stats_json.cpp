@@ -94,6 +94,8 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
       .value("long_elements", r.long_elements)
       .value("ends", r.ends)
       .value("interior_ends", r.interior_ends)
+      .value("closed_long_elements", r.closed_long_elements)
+      .value("median_long_length", r.median_long_length)
       .value("area", r.area > 0 ? r.area : std::nan(""))
       .value("density", r.density > 0 ? r.density : std::nan(""))
       .value("density_cells", r.density_cells)
@@ -142,7 +144,9 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
     j.end_array()
         .value("density_ratio",
                comparison->density_ratio > 0 ? comparison->density_ratio : std::nan(""))
-        .value("linear_scale", comparison->linear_scale);
+        .value("linear_scale", comparison->linear_scale)
+        .value("long_length_ratio", known(comparison->long_length_ratio))
+        .value("interior_ends_per_swatch_area", known(comparison->interior_ends_per_swatch_area));
     j.begin_object("shape")
         .value("elements", s.elements)
         .value("by_correspondence", s.by_correspondence);
@@ -180,10 +184,10 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
                 histogram_text(r.link_histogram).c_str(), r.degenerate_rings());
   }
   if (r.long_elements > 0) {
-    std::printf("long elements:     %d, %d ends, %d away from the border", r.long_elements, r.ends,
-                r.interior_ends);
+    std::printf("long elements:     %d (%d closed on themselves), %d ends, %d away from the border",
+                r.long_elements, r.closed_long_elements, r.ends, r.interior_ends);
     if (r.area > 0) std::printf(" (%.4g per unit area)", r.interior_ends_per_area);
-    std::printf("\n");
+    std::printf("; median length %.4g\n", r.median_long_length);
   }
   if (r.density > 0)
     std::printf("density:           %.6g elements per unit area (%d closed Voronoi cells)\n",
@@ -235,6 +239,14 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
     if (comparison->density_ratio > 0)
       std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",
                   100 * comparison->density_ratio, comparison->linear_scale);
+    if (comparison->long_length_ratio > 0) {
+      std::printf("long elements:     median %.2f swatch long elements long",
+                  comparison->long_length_ratio);
+      if (comparison->interior_ends_per_swatch_area > 0)
+        std::printf("; %.4g interior ends per swatch unit squared",
+                    comparison->interior_ends_per_swatch_area);
+      std::printf(" (%.6g output units per swatch unit)\n", comparison->linear_scale);
+    }
     const ShapeSummary& s = comparison->shape;
     if (s.elements > 0) {
       std::printf(

@@ -5,6 +5,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <unordered_map>
 
@@ -14,13 +15,16 @@
 #include "core/geometry_measures.h"
 #include "core/global_parameterization.h"
 #include "core/line_field.h"
+#include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/planar_quilting.h"
 #include "core/quilt_elements.h"
-#include "core/swatch_symmetry.h"
 #include "core/straightest_geodesic.h"
+#include "core/swatch_symmetry.h"
 #include "core/tangent_field.h"
+#include "core/thread_tiling.h"
 #include "core/trivial_connection.h"
+#include "core/vertex_cover.h"
 #include "core/vine_growth.h"
 #include "core/weld_vertices.h"
 
@@ -635,6 +639,199 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
   return placed;
 }
 
+// How far the layout may bend a thread piece out of the swatch's shape (within_shape_limits'
+// scale, aspect and variation) before it is left out. Looser than for rings, which have a copy
+// to fall back to (place_linear): a left-out piece ends two threads and bares the surface.
+// Measured on the cup at 1.3 / 1.6 / 2.5: coverage 0.897 / 0.979 / 0.992 (the handle's side,
+// where the layout gathers its cones, bare at 1.3); at 2.5 threads there are visibly thickened.
+constexpr double kThreadShapeLimit = 1.6;
+
+// A thread of one piece, cut off on both sides (next to a cone, between pieces left out), is a
+// stub of one period, debris rather than a thread: left out (bunny: 6 of 151 threads).
+constexpr int kMinThreadPieces = 2;
+
+// Whether the layout can carry a tiling: the charts' area in the plane is at most 4 times the
+// surface's, and the faces whose layout scales area within [1/4, 4] hold 80% of it. A layout
+// that collapses and blows up faces (on the wicker chair's 77 parts: 1% of faces 140,000 times
+// too large, 10% 250 times too small) would ask for millions of copies and leave parts bare.
+bool layout_fit_for_tiling(const GlobalParameterization& gp, const TriMesh& base) {
+  double plane = 0, surface = 0, even = 0;
+  for (int f = 0; f < base.num_faces(); ++f) {
+    const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
+    const double ap = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    const Vector3d p0 = base.V.row(base.F(f, 0)), p1 = base.V.row(base.F(f, 1)),
+                   p2 = base.V.row(base.F(f, 2));
+    const double a3 = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    plane += ap;
+    surface += a3;
+    if (ap >= 0.25 * a3 && ap <= 4 * a3) even += a3;
+  }
+  return surface > 0 && plane <= 4 * surface && even >= 0.8 * surface;
+}
+
+// A periodic swatch of threads (core/thread_tiling) carried onto the base: every lattice copy of
+// every thread piece whose centre lies on the parameterised surface, placed through the layout
+// like place_lattice's elements, then welded end to end into threads. A piece is left out, and
+// its threads end there:
+// - where the layout bends it beyond kThreadShapeLimit (within_shape_limits);
+// - within one thread spacing of a cone. Straight threads wrap round cones: a cone of angle pi
+//   (a + cone of the line field) turns a line passing it by a half turn, in a hairpin as tight
+//   as the line passes close. These were the U-turns of --method global (every sharp turn of a
+//   thread within the tangent plane on the cup and the bunny lay 0.7-1.5 spacings from a +
+//   cone); a thread farther away turns round it in a wide arc;
+// - where, embedded by normal displacement, it intersects another piece (as few left out as can
+//   be, greedy_vertex_cover: the embedding removes whole elements, and an element here is a
+//   whole thread; bunny + weave: 103 threads removed after the shell map without this), or
+//   folds through itself when options.global.drop_folded_pieces says the quilt will be
+//   embedded so (the shell map unfolds them: 148 of the bunny's 1,642 pieces fold under
+//   normal displacement, none after the shell map).
+// The work follows the surface's parameter area.
+std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, const SurfaceJob& job,
+                                          const ThreadTiling& tiling, const SwatchSymmetry& sym,
+                                          const Vector2d& lo, double shell_height,
+                                          const SurfaceQuiltingOptions& options,
+                                          GlobalQuiltingStats& gstats, StageTimes& times,
+                                          ProgressSink* progress) {
+  Eigen::Matrix2d basis;
+  basis.col(0) = sym.a;
+  basis.col(1) = sym.b;
+  std::vector<LatticeCopy> copies;
+  {
+    ScopedStageTimer timer(times, "tiling");
+    ScopedStageProgress shown(progress, "tiling");
+    std::vector<Vector2d> centres;
+    for (const ThreadPiece& p : tiling.pieces) centres.push_back(p.centre + lo);
+    copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
+    double faces = 0;
+    for (const LatticeCopy& c : copies)
+      faces += static_cast<double>(tiling.pieces[static_cast<size_t>(c.rep)].F.rows());
+    MQ_CHECK(faces <= options.max_faces, InvalidInput, "the global layout would place ",
+             copies.size(), " thread pieces of about ", faces,
+             " faces in all, more than the limit of ", options.max_faces,
+             " (--max-faces); use a larger --scale");
+    for (int f = 0; f < job.base.num_faces(); ++f) {
+      const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
+      gstats.parameter_area +=
+          0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    }
+  }
+  ScopedStageTimer timer(times, "placement");
+  ScopedStageProgress shown(progress, "placement");
+  const Eigen::MatrixXd differential = layout_differential(gp, job.base);
+  const MatrixX3d N = vertex_normals(job.base.V, job.base.F);
+  std::vector<Vector3d> cones;
+  for (int v = 0; v < job.base.num_vertices(); ++v)
+    if (gp.singular[static_cast<size_t>(v)]) cones.push_back(job.base.V.row(v).transpose());
+  SurfaceQuiltingOptions::Global limits = options.global;
+  limits.max_element_scale = limits.max_element_aspect = limits.max_element_variation =
+      kThreadShapeLimit;
+  const int n = static_cast<int>(copies.size());
+  enum Outcome : char { kPlaced, kOff, kDistorted, kNearCone };
+  std::vector<PlacedPiece> out(copies.size());
+  std::vector<MatrixX3d> proxy(copies.size());
+  std::vector<char> outcome(copies.size(), kOff);
+  const int block = std::max(64, n / 50);
+  for (int first = 0; first < n; first += block) {
+    report_progress(progress, "placement", first, n);
+    tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
+      const LatticeCopy& c = copies[static_cast<size_t>(i)];
+      const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(c.rep)];
+      const Vector2d t = lo + basis * c.k.cast<double>();
+      MatrixX3d P = piece.V;
+      P.col(0).array() += t.x();
+      P.col(1).array() += t.y();
+      PlacedPiece& pp = out[static_cast<size_t>(i)];
+      pp.piece = c.rep;
+      SurfaceElement& s = pp.element;
+      s.F = piece.F;
+      s.kind = piece.kind;
+      std::vector<signed char> turn;
+      if (!place_from(gp, job, P, c.face, shell_height, s, &turn)) return;
+      s.flat.resize(0, 3);  // a thread has no rigid shape to fall back to
+      Eigen::Matrix<double, 2, 3> M;
+      if (!within_shape_limits(differential, P, s, turn, limits, M)) {
+        outcome[static_cast<size_t>(i)] = kDistorted;
+        return;
+      }
+      MatrixX3d& X = proxy[static_cast<size_t>(i)];
+      X.resize(P.rows(), 3);
+      for (Eigen::Index v = 0; v < P.rows(); ++v)
+        X.row(v) = displace_along_normal(job.base, N, s.face[static_cast<size_t>(v)],
+                                         s.barycentric.row(v).transpose(), s.height(v))
+                       .transpose();
+      // One thread spacing: the distance between a thread and its next copy alongside.
+      const double clearance = std::abs(basis.determinant()) / piece.period.norm();
+      for (const Vector3d& cone : cones)
+        if (((X.rowwise() - cone.transpose()).rowwise().norm().array() < clearance).any()) {
+          outcome[static_cast<size_t>(i)] = kNearCone;
+          return;
+        }
+      outcome[static_cast<size_t>(i)] = kPlaced;
+    });
+  }
+  std::vector<PlacedPiece> placed;
+  std::vector<MatrixX3d> positions;
+  for (size_t i = 0; i < copies.size(); ++i) {
+    gstats.off_surface += outcome[i] == kOff;
+    gstats.pieces_distorted += outcome[i] == kDistorted;
+    gstats.pieces_near_cones += outcome[i] == kNearCone;
+    if (outcome[i] != kPlaced) continue;
+    placed.push_back(std::move(out[i]));
+    positions.push_back(std::move(proxy[i]));
+  }
+  std::vector<PlacedPiece>().swap(out);
+  gstats.thread_pieces = static_cast<int>(placed.size());
+  const std::vector<ThreadWeld> welds =
+      find_thread_welds(placed, tiling, [&](int k, int v) -> Vector3d {
+        return positions[static_cast<size_t>(k)].row(v).transpose();
+      });
+  ThreadWeldStats ws;
+  std::vector<std::vector<int>> face_piece;
+  std::vector<SurfaceElement> threads = weld_threads(placed, tiling, welds, {}, &ws, &face_piece);
+  // The threads embedded by normal displacement, welded: the pieces of a thread share their
+  // loops and do not count as touching there.
+  {
+    std::vector<Eigen::Index> first(threads.size() + 1, 0), first_face(threads.size() + 1, 0);
+    for (size_t k = 0; k < threads.size(); ++k) {
+      first[k + 1] = first[k] + static_cast<Eigen::Index>(threads[k].face.size());
+      first_face[k + 1] = first_face[k] + threads[k].F.rows();
+    }
+    MatrixX3d V(first.back(), 3);
+    MatrixX3i F(first_face.back(), 3);
+    std::vector<int> piece_of(static_cast<size_t>(first_face.back()));
+    tbb::parallel_for(size_t{0}, threads.size(), [&](size_t k) {
+      const SurfaceElement& e = threads[k];
+      for (size_t v = 0; v < e.face.size(); ++v) {
+        const Eigen::Index r = static_cast<Eigen::Index>(v);
+        V.row(first[k] + r) = displace_along_normal(job.base, N, e.face[v],
+                                                    e.barycentric.row(r).transpose(), e.height(r))
+                                  .transpose();
+      }
+      F.middleRows(first_face[k], e.F.rows()) = e.F.array() + static_cast<int>(first[k]);
+      std::copy(face_piece[k].begin(), face_piece[k].end(), piece_of.begin() + first_face[k]);
+    });
+    IntersectionOptions io;
+    io.between_components_only = false;
+    std::vector<char> drop(placed.size(), 0);
+    std::vector<std::pair<int, int>> touching;
+    for (const auto& [f, g] : intersecting_face_pairs(V, F, io)) {
+      const int a = piece_of[static_cast<size_t>(f)], b = piece_of[static_cast<size_t>(g)];
+      if (a != b)
+        touching.emplace_back(a, b);
+      else if (options.global.drop_folded_pieces)
+        drop[static_cast<size_t>(a)] = 1;
+    }
+    greedy_vertex_cover(touching, drop);
+    gstats.pieces_intersecting = static_cast<int>(std::count(drop.begin(), drop.end(), 1));
+    threads = weld_threads(placed, tiling, welds, drop, &ws, nullptr, kMinThreadPieces);
+  }
+  gstats.thread_welds = ws.welds;
+  gstats.thread_ends = ws.caps;
+  gstats.closed_threads = ws.closed_threads;
+  gstats.short_threads = ws.short_threads;
+  return threads;
+}
+
 // The line field whose singularities are the layout's first cones, on the smoothed copy V of
 // the base. The guidance (the user's field, or the smooth default along the longest box axis)
 // is followed weakly; when that leaves a pole (an index-1 singularity), the smoothest line
@@ -669,12 +866,16 @@ DirectionField layout_line_field(const MatrixX3d& V, const SurfaceJob& job,
 }
 
 // The global method from a prepared job and the swatch's symmetry (found on job.swatch).
+// threads: the swatch's thread tiling when known (empty: found here when the swatch is no
+// lattice of compact elements). unfit (optional): set, and nothing placed or returned, when the
+// swatch is a lattice of threads and the layout cannot carry its tiling
+// (layout_fit_for_tiling); the caller quilts otherwise.
 SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch,
-                                   const SwatchSymmetry& symmetry,
+                                   const SwatchSymmetry& symmetry, ThreadTiling threads,
                                    const SurfaceQuiltingOptions& options,
                                    TranslationCostEvaluator& evaluator, SurfaceQuiltingStats stats,
                                    SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
-                                   ProgressSink* progress) {
+                                   ProgressSink* progress, bool* unfit = nullptr) {
   GlobalQuiltingStats gstats;
   StageTimes& times = stats.times;
   const TriMesh& base = job.base;
@@ -748,6 +949,17 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     stats.iterations = 1;
     stats.cell_size = matching_cell_size(swatch);
     placed = place_lattice(gp, job, swatch, symmetry, lo, options, gstats, times, progress);
+  } else if (options.global.tile &&
+             !(threads.empty() ? (threads = thread_tiling(swatch, symmetry)) : threads).empty()) {
+    if (unfit && !layout_fit_for_tiling(gp, base)) {
+      *unfit = true;
+      return {};
+    }
+    gstats.threads = true;
+    stats.iterations = 1;
+    stats.cell_size = matching_cell_size(swatch);
+    placed = place_threads(gp, job, threads, symmetry, lo, swatch.size.z(), options, gstats, times,
+                           progress);
   } else {
     PlanarQuiltingOptions po;
     po.length = std::max(hi.x() - lo.x(), swatch.size.x());
@@ -810,7 +1022,7 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
   const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
-  return quilt_prepared_global(job, swatch, symmetry, options, evaluator, std::move(stats),
+  return quilt_prepared_global(job, swatch, symmetry, {}, options, evaluator, std::move(stats),
                                stats_out, global_out, progress);
 }
 
@@ -823,18 +1035,42 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
-  bool repeating = false;
+  bool repeating = false, threads = false;
   {
     ScopedStageTimer timer(stats.times, "method choice");
     repeating = repeating_elements(swatch);
+    threads = !repeating && long_elements(swatch);
   }
-  if (repeating) {
+  if (repeating || threads) {
     // The symmetry decides and, for a lattice, is the one the layout uses: found once.
     const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
-    if (tileable(swatch, symmetry)) {
+    ThreadTiling tiling;
+    bool global = false;
+    {
+      ScopedStageTimer timer(stats.times, "method choice");
+      global = repeating ? tileable(swatch, symmetry)
+                         : !(tiling = thread_tiling(swatch, symmetry)).empty();
+    }
+    if (global && repeating) {
       if (used_global) *used_global = true;
-      return quilt_prepared_global(job, swatch, symmetry, options, evaluator, std::move(stats),
-                                   stats_out, global_out, progress);
+      return quilt_prepared_global(job, swatch, symmetry, std::move(tiling), options, evaluator,
+                                   std::move(stats), stats_out, global_out, progress);
+    }
+    if (global) {
+      // Threads: the layout is made first, and where it cannot carry the tiling (a base of
+      // many small, rough parts) the patches quilt the job instead.
+      const auto start = std::chrono::steady_clock::now();
+      bool unfit = false;
+      SurfaceQuilt quilt =
+          quilt_prepared_global(job, swatch, symmetry, std::move(tiling), options, evaluator, stats,
+                                stats_out, global_out, progress, &unfit);
+      if (!unfit) {
+        if (used_global) *used_global = true;
+        return quilt;
+      }
+      stats.times.add(
+          "unfit layout",
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
   }
   if (used_global) *used_global = false;

@@ -41,10 +41,21 @@ struct GlobalQuiltingStats {
   // Placed as copies of the layout's first-order image at their centre (the layout itself
   // would have distorted them; SurfaceQuiltingOptions::Global::placement).
   int copied_elements = 0;
+  // A periodic swatch of threads (core/thread_tiling): its one-period pieces tiled and welded.
+  bool threads = false;
+  int thread_pieces = 0;        // pieces placed (those off the surface count in off_surface)
+  int pieces_distorted = 0;     // left out: the layout bends them out of shape
+  int pieces_near_cones = 0;    // left out: within a thread spacing of a cone
+  int pieces_intersecting = 0;  // left out: intersecting others (normal displacement)
+  int thread_welds = 0;         // loops where two pieces were joined
+  int thread_ends = 0;          // loops left open, capped
+  int closed_threads = 0;       // threads closed on themselves
+  int short_threads = 0;        // threads of a single piece, left out
 };
 
-// Like quilt_surface (same options, same result), through a global parameterisation.
-// Throws like quilt_surface.
+// Like quilt_surface (same options, same result), through a global parameterisation: a lattice
+// of compact elements is tiled, a lattice of threads tiled by one-period pieces welded into
+// threads, any other swatch quilted over the parameter plane. Throws like quilt_surface.
 SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
                                   const SurfaceQuiltingOptions& options,
                                   TranslationCostEvaluator& evaluator,
@@ -53,11 +64,12 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base, const TriMesh& swatch,
                                   ProgressSink* progress = nullptr);
 
 // --method auto: quilt_surface_global for a lattice of compact elements (periodic and
-// tileable, core/swatch_symmetry: the textures whose structure the patch method loses, decided
-// on the swatch at the job's scale), quilt_prepared_vines (core/vine_growth) for a vine with
-// compact elements attached along it (is_vine_swatch: the ivy section), quilt_surface
-// otherwise; the swatch's symmetry is found once. *used_global and *used_vines (optional) say
-// which ran, *vine_stats (optional) gets the vines' figures. Throws like quilt_surface.
+// tileable, core/swatch_symmetry) or of threads (core/thread_tiling): the textures whose
+// structure the patch method loses (links, threads that run on), decided on the swatch at the
+// job's scale; quilt_prepared_vines (core/vine_growth) for a vine with compact elements
+// attached along it (is_vine_swatch: the ivy section); quilt_surface otherwise. The swatch's
+// symmetry is found once. *used_global and *used_vines (optional) say which ran, *vine_stats
+// (optional) gets the vines' figures. Throws like quilt_surface.
 SurfaceQuilt quilt_surface_auto(const TriMesh& base, const TriMesh& swatch,
                                 const SurfaceQuiltingOptions& options,
                                 TranslationCostEvaluator& evaluator,

@@ -120,8 +120,13 @@ struct SurfaceQuiltingOptions {
     double max_element_aspect = 1.3;
     double max_element_variation = 1.3;
     // A periodic swatch of compact elements is tiled over the parameter plane (the planar
-    // quilt it would give); else the plane is quilted.
+    // quilt it would give), one of threads by one-period pieces welded into threads
+    // (core/thread_tiling); else the plane is quilted.
     bool tile = true;
+    // The quilt will be embedded by plain normal displacement: thread pieces that it folds
+    // through themselves are left out (a folded thread would be removed whole). The shell map
+    // unfolds them, so they are kept for it.
+    bool drop_folded_pieces = false;
   } global;
 };
 

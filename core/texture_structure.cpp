@@ -103,6 +103,7 @@ int farthest(const std::vector<double>& dist) {
 struct ElementFigures {
   ElementStructure s;
   std::optional<Loop> loop;
+  bool closed_genus_one = false;  // every edge in two faces, Euler characteristic 0
   Vector3d end[2] = {Vector3d::Zero(), Vector3d::Zero()};
   double raw_size = 0, raw_stretch = 0;  // shape figures before division by the linear scale
 };
@@ -207,13 +208,20 @@ ElementFigures figures_of(const TriMesh& part, int loop_bins) {
     return out;
   }
   if (V.rows() < 2) return out;
-  // Length: the double-sweep graph diameter (exact on a tube, a close lower bound elsewhere);
-  // width: the diameter a tube of that length and the element's area would have.
+  {
+    const EdgeTopology topo = edge_topology(part.F, static_cast<int>(V.rows()));
+    bool closed = true;
+    for (int e = 0; e < topo.num_edges() && closed; ++e) closed = topo.edge_faces.degree(e) == 2;
+    out.closed_genus_one = closed && V.rows() - topo.num_edges() + part.F.rows() == 0;
+  }
+  // Length: the double-sweep graph diameter (exact on a tube, a close lower bound elsewhere;
+  // twice it round a closed tube, whose farthest points are half way round); width: the
+  // diameter a tube of that length and the element's area would have.
   const Adjacency adj = vertex_adjacency(part.F, static_cast<int>(V.rows()));
   const int a = farthest(graph_distances(V, adj, 0));
   const std::vector<double> from_a = graph_distances(V, adj, a);
   const int b = farthest(from_a);
-  const double length = from_a[b];
+  const double length = (out.closed_genus_one ? 2 : 1) * from_a[b];
   if (!(length > 0)) return out;
   const double width = out.s.area / (M_PI * length);
   out.s.length = length;
@@ -434,6 +442,18 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
       if (f.s.ring_shaped) wires[static_cast<size_t>(f.s.kind)].push_back(f.s.wire);
     for (size_t k = 0; k < gauge.size(); ++k) gauge[k] = median(wires[k]);
   }
+  // Long kinds: the swatch's (neither rings nor compact), or the mesh's own (most of a kind's
+  // elements long). Their closed elements are threads closed on themselves, not rings.
+  std::vector<char> long_kind(report.kinds.size(), 0);
+  if (!swatch) {
+    std::vector<int> longs(report.kinds.size(), 0), all(report.kinds.size(), 0);
+    for (const ElementFigures& f : figures) {
+      ++all[static_cast<size_t>(f.s.kind)];
+      longs[static_cast<size_t>(f.s.kind)] += f.s.long_element ? 1 : 0;
+    }
+    for (size_t k = 0; k < long_kind.size(); ++k)
+      long_kind[k] = !ring_kind[k] && 2 * longs[k] > all[k];
+  }
   report.elements.resize(static_cast<size_t>(n));
   std::vector<Vector3d> centres(static_cast<size_t>(n));
   std::vector<double> sizes(static_cast<size_t>(n)), areas(static_cast<size_t>(n)), widths;
@@ -442,7 +462,23 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
     ElementStructure& e = f.s;
     const SwatchKind* sk = swatch && e.swatch_kind >= 0 ? &swatch->kinds[e.swatch_kind] : nullptr;
     const bool of_ring_kind = sk ? sk->ring : ring_kind[static_cast<size_t>(e.kind)] != 0;
-    if (!e.ring_shaped && of_ring_kind) {
+    const bool of_long_kind =
+        sk ? !sk->ring && !sk->compact : long_kind[static_cast<size_t>(e.kind)] != 0;
+    if (of_long_kind && !of_ring_kind &&
+        (e.ring_shaped || (f.closed_genus_one && e.long_element))) {
+      // A thread closed on itself: as long as its loop, without ends.
+      if (e.ring_shaped) {
+        double length = 0;
+        const Loop& loop = *f.loop;
+        for (size_t k = 0; k < loop.size(); ++k)
+          length += (loop[(k + 1) % loop.size()] - loop[k]).norm();
+        e.length = length;
+        e.width = length > 0 ? e.area / (M_PI * length) : 0;
+      }
+      e.ring = false;
+      e.long_element = e.closed = true;
+      e.wire = e.opening = e.fold = 0;
+    } else if (!e.ring_shaped && of_ring_kind) {
       // A torn, merged or melted ring: a miss, not a thread with two ends.
       e.ring = true;
       e.defect = RingDefect::NotRing;
@@ -462,11 +498,23 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
   }
   report.median_size = median(sizes);
   report.median_area = median(areas);
+  {
+    std::vector<double> lengths;
+    for (const ElementStructure& e : report.elements)
+      if (e.long_element) lengths.push_back(e.length);
+    report.median_long_length = median(lengths);
+    report.median_long_width = median(widths);
+  }
   if (n == 0) return report;
 
   // Shapes at the output's scale.
   if (swatch) {
     double scale = options.linear_scale;
+    const bool long_swatch =
+        2 * swatch->report.long_elements > static_cast<int>(swatch->report.elements.size());
+    if (!(scale > 0) && long_swatch && report.median_long_width > 0 &&
+        swatch->report.median_long_width > 0)
+      scale = report.median_long_width / swatch->report.median_long_width;
     if (!(scale > 0) && swatch->report.median_area > 0)
       scale = std::sqrt(report.median_area / swatch->report.median_area);
     report.linear_scale = scale > 0 ? scale : 0;
@@ -538,7 +586,7 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
   tbb::parallel_for(0, n, [&](int c) {
     ElementStructure& e = report.elements[c];
     e.interior = border_distance(e.centre) > margin;
-    if (e.long_element)
+    if (e.long_element && !e.closed)
       for (const Vector3d& p : figures[c].end)
         if (border_distance(p) > end_margin) ++e.interior_ends;
   });
@@ -551,7 +599,7 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
     std::vector<Vector3d> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n));
     std::vector<double> ring_sizes;
     for (int c = 0; c < n; ++c) {
-      if (!figures[c].loop) continue;
+      if (!figures[c].loop || !report.elements[c].ring) continue;
       rings.push_back(c);
       lo[c] = hi[c] = figures[c].loop->front();
       for (const Vector3d& p : *figures[c].loop) {
@@ -590,13 +638,12 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
     if (e.ring) max_links = std::max(max_links, e.links);
   report.link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
   report.interior_link_histogram.assign(static_cast<size_t>(max_links) + 1, 0);
-  std::vector<double> long_lengths;
   for (const ElementStructure& e : report.elements) {
     if (e.long_element) {
       ++report.long_elements;
-      report.ends += 2;
+      report.closed_long_elements += e.closed ? 1 : 0;
+      report.ends += e.closed ? 0 : 2;
       report.interior_ends += e.interior_ends;
-      long_lengths.push_back(e.length);
       report.long_length += e.length;
     } else {
       ++report.compact_elements;
@@ -612,11 +659,6 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
       ++report.interior_defects[defect];
       if (!e.degenerate()) ++report.interior_link_histogram[e.links];
     }
-  }
-
-  if (!long_lengths.empty()) {
-    std::sort(long_lengths.begin(), long_lengths.end());
-    report.median_long_length = percentile(long_lengths, 0.5);
   }
 
   // Density from the Voronoi cells of interior elements in their tangent planes.
@@ -878,6 +920,9 @@ StructureComparison compare_structure(const StructureReport& output, const Swatc
       2 * swatch.report.long_elements > static_cast<int>(swatch.report.elements.size());
   if (output.density > 0 && swatch.density > 0 && c.linear_scale > 0 && !long_swatch)
     c.density_ratio = output.density / (swatch.density / (c.linear_scale * c.linear_scale));
+  if (c.linear_scale > 0 && output.long_elements > 0 && output.area > 0)
+    c.interior_ends_per_swatch_area =
+        output.interior_ends_per_area * c.linear_scale * c.linear_scale;
   // Shapes, measured with the swatch (measure_structure's options.swatch).
   std::vector<double> sizes, aspects;
   for (const ElementStructure& e : output.elements) {

@@ -65,7 +65,8 @@ struct StructureOptions {
   // of its elements are ring-shaped).
   const SwatchStructure* swatch = nullptr;
   // With swatch: output length per swatch length, for the shape figures; 0: estimated from the
-  // median element areas (their square root).
+  // median element areas (their square root), or for a swatch mostly of long elements from
+  // their median widths (the areas of welded threads follow their lengths, not the scale).
   double linear_scale = 0;
   // Rings judged folded (off only for the swatch itself, whose rings are the reference).
   bool judge_folds = true;
@@ -118,7 +119,12 @@ struct ElementStructure {
   double wire = 0, opening = 0, fold = 0;  // ring-shaped elements: RingShape
   bool interior = true;                    // farther than interior_margin from the border
   bool long_element = false;               // a thread or vine: length >= 4 times its width
-  double length = 0, width = 0;            // long elements: end-to-end length along the surface
+  // A long element closed on itself (a thread round a cup's body or handle: closed, genus 1,
+  // ring-shaped or long, and of a long kind), with no ends. Not a ring.
+  bool closed = false;
+  // Long elements: end-to-end length along the surface (closed: the length of the loop round);
+  // width: the diameter of a tube of that length and the element's area.
+  double length = 0, width = 0;
   int interior_ends = 0;                   // of its two ends, those away from the border
   // Measured against options.swatch: the swatch kind it was matched to (-1: none) and, for a
   // compact element (its swatch kind's elements mostly not long), its shape against the swatch
@@ -159,9 +165,11 @@ struct StructureReport {
   std::vector<int> interior_link_histogram;
   std::vector<int> link_histogram;  // the same over all rings
   int long_elements = 0, ends = 0, interior_ends = 0;
-  // The long elements' lengths (ElementStructure::length): their median and their sum; and
-  // the elements that are not long (leaves along vines; rings), for their count per length.
-  double median_long_length = 0, long_length = 0;
+  int closed_long_elements = 0;  // of the long elements, closed on themselves (no ends)
+  // The long elements' lengths (ElementStructure::length): their median and their sum; their
+  // median width; and the elements that are not long (leaves along vines; rings), for their
+  // count per length.
+  double median_long_length = 0, long_length = 0, median_long_width = 0;
   int compact_elements = 0;
   double area = 0;  // 0: unknown
   // Elements per unit area: interior elements over the total area of their Voronoi cells in
@@ -264,18 +272,23 @@ struct StructureComparison {
   // Output density / swatch density at the output's scale; 0 when most swatch elements are long
   // (threads join across seams, so their count per area says nothing; see interior ends).
   double density_ratio = 0;
-  double linear_scale = 0;  // output length units per swatch unit
+  // Output length units per swatch unit: given, else the shapes' (StructureReport::
+  // linear_scale), else from the median element areas.
+  double linear_scale = 0;
+  // Long elements (threads, vines): the output's median length in swatch long elements (its
+  // median length over the swatch's at the output's scale: how many swatch threads a thread
+  // runs, 1 for vines in swatch-sized pieces); its compact elements per long length against the
+  // swatch's (1: leaves at the swatch's leaves per vine length); and its interior ends per unit
+  // area at the swatch's scale (per swatch unit squared, comparable with a plane quilted from
+  // the swatch). 0 when either has no long elements or the area is unknown.
+  double long_length_ratio = 0, compact_per_length_ratio = 0;
+  double interior_ends_per_swatch_area = 0;
   // The shape figures (ElementStructure::size_ratio, aspect) of compact elements (rings,
   // apples; not threads or vines, which seams cut); empty unless the output was measured with
   // the swatch. The map stretches an element where it is as wide as the feature under it (a
   // spike, a hoof).
   ShapeSummary shape;
   int stretched = 0;  // compact elements stretched over kStretchedSize along some direction
-  // With long elements in both (issue 23: vines that run on): the output's median long element
-  // in swatch long elements (its median length over the swatch's at the output's scale: 1 for
-  // vines in swatch-sized pieces), and its compact elements per long length against the
-  // swatch's (1: leaves at the swatch's leaves per vine length). 0 when either has none.
-  double long_length_ratio = 0, compact_per_length_ratio = 0;
   double largest_stretch = 0;  // their largest ElementStructure::stretch
   static constexpr double kStretchedSize = 1.5;
 };

@@ -483,6 +483,49 @@ TEST(TextureStructure, VineLengthsAreMeasuredInSwatchVines) {
   EXPECT_EQ(compare_structure(measure_structure(apple_layer({})), ref, 1.0).long_length_ratio, 0.0);
 }
 
+// A thread closed on itself (round a cup's body) is a long element without ends, as long as its
+// loop, and not a ring; threads are measured in swatch threads, at a scale found from their
+// widths when not given (the areas of welded threads follow their lengths, not the scale).
+TEST(TextureStructure, ClosedThreadsHaveNoEndsAndLengthsCountInSwatchThreads) {
+  WeaveOptions o;
+  o.threads_x = o.threads_y = 6;
+  const TriMesh weave = plain_weave(o);
+  const SwatchStructure swatch = measure_swatch_structure(weave);
+  TriMesh loop = test::planar_tube(
+      [](double t) { return Vector2d(30 + 20 * std::cos(t), 20 * std::sin(t)); }, 0.15, 512, 10);
+  set_single_kind(loop, "thread_x");
+  TriMesh mesh = weave;
+  append_mesh(mesh, loop);
+  StructureOptions so;
+  so.automatic_border = false;  // every end counts
+  so.swatch = &swatch;
+  const StructureReport r = measure_structure(mesh, so);
+  EXPECT_EQ(r.rings, 0);
+  EXPECT_EQ(r.long_elements, 13);
+  EXPECT_EQ(r.closed_long_elements, 1);
+  EXPECT_EQ(r.ends, 24);
+  EXPECT_EQ(r.interior_ends, 24);
+  ASSERT_EQ(r.elements.size(), 13u);
+  const ElementStructure& closed = r.elements.back();
+  EXPECT_TRUE(closed.closed);
+  EXPECT_FALSE(closed.ring);
+  EXPECT_NEAR(closed.length, 2 * M_PI * 20, 0.5);
+  EXPECT_NEAR(closed.width, 0.3, 0.01);
+  EXPECT_EQ(closed.interior_ends, 0);
+  // The sheet against itself is one swatch thread long, and so it is twice as large.
+  so.automatic_border = true;
+  const StructureComparison self = compare_structure(measure_structure(weave, so), swatch);
+  EXPECT_NEAR(self.long_length_ratio, 1.0, 1e-6);
+  TriMesh twice = weave;
+  twice.V *= 2;
+  const StructureReport big = measure_structure(twice, so);
+  EXPECT_NEAR(big.linear_scale, 2.0, 1e-6);
+  const StructureComparison c = compare_structure(big, swatch);
+  EXPECT_NEAR(c.long_length_ratio, 1.0, 1e-6);
+  // Interior ends per swatch unit squared: the same as the sheet's own.
+  EXPECT_NEAR(c.interior_ends_per_swatch_area, self.interior_ends_per_swatch_area, 1e-9);
+}
+
 TEST(TextureStructure, BaseBoundaryDecidesTheInteriorOfACurvedResult) {
   // Rings standing on an open half cylinder: those near its straight edges are border ones.
   const TriMesh grid = test::plane_grid(10, 10, 10, 10);
