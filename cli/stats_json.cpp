@@ -95,7 +95,6 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
       .value("ends", r.ends)
       .value("interior_ends", r.interior_ends)
       .value("closed_long_elements", r.closed_long_elements)
-      .value("median_long_length", r.median_long_length)
       .value("area", r.area > 0 ? r.area : std::nan(""))
       .value("density", r.density > 0 ? r.density : std::nan(""))
       .value("density_cells", r.density_cells)
@@ -165,7 +164,6 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
         .value("stretched_elements", comparison->stretched)
         .value("largest_stretch", known(comparison->largest_stretch))
         .value("largest_size_ratio", known(s.size_max))
-        .value("long_length_ratio", known(comparison->long_length_ratio))
         .value("compact_per_length_ratio", known(comparison->compact_per_length_ratio));
   }
   j.end_object();
@@ -228,14 +226,6 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
                       (k.kind + ":").c_str(), 100 * k.share, k.interior_rings, k.interior_links,
                       k.degenerate);
     }
-    if (comparison->long_length_ratio > 0) {
-      std::printf("long lengths:      median %.2f swatch long elements (%.4g)",
-                  comparison->long_length_ratio, r.median_long_length);
-      if (comparison->compact_per_length_ratio > 0)
-        std::printf(", %.3g compact elements per length, %.3f times the swatch's",
-                    r.compact_elements / r.long_length, comparison->compact_per_length_ratio);
-      std::printf("\n");
-    }
     if (comparison->density_ratio > 0)
       std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",
                   100 * comparison->density_ratio, comparison->linear_scale);
@@ -245,6 +235,9 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
       if (comparison->interior_ends_per_swatch_area > 0)
         std::printf("; %.4g interior ends per swatch unit squared",
                     comparison->interior_ends_per_swatch_area);
+      if (comparison->compact_per_length_ratio > 0)
+        std::printf("; %.3g compact elements per length, %.3f times the swatch's",
+                    r.compact_elements / r.long_length, comparison->compact_per_length_ratio);
       std::printf(" (%.6g output units per swatch unit)\n", comparison->linear_scale);
     }
     const ShapeSummary& s = comparison->shape;

@@ -112,7 +112,10 @@ TEST(SurfaceAcceptance, ShellMapRemovesNormalDisplacementsIntersectionsOnTheKnig
       normal, shell);
   ASSERT_TRUE(shell_stats.shell_map_failure.empty()) << shell_stats.shell_map_failure;
   EXPECT_GT(normal, 0u);
-  EXPECT_LE(4 * shell, normal);
+  // At least three times fewer (four before issue 23, when normal displacement took the plain
+  // vertex normals of the base as given, which fan out at the knight's spikes; now the shell's
+  // smoothed directions over the refined base: 672 pairs instead of over 1,000).
+  EXPECT_LE(3 * shell, normal);
 }
 
 // Issue 4, "threads continue across patch seams": a plain weave guided by a constant world
