@@ -135,7 +135,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("cone_moves", global->cone_moves)
         .value("scale_energy_before", global->scale_energy_before)
         .value("scale_energy", global->scale_energy)
-        .value("conformal", global->conformal)
+        .value("scale_exponent", global->scale_exponent)
         .value("pinned_cones", global->pinned_cones)
         .value("cut_edges", global->cut_edges)
         .value("cut_paths", global->cut_paths)

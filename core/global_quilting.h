@@ -27,9 +27,9 @@ struct GlobalQuiltingStats {
   // Cone placement (core/cone_placement): poles split, moves, and the mean squared log scale
   // of the flat cone metric before and after.
   int split_poles = 0, cone_moves = 0;
-  // Whether the layout followed the cone metric's scale (SurfaceQuiltingOptions::Global::
-  // max_scale_energy), else the field at unit scale.
-  bool conformal = false;
+  // How far the layout followed the cone metric's scale e^u: e^(a u), a in [0, 1]
+  // (SurfaceQuiltingOptions::Global::max_overfill); 0 when the layout is not conformal.
+  double scale_exponent = 0;
   double scale_energy_before = 0, scale_energy = 0;
   int pinned_cones = 0;
   int cut_edges = 0, cut_paths = 0;

@@ -105,10 +105,10 @@ struct SurfaceQuiltingOptions {
     // out conformally, by the field parallel in their flat metric scaled by e^u
     // (core/trivial_connection); false: unit frames of the smooth line field.
     bool conformal = true;
-    // Above this mean squared log scale (after the cones are placed) the metric is not
-    // followed, only its field (at unit scale): e^(2E) is how many times over the lattice would
-    // fill the surface.
-    double max_scale_energy = 0.12;
+    // The metric's scale is followed as e^(a u) with a <= 1 such that the lattice, normalised
+    // to the typical element's size, fills the surface at most this many times over
+    // (e^(2 a^2 E), E the mean squared log scale after the cones are placed).
+    double max_overfill = 1.2;
     // How a lattice element is carried onto the base: through the layout vertex by vertex
     // (kLayout: it keeps its place among its neighbours exactly, and takes the layout's
     // distortion across it); as a copy of the layout's first-order image at its centre whose

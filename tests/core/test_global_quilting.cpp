@@ -132,7 +132,7 @@ TEST(GlobalQuilting, SpikySphereTransitionsAreSymmetries) {
   EXPECT_LT(r.global.worst_transition_error, 0.01);
   // Twelve spikes narrower than a ring: the rings on their tips are folded over them
   // (degenerate: misses, and isolated, by the honest measure).
-  expect_mail(r, {0.85, 0.04, 0.08, 1.15}, "spiky sphere");
+  expect_mail(r, {0.84, 0.05, 0.08, 1.15}, "spiky sphere");
 }
 
 // Blender's default UV sphere: at each pole 32 thin triangles meet, and the smooth line field
