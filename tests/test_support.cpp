@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
+
+#include <unistd.h>
 
 namespace mq::test {
 
@@ -29,14 +33,34 @@ void spit(const std::string& path, const std::string& text) {
 }
 
 std::string temp_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = "meshquilt_test";
-  if (info) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  // ctest runs each test in its own process, several at once: a suite's SetUpTestSuite (no
+  // current test) and parameterised tests must not share a directory across processes.
+  const auto* unit = ::testing::UnitTest::GetInstance();
+  const auto* info = unit->current_test_info();
+  const auto* suite = unit->current_test_suite();
+  std::string name = "meshquilt_test_" + std::to_string(::getpid());
+  if (info)
+    name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  else if (suite)
+    name += std::string("_") + suite->name();
   for (char& c : name)
     if (c == '/') c = '_';
   const auto dir = std::filesystem::temp_directory_path() / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  // Named by process, so removed when the process ends (MESHQUILT_KEEP_TEST_DIRS=1 keeps them
+  // to look at a failure).
+  struct Cleanup {
+    std::vector<std::filesystem::path> dirs;
+    ~Cleanup() {
+      const char* keep = std::getenv("MESHQUILT_KEEP_TEST_DIRS");
+      if (keep && std::string(keep) == "1") return;
+      std::error_code ec;
+      for (const auto& d : dirs) std::filesystem::remove_all(d, ec);
+    }
+  };
+  static Cleanup cleanup;
+  cleanup.dirs.push_back(dir);
   return dir.string();
 }
 
