@@ -646,6 +646,10 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
 // where the layout gathers its cones, bare at 1.3); at 2.5 threads there are visibly thickened.
 constexpr double kThreadShapeLimit = 1.6;
 
+// The share of the thread pieces on the surface that the layout must keep (not bent out of shape,
+// not next to a cone) for auto to take it; below it the patches quilt the job.
+constexpr double kMinThreadPiecesKept = 0.5;
+
 // A thread of one piece, cut off on both sides (next to a cone, between pieces left out), is a
 // stub of one period, debris rather than a thread: left out (bunny: 6 of 151 threads).
 constexpr int kMinThreadPieces = 2;
@@ -972,6 +976,14 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     stats.cell_size = matching_cell_size(swatch);
     placed = place_threads(gp, job, threads, symmetry, lo, swatch.size.z(), options, gstats, times,
                            progress);
+    // A layout that bends or breaks most pieces carries no threads that run on, even when its
+    // area is even (the wicker chair's 77 rough parts, 471 cones: 28% of the pieces on the surface
+    // kept, coverage 48%; bunny 88%, cup 93%).
+    const int on_surface = gstats.thread_pieces + gstats.pieces_distorted + gstats.pieces_near_cones;
+    if (unfit && gstats.thread_pieces < kMinThreadPiecesKept * on_surface) {
+      *unfit = true;
+      return {};
+    }
   } else {
     PlanarQuiltingOptions po;
     po.length = std::max(hi.x() - lo.x(), swatch.size.x());

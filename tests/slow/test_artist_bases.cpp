@@ -124,5 +124,24 @@ TEST(ArtistBases, SquarePatternOnPrimitives) {
   expect_even_mail("square 4-in-1 on the cube", quilt(blender("cube.obj"), mail, 0.08), {});
 }
 
+// A base of many small rough parts (the wicker chair: 77 parts, 471 cones in its layout) bends
+// or breaks most thread pieces of the weave's global layout (28% kept, 48% covered): `auto`
+// sees it and quilts the job with the patches instead (71% covered, the rods narrower than
+// the weave's period bare); on the cup the layout keeps 95% of the pieces and is taken.
+TEST(ArtistBases, AutoLeavesTheThreadLayoutWhereItBreaksThreads) {
+  WeaveOptions w;  // as `swatch weave --rows 4 --cols 4 --detail 8` (the chair and cup jobs)
+  w.threads_x = 4;
+  w.threads_y = 4;
+  w.tube_segments = 8;
+  const TriMesh weave = plain_weave(w);
+  const TriMesh chair = read_mesh(test::shared_data("base/wicker_chair_17k.obj"));
+  const ::mq::Run on_chair = quilt(chair, weave, 0.073);
+  EXPECT_FALSE(on_chair.used_global);
+  EXPECT_GT(on_chair.embedding.coverage, 0.6);
+  const ::mq::Run on_cup = quilt(read_mesh(test::shared_data("base/cup_mug_11k.off")), weave, 0.145);
+  EXPECT_TRUE(on_cup.used_global);
+  EXPECT_GT(on_cup.embedding.coverage, 0.95);
+}
+
 }  // namespace
 }  // namespace mq
