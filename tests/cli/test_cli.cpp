@@ -38,11 +38,14 @@ bool opencl_platform_present() {
 
 TEST(Cli, HelpOfEveryCommand) {
   const std::string dir = test::temp_dir();
-  for (const std::string cmd : {"", "plane", "swatch", "info", "render"}) {
+  for (const std::string cmd : {"", "plane", "surface", "swatch", "info", "render"}) {
     const CliRun r = meshquilt(dir, cmd + " --help");
     EXPECT_EQ(r.status, 0) << cmd;
     EXPECT_NE(r.out.find("usage: meshquilt " + cmd), std::string::npos) << cmd << ":\n" << r.out;
     EXPECT_TRUE(r.err.empty()) << cmd << ": " << r.err;
+    // The exit statuses, which a farm scheduler's retry rule needs (issue 24).
+    for (const char* status : {"exit status: 0 done; 1 bad input", "2 bad usage", "3 internal error"})
+      EXPECT_NE(r.out.find(status), std::string::npos) << cmd << " --help lacks '" << status << "'";
   }
   const CliRun v = meshquilt(dir, "--version");
   EXPECT_EQ(v.status, 0);
