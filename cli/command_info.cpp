@@ -20,13 +20,18 @@
 namespace mq::cli {
 
 int run_info(int argc, char** argv, int first) {
-  CommandLine cl("info", "FILE [--json] [--intersections] [--links [--swatch SW] [--base BASE]]",
-                 "Prints the faces, vertices, geometry elements (connected components), bounding\n"
-                 "box, thickness (smallest box side), closedness and manifoldness of a mesh file\n"
-                 "(OBJ, PLY or OFF). --links measures the texture's structure: how many rings\n"
-                 "each ring-shaped element is interlinked with (linking number of centre loops),\n"
-                 "where long elements (threads, vines) end, and elements per unit area; with\n"
-                 "--swatch, how that compares with the swatch's own structure.");
+  CommandLine cl(
+      "info", "FILE [--json] [--intersections] [--links [--swatch SW] [--base BASE]]",
+      "Prints the faces, vertices, geometry elements (connected components), bounding\n"
+      "box, thickness (smallest box side), closedness and manifoldness of a mesh file\n"
+      "(OBJ, PLY or OFF). --links measures the texture's structure: how many rings\n"
+      "each ring-shaped element is interlinked with (linking number of centre loops),\n"
+      "where long elements (threads, vines) end, and elements per unit area. A ring\n"
+      "whose free hole is narrower than its wire (no hole), whose halves turn more than\n"
+      "45 degrees against each other (folded), or of a ring kind but not ring-shaped is\n"
+      "degenerate: a miss, linked to nothing. With --swatch, how that compares with the\n"
+      "swatch's own structure: each ring against its own kind's interior link count, and\n"
+      "the shape (size ratio, aspect) of compact elements against their swatch element.");
   cl.positional("FILE", "mesh file to inspect");
   cl.flag("json", "print the same figures as JSON");
   cl.flag("intersections",
@@ -40,8 +45,11 @@ int run_info(int argc, char** argv, int first) {
             "with --swatch and --base: the scale the result was quilted at, as surface --scale "
             "(default: estimated from the element sizes)");
   cl.option("elements", "CSV",
-            "with --links: write one line per element (centre, size, area, ring, links, interior, "
-            "length, interior ends) to this CSV file");
+            "with --links: write one line per element to this CSV file: centre, size, area, ring, "
+            "links, interior, long, length, interior ends, kind, defect (none, not_ring, no_hole, "
+            "folded), loop links (degenerate rings' counted), wire and opening (diameters), fold "
+            "(degrees), and with --swatch size ratio, aspect, stretch and by_correspondence (0 "
+            "where not measured)");
   if (!cl.parse(argc, argv, first)) return 0;
   const std::string path = cl.positional_value("FILE");
   const bool links = cl.has("links");
@@ -83,13 +91,21 @@ int run_info(int argc, char** argv, int first) {
     }
   }
   if (links && cl.has("elements")) {
-    std::string csv = "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends\n";
-    char line[256];
+    std::string csv =
+        "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends,kind,defect,"
+        "loop_links,wire,opening,fold_degrees,size_ratio,aspect,stretch,by_correspondence\n";
+    char line[512];
     for (size_t k = 0; k < structure.elements.size(); ++k) {
       const ElementStructure& e = structure.elements[k];
-      std::snprintf(line, sizeof line, "%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.9g,%d\n", k,
-                    e.centre.x(), e.centre.y(), e.centre.z(), e.size, e.area, e.ring ? 1 : 0,
-                    e.links, e.interior ? 1 : 0, e.long_element ? 1 : 0, e.length, e.interior_ends);
+      std::snprintf(line, sizeof line,
+                    "%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.9g,%d,%s,%s,%d,%.9g,%.9g,%.6g,%.9g,"
+                    "%.9g,%.9g,%d\n",
+                    k, e.centre.x(), e.centre.y(), e.centre.z(), e.size, e.area, e.ring ? 1 : 0,
+                    e.links, e.interior ? 1 : 0, e.long_element ? 1 : 0, e.length, e.interior_ends,
+                    sanitized_kind(structure.kinds[static_cast<size_t>(e.kind)]).c_str(),
+                    ring_defect_name(e.defect), e.loop_links, e.wire, e.opening,
+                    e.fold * 180 / M_PI, e.size_ratio, e.aspect, e.stretch,
+                    e.by_correspondence ? 1 : 0);
       csv += line;
     }
     write_file_atomically(cl.get("elements"), csv);

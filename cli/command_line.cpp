@@ -155,6 +155,7 @@ std::string CommandLine::help() const {
     if (!o.fallback.empty()) os << " (default: " << o.fallback << ")";
     os << "\n";
   }
+  os << "\n" << kExitStatus;
   return os.str();
 }
 

@@ -9,6 +9,14 @@
 
 namespace mq::cli {
 
+// The exit statuses of every command, for scripts and render-farm schedulers: 1 and 2 are not
+// worth retrying with the same input, 3 may be (a bug, or the OpenCL device failing).
+inline constexpr const char* kExitStatus =
+    "exit status: 0 done; 1 bad input or an impossible job (one line on stderr says which);\n"
+    "  2 bad usage (an unknown option or a value out of range); 3 internal error (a bug in\n"
+    "  meshquilt, or the OpenCL device failed).\n";
+
+
 // Wrong usage: the CLI prints the message and a hint to --help, and exits with status 2.
 class UsageError : public std::runtime_error {
  public:

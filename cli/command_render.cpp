@@ -1,5 +1,7 @@
 // meshquilt render MESH -o PNG: a preview picture by Embree ray casting.
+#include <algorithm>
 #include <cstdio>
+#include <optional>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -9,6 +11,7 @@
 #include "core/mesh_io.h"
 #include "core/mesh_topology.h"
 #include "core/render.h"
+#include "core/surface_quilting.h"
 #include "core/texture_structure.h"
 
 namespace mq::cli {
@@ -28,10 +31,22 @@ int run_render(int argc, char** argv, int first) {
             "the mesh's up axis; auto: the thickness axis of flat layers, else y", "auto");
   cl.flag("ground", "draw a ground plane that catches the shadow");
   cl.flag("single-color", "one colour for the whole mesh");
-  cl.option("color", "elements|links|single",
-            "colour per element, by its link count (0 red, 1 orange, 2 yellow, 3 cyan, 4 green, "
-            "more blue, not a ring grey), or one colour",
+  cl.option("color", "elements|links|shape|single",
+            "elements: a colour per element. links: each ring by its link count (0 red, 1 orange, "
+            "2 yellow, 3 cyan, 4 green, more blue); with --swatch by its shortfall against its "
+            "own kind's interior count in the swatch (as many green, 1 fewer cyan, 2 fewer yellow, "
+            "3 fewer orange, none red, more blue); degenerate rings (no hole, folded, not "
+            "ring-shaped) magenta; not a ring grey. shape (needs --swatch): each compact element "
+            "by its shape against its swatch element at the output's scale: green size ratio "
+            "0.9-1.1 and aspect <= 1.1 (as the swatch's), yellow size or aspect off by up to 1.3x, "
+            "orange up to 1.5x, red over 1.5x, blue smaller than 1/1.3 with aspect <= 1.3, "
+            "magenta degenerate rings, grey not measured (threads, vines). single: one colour",
             "elements");
+  cl.option("swatch", "FILE",
+            "the swatch the mesh was made from: links judged per kind, and --color shape");
+  cl.option("scale", "S",
+            "with --swatch and --base: the scale the result was quilted at, as surface --scale "
+            "(default: estimated from the element areas)");
   cl.option("crop", "X Y Z R", "show only the elements whose centre lies within R of (X, Y, Z)", "",
             4);
   cl.option("base", "FILE", "also draw this base mesh, in a neutral colour, under the texture");
@@ -45,24 +60,69 @@ int run_render(int argc, char** argv, int first) {
   o.elevation_deg = cl.get_double("elevation", 0, -89, 89);
   o.samples_per_pixel = static_cast<int>(cl.get_int("samples", 1, 64));
   const std::string color = cl.has("single-color") ? std::string("single") : cl.get("color");
-  if (color != "elements" && color != "links" && color != "single")
-    throw UsageError("--color expects elements, links or single, got '" + color + "'");
+  if (color != "elements" && color != "links" && color != "shape" && color != "single")
+    throw UsageError("--color expects elements, links, shape or single, got '" + color + "'");
+  if (color == "shape" && !cl.has("swatch"))
+    throw UsageError("--color shape needs --swatch (shapes are measured against its elements)");
+  if (cl.has("scale") && !(cl.has("swatch") && cl.has("base")))
+    throw UsageError("--scale needs --swatch and --base (it is relative to the base's size)");
+  const double scale = cl.has("scale") ? cl.get_double("scale", 0, 1e-12, 1e12) : 0;
   o.color_elements = color != "single";
   o.ground_plane = cl.has("ground");
-  check_paths({cl.get("output")}, {cl.positional_value("MESH"), cl.get("base")});
+  check_paths({cl.get("output")}, {cl.positional_value("MESH"), cl.get("base"), cl.get("swatch")});
   TriMesh mesh = read_mesh(cl.positional_value("MESH"));
   std::vector<std::array<unsigned char, 3>> colors;
-  if (color == "links") {
-    const StructureReport r = measure_structure(mesh);
+  if (color == "links" || color == "shape") {
+    using Rgb = std::array<unsigned char, 3>;
+    const Rgb red{{220, 40, 40}}, orange{{240, 140, 30}}, yellow{{225, 205, 40}},
+        cyan{{60, 200, 220}}, green{{40, 170, 60}}, blue{{50, 80, 220}}, grey{{150, 150, 150}},
+        magenta{{200, 50, 200}};
+    std::optional<StructureSummary> judged;
+    if (cl.has("swatch")) {
+      const TriMesh swatch = read_mesh(cl.get("swatch"));
+      std::optional<TriMesh> base;
+      if (cl.has("base")) base = read_mesh(cl.get("base"));
+      const double linear_scale = scale > 0 ? swatch_scale_for(*base, swatch, scale) : 0;
+      judged = summarize_structure(mesh, swatch, base ? &*base : nullptr, linear_scale);
+    }
+    const StructureReport r = judged ? judged->output : measure_structure(mesh);
     for (const ElementStructure& e : r.elements) {
-      static const std::array<unsigned char, 3> by_links[] = {
-          {{220, 40, 40}}, {{240, 140, 30}}, {{225, 205, 40}}, {{60, 200, 220}}, {{40, 170, 60}}};
-      if (!e.ring)
-        colors.push_back({{150, 150, 150}});
-      else if (e.links <= 4)
-        colors.push_back(by_links[e.links]);
-      else
-        colors.push_back({{50, 80, 220}});
+      if (e.ring && e.degenerate()) {
+        colors.push_back(magenta);
+      } else if (color == "shape") {
+        const double size = e.size_ratio, aspect = e.aspect;
+        const double off = std::max({size, 1 / std::max(size, 1e-300), aspect});
+        if (!(size > 0))
+          colors.push_back(grey);
+        else if (size > 1.5 || aspect > 1.5)
+          colors.push_back(red);
+        else if (size > 1.3 || aspect > 1.3)
+          colors.push_back(orange);
+        else if (size < 1 / 1.3)
+          colors.push_back(blue);
+        else if (off > 1.1 || size < 0.9)
+          colors.push_back(yellow);
+        else
+          colors.push_back(green);
+      } else if (!e.ring) {
+        colors.push_back(grey);
+      } else if (judged) {
+        const SwatchStructure& sw = judged->swatch;
+        const int sk = e.swatch_kind;
+        const int want = sk >= 0 && sw.kinds[static_cast<size_t>(sk)].interior_links >= 0
+                             ? sw.kinds[static_cast<size_t>(sk)].interior_links
+                             : sw.interior_links;
+        static const Rgb* const by_shortfall[] = {&green, &cyan, &yellow, &orange};
+        if (e.links == 0)
+          colors.push_back(red);
+        else if (e.links > want)
+          colors.push_back(blue);
+        else
+          colors.push_back(*by_shortfall[std::min(3, want - e.links)]);
+      } else {
+        const Rgb* const by_links[] = {&red, &orange, &yellow, &cyan, &green};
+        colors.push_back(e.links <= 4 ? *by_links[e.links] : blue);
+      }
     }
   }
   if (cl.has("crop")) {

@@ -1,6 +1,8 @@
 // meshquilt surface: mesh quilting over a base mesh (paper section 3.1).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -12,9 +14,11 @@
 #include "core/global_quilting.h"
 #include "core/mesh_io.h"
 #include "core/quilt_embedding.h"
+#include "core/surface_coverage.h"
 #include "core/surface_quilting.h"
 #include "core/tangent_field.h"
 #include "core/texture_structure.h"
+#include "core/vine_growth.h"
 #include "host/tet_stretch_evaluator.h"
 #include "host/translation_cost_evaluator.h"
 
@@ -26,7 +30,12 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
                  const QuiltEmbeddingStats& em, const std::string& embedding,
                  const std::string& device, int threads, double wall, const std::string& base,
                  const std::string& swatch, const std::string& method,
-                 const GlobalQuiltingStats* global, const StructureSummary& structure) {
+                 const GlobalQuiltingStats* global, const StructureSummary& structure,
+                 double memory_limit_bytes, double min_coverage, double swatch_cover) {
+  // The global layout counts its output exactly before building it; else the estimate made
+  // before any work.
+  const double estimated_faces =
+      global && global->layout_faces > 0 ? global->layout_faces : s.estimated_faces;
   JsonWriter j;
   j.begin_object()
       .value("command", "surface")
@@ -68,6 +77,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("removed_self_intersecting", em.removed_self_intersecting)
       .value("rigid_repairs", em.rigid_repairs)
       .value("shrunk_to_fit", em.shrunk_to_fit)
+      .value("layout_versions", em.layout_versions)
       .value("separated_rings", em.separated_rings)
       .value("separation_reverted", em.separation_reverted)
       .value("separation_left_shell", em.separation_left_shell)
@@ -81,7 +91,37 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("max", em.element_area_max)
       .end_object()
       .value("coverage", em.coverage)
-      .value("matched_point_offsets", s.matched_point_offsets);
+      .begin_object("memory")
+      .value("estimated_faces", estimated_faces)
+      .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
+      .value("limit_bytes", memory_limit_bytes)
+      .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
+      .end_object()
+      .value("swatch_coverage", swatch_cover)
+      .value("min_coverage", min_coverage);
+  // The embedding's check of its own result (issue 23): where the shell map was not built,
+  // and the output's signed heights over the base as given.
+  j.begin_object("placement")
+      .value("shell_map", embedding != "shell"            ? "not asked"
+                          : !em.shell_map_failure.empty() ? "failed"
+                          : em.fallback_faces > 0         ? "partial"
+                                                          : "whole base")
+      .value("fallback_faces", em.fallback_faces)
+      .value("fallback_area_share", em.fallback_area_share)
+      .value("fallback_fold_faces", em.fallback_fold_faces)
+      .value("fallback_reason", em.fallback_reason)
+      .value("fallback_elements", em.fallback_elements)
+      .value("tolerance", em.placement_tolerance)
+      .value("below_base_embedded", em.below_base_embedded)
+      .value("replaced_below", em.replaced_below)
+      .value("lifted_below", em.lifted_below)
+      .value("removed_below", em.removed_below)
+      .value("vertices", em.checked_vertices)
+      .value("below_base", em.below_base)
+      .value("above_shell", em.above_shell)
+      .value("lowest_height", em.lowest_height)
+      .end_object();
+  j.value("matched_point_offsets", s.matched_point_offsets);
   write_match_counts(j, s.counts);
   if (global)
     j.begin_object("global")
@@ -91,6 +131,11 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("orbits", global->orbits)
         .value("singular_vertices", global->singular_vertices)
         .value("cancelled_cone_pairs", global->cancelled_cone_pairs)
+        .value("split_poles", global->split_poles)
+        .value("cone_moves", global->cone_moves)
+        .value("scale_energy_before", global->scale_energy_before)
+        .value("scale_energy", global->scale_energy)
+        .value("scale_exponent", global->scale_exponent)
         .value("pinned_cones", global->pinned_cones)
         .value("cut_edges", global->cut_edges)
         .value("cut_paths", global->cut_paths)
@@ -99,6 +144,16 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
         .value("parameter_area", global->parameter_area)
         .value("placed", global->placed)
         .value("off_surface", global->off_surface)
+        .value("copied_elements", global->copied_elements)
+        .value("threads", global->threads)
+        .value("thread_pieces", global->thread_pieces)
+        .value("pieces_distorted", global->pieces_distorted)
+        .value("pieces_near_cones", global->pieces_near_cones)
+        .value("pieces_intersecting", global->pieces_intersecting)
+        .value("thread_welds", global->thread_welds)
+        .value("thread_ends", global->thread_ends)
+        .value("closed_threads", global->closed_threads)
+        .value("short_threads", global->short_threads)
         .end_object();
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
   j.begin_object("stage_seconds");
@@ -133,16 +188,29 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("embedding", "shell|normal",
             "place the texture through the shell map or by plain normal displacement", "shell");
   cl.flag("keep-intersecting", "keep elements that intersect others after embedding");
+  cl.option("min-coverage", "F",
+            "fail (exit 1, nothing written) when the base is covered less than this fraction of "
+            "what the swatch covers of its own footprint (covered: texture within 1.5 shell "
+            "heights on the base's outer side); 0 accepts any result",
+            "0.9");
   cl.flag("keep-orientation",
           "grow the texture along the base's normals as given, even where they face inward");
   cl.flag("no-proxy",
           "use a base of over 200,000 faces as given (by default it is first simplified to the "
           "texture's scale, within 5% of the shell height)");
-  cl.option("method", "auto|global|patches",
+  cl.option("method", "auto|global|patches|vines",
             "global: one field-aligned parameterisation, seamless for a periodic swatch (keeps "
-            "chain mail linked); patches: local conformal patches (the paper's); auto: global "
-            "for a lattice of compact elements",
+            "chain mail linked); patches: local conformal patches (the paper's); vines: stems "
+            "grown along the field (up +Y without --field), evenly spaced, with the swatch's "
+            "leaves along them; auto: global for a lattice of compact elements, vines for a vine "
+            "with elements attached along it (ivy)",
             "auto");
+  cl.option("element-placement", "adaptive|layout|rigid",
+            "global layout: how a lattice element reaches the surface. layout: through the "
+            "layout (keeps every link, takes its distortion); rigid: an even copy bent only by "
+            "the surface; adaptive: through the layout where that keeps the element's shape, an "
+            "even copy elsewhere",
+            "adaptive");
   add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
@@ -173,11 +241,21 @@ int run_surface(int argc, char** argv, int first) {
   embedding.optimize_stretch = !cl.has("no-stretch-opt");
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
+  const double min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
+  options.global.drop_folded_pieces = !embedding.shell_map;
   options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
+  const std::string placement = cl.get("element-placement");
+  if (placement == "layout")
+    options.global.placement = SurfaceQuiltingOptions::Global::Placement::kLayout;
+  else if (placement == "rigid")
+    options.global.placement = SurfaceQuiltingOptions::Global::Placement::kRigid;
+  else if (placement != "adaptive")
+    throw UsageError("--element-placement expects adaptive, layout or rigid, got '" + placement +
+                     "'");
   const std::string method = cl.get("method");
-  if (method != "auto" && method != "global" && method != "patches")
-    throw UsageError("--method expects auto, global or patches, got '" + method + "'");
+  if (method != "auto" && method != "global" && method != "patches" && method != "vines")
+    throw UsageError("--method expects auto, global, patches or vines, got '" + method + "'");
 
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
@@ -198,13 +276,15 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats gstats;
-  bool global = method == "global";
+  bool global = method == "global", vines = method == "vines";
+  VineGrowthStats vstats;
   const SurfaceQuilt quilt =
       method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
-                                            run.progress(), &global)
+                                            run.progress(), &global, &vines, &vstats)
       : global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
-          : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+      : vines ? quilt_surface_vines(base, swatch, options, {}, &stats, &vstats, run.progress())
+              : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
@@ -216,8 +296,39 @@ int run_surface(int argc, char** argv, int first) {
            " (is the swatch larger than the base?); "
            "nothing written");
   MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
-           " elements placed intersect others or themselves after embedding and were removed "
-           "(try a smaller --scale, or --keep-intersecting); nothing written");
+           " elements placed were removed after embedding (",
+           embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+           " intersecting others or themselves, ", embedding_stats.removed_below,
+           " inside the base; try a smaller --scale, or --keep-intersecting); nothing written");
+  // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
+  // likely cause. Judged against what the swatch covers of its own footprint: a sparse swatch
+  // (vines) cannot cover more of the base than of itself.
+  const double own_coverage = swatch_coverage(swatch);
+  const double needed = min_coverage * own_coverage;
+  if (embedding_stats.coverage < needed) {
+    const QuiltEmbeddingStats& e = embedding_stats;
+    const int placed = static_cast<int>(quilt.elements.size());
+    const int removed = e.removed_intersecting + e.removed_self_intersecting + e.removed_below;
+    std::string cause;
+    if (removed > placed / 10)
+      cause = std::to_string(removed) + " of " + std::to_string(placed) +
+              " elements were removed (" +
+              std::to_string(e.removed_intersecting + e.removed_self_intersecting) +
+              " intersecting, " + std::to_string(e.removed_below) +
+              " inside the base: parts of it closer than the shell height?); try a smaller "
+              "--scale";
+    if (e.fallback_area_share > 0.5)
+      cause += std::string(cause.empty() ? "" : "; ") + "the shell map was not built over " +
+               std::to_string(static_cast<int>(std::lround(100 * e.fallback_area_share))) +
+               "% of the base (" + e.fallback_reason + ")";
+    if (cause.empty())
+      cause = std::to_string(placed) +
+              " elements leave the rest bare: the swatch may be too large for the base's parts "
+              "(try a smaller --scale)";
+    MQ_THROW(InvalidInput, "only ", 100 * e.coverage, "% of the base is covered, below ",
+             100 * needed, "% (--min-coverage ", min_coverage, " of the ", 100 * own_coverage,
+             "% the swatch covers of itself): ", cause, "; nothing written");
+  }
   {
     ScopedStageTimer timer(stats.times, "write");
     ScopedStageProgress shown(run.progress(), "writing");
@@ -236,7 +347,11 @@ int run_surface(int argc, char** argv, int first) {
     }
     write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
                 run.threads(), wall, cl.get("base"), cl.get("swatch"),
-                global ? "global" : "patches", global ? &gstats : nullptr, structure);
+                global  ? "global"
+                : vines ? "vines"
+                        : "patches",
+                global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
+                own_coverage);
   }
   if (!run.quiet()) {
     std::printf(
@@ -253,20 +368,42 @@ int run_surface(int argc, char** argv, int first) {
           "base: simplified to %d faces, within %.3g of the surface given "
           "(--no-proxy keeps it)\n",
           stats.proxy_faces, stats.proxy_error);
-    if (!embedding_stats.shell_map_failure.empty())
+    const QuiltEmbeddingStats& e = embedding_stats;
+    if (!e.shell_map_failure.empty())
       std::printf("shell map unavailable (%s): placed by normal displacement\n",
-                  embedding_stats.shell_map_failure.c_str());
+                  e.shell_map_failure.c_str());
     else if (embedding.shell_map)
-      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n",
-                  embedding_stats.stretch_before, embedding_stats.stretch_after,
-                  embedding_stats.atlas_charts);
+      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n", e.stretch_before,
+                  e.stretch_after, e.atlas_charts);
+    if (e.shell_map_failure.empty() && e.fallback_faces > 0)
+      std::printf(
+          "shell map left out %d base faces (%.1f%% of the area; %s): %d elements "
+          "placed over them by normal displacement\n",
+          e.fallback_faces, 100 * e.fallback_area_share, e.fallback_reason.c_str(),
+          e.fallback_elements);
+    std::printf(
+        "placement: %.2f%% of vertices under the base (%.2f%% as embedded; elements "
+        "under it: %d placed again by normal displacement, %d lifted, %d removed), "
+        "%.2f%% above the shell\n",
+        100 * e.below_base, 100 * e.below_base_embedded, e.replaced_below, e.lifted_below,
+        e.removed_below, 100 * e.above_shell);
     if (global)
       std::printf(
           "global parameterisation: %d cones, %d cut edges%s; %s plane texture, %d elements "
           "placed (%d off the surface)\n",
           gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
           gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
-    if (global && gstats.tiled)
+    if (vines)
+      std::printf(
+          "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "
+          "intersect, %d pieces and %d short lines left out), %d of %d leaves placed (%d moved "
+          "along the stem), %.2f s on %d threads; %d removed (%d folded)\n",
+          vstats.stems, vstats.spacing, vstats.median_length, vstats.stems_cut,
+          vstats.stems_dropped, vstats.streamlines_short, vstats.leaves, vstats.leaf_slots,
+          vstats.leaves_shifted, wall, run.threads(),
+          embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
+          embedding_stats.removed_self_intersecting);
+    else if (global && gstats.tiled)
       std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", wall,
                   evaluator->name().c_str(), run.threads(), embedding_stats.rigid_repairs,
                   embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting);

@@ -14,14 +14,16 @@ namespace mq::cli {
 int run_swatch(int argc, char** argv, int first) {
   CommandLine cl("swatch", "KIND -o FILE [options]",
                  "Generates a flat, thin sample swatch. KIND is one of:\n"
-                 "  chainmail  European 4-in-1 chain mail sheet of closed rings\n"
-                 "  weave      plain weave of interlaced threads\n"
-                 "  apples     a layer of apple-like blobs of varied size\n"
-                 "  ivy        a vine section with leaves");
-  cl.positional("KIND", "chainmail | weave | apples | ivy");
+                 "  chainmail         European 4-in-1 chain mail sheet of closed rings\n"
+                 "  chainmail-square  square 4-in-1: flat rings on a square grid, each linked to\n"
+                 "                    4 upright connector rings (kinds ring and connector)\n"
+                 "  weave             plain weave of interlaced threads\n"
+                 "  apples            a layer of apple-like blobs of varied size\n"
+                 "  ivy               a vine section with leaves");
+  cl.positional("KIND", "chainmail | chainmail-square | weave | apples | ivy");
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
-  cl.option("rows", "N", "chainmail: ring rows; weave: threads along x", "6");
-  cl.option("cols", "N", "chainmail: ring columns; weave: threads along y", "6");
+  cl.option("rows", "N", "chainmail(-square): ring rows; weave: threads along x", "6");
+  cl.option("cols", "N", "chainmail(-square): ring columns; weave: threads along y", "6");
   cl.option("count", "N", "apples: number of apples; ivy: number of leaves", "24");
   cl.option("scale", "S", "size of one element (ring/apple radius, thread spacing, leaf)", "1");
   cl.option("length", "L", "ivy: vine length in units of --scale", "10");
@@ -63,6 +65,19 @@ int run_swatch(int argc, char** argv, int first) {
     one.rows = one.cols = 1;
     check_size(static_cast<double>(chainmail_4in1(one).num_faces()) * o.rows * o.cols);
     mesh = chainmail_4in1(o);
+  } else if (kind == "chainmail-square") {
+    SquareMailOptions o;
+    o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
+    o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
+    o.ring_radius *= scale;
+    o.wire_radius *= scale;
+    if (detail) o.ring_segments = std::max(8, detail), o.wire_segments = std::max(4, detail / 4);
+    SquareMailOptions one = o;
+    one.rows = one.cols = 1;
+    // A flat ring per cell and up to two connectors of as many faces.
+    check_size(static_cast<double>(chainmail_square(one).num_faces()) *
+               (3.0 * o.rows * o.cols - o.rows - o.cols));
+    mesh = chainmail_square(o);
   } else if (kind == "weave") {
     WeaveOptions o;
     o.threads_x = static_cast<int>(cl.get_int("rows", 1, 200));
@@ -101,7 +116,8 @@ int run_swatch(int argc, char** argv, int first) {
     check_size(vine * o.length / bare.length + leaf * o.leaves);
     mesh = ivy_section(o);
   } else {
-    throw UsageError("unknown swatch kind '" + kind + "' (chainmail, weave, apples or ivy)");
+    throw UsageError("unknown swatch kind '" + kind +
+                     "' (chainmail, chainmail-square, weave, apples or ivy)");
   }
   write_output(out, mesh, write_options);
   if (!cl.has("quiet")) {

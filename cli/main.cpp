@@ -20,11 +20,12 @@ constexpr const char* kUsage =
     "commands:\n"
     "  plane    grow a swatch into a seamless L x W layer\n"
     "  surface  cover a base mesh with the swatch's geometry in a thin shell\n"
-    "  swatch   generate a sample swatch (chainmail, weave, apples, ivy)\n"
+    "  swatch   generate a sample swatch (chainmail, chainmail-square, weave, apples, ivy)\n"
     "  info     print counts, bounding box and topology of a mesh file\n"
     "  render   render a mesh to a PNG preview\n"
     "\n"
-    "Run 'meshquilt COMMAND --help' for the options of a command.\n";
+    "Run 'meshquilt COMMAND --help' for the options of a command.\n"
+    "\n";
 
 struct Command {
   const char* name;
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    std::fputs(mq::cli::kExitStatus, argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
   }
   if (!std::strcmp(argv[1], "--version")) {
@@ -58,6 +60,15 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "meshquilt %s: %s (see 'meshquilt %s --help')\n", c.name,
                    mq::detail::printable(e.what()).c_str(), c.name);
       return 2;
+    } catch (const mq::InternalError& e) {
+      // A violated invariant is meshquilt's fault, not the input's: 3, as for other bugs.
+      std::fprintf(stderr, "meshquilt %s: internal error: %s\n", c.name,
+                   mq::detail::printable(e.what()).c_str());
+      return 3;
+    } catch (const mq::DeviceError& e) {
+      std::fprintf(stderr, "meshquilt %s: OpenCL device error: %s\n", c.name,
+                   mq::detail::printable(e.what()).c_str());
+      return 3;
     } catch (const mq::Error& e) {
       std::fprintf(stderr, "meshquilt %s: error: %s\n", c.name,
                    mq::detail::printable(e.what()).c_str());
@@ -66,7 +77,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "meshquilt %s: error: out of memory\n", c.name);
       return 1;
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "meshquilt %s: internal error: %s\n", c.name, e.what());
+      std::fprintf(stderr, "meshquilt %s: internal error: %s\n", c.name,
+                   mq::detail::printable(e.what()).c_str());
       return 3;
     }
   }

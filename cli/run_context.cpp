@@ -1,6 +1,7 @@
 #include "cli/run_context.h"
 
 #include <tbb/info.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -24,8 +25,11 @@ void add_run_options(CommandLine& cl) {
   cl.flag("progress-lines",
           "progress as 'progress STAGE FRACTION ELAPSED_S REMAINING_S' lines (for other programs)");
   cl.option("max-faces", "N",
-            "refuse a job estimated to output more faces (also bounded by the machine's memory)",
+            "refuse a job estimated to output more faces (also bounded by the memory limit)",
             "2e7");
+  cl.option("max-memory", "GIB",
+            "refuse a job estimated to need more memory, at about 400 bytes per output face "
+            "(default: 80% of the machine's memory)");
 }
 
 void add_output_options(CommandLine& cl) {
@@ -62,18 +66,35 @@ void write_output(const std::string& path, TriMesh mesh, const WriteOptions& opt
   write_mesh(path, mesh, options);
 }
 
+double memory_limit(const CommandLine& cl) {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  const double machine =
+      pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
+  if (cl.has("max-memory")) {
+    const double asked = cl.get_double("max-memory", 0, 0.01, 1e6) * (1 << 30);
+    MQ_CHECK(machine == 0 || asked <= machine, InvalidInput, "--max-memory ",
+             asked / (1 << 30), " GiB is more than this machine's ", machine / (1 << 30),
+             " GiB");
+    return asked;
+  }
+  return machine > 0 ? 0.8 * machine : 0.0;
+}
+
 double face_limit(const CommandLine& cl) {
   const double asked = cl.get_double("max-faces", 0, 1, 1e12);
-  // About 350 bytes of peak memory per output face (the armor job: 710 MiB for 2.2M faces);
-  // 400 with a margin, against 80% of the physical memory.
-  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page <= 0) return asked;
-  const double memory = static_cast<double>(pages) * static_cast<double>(page);
-  const double fits = 0.8 * memory / 400.0;
+  const double memory = memory_limit(cl);
+  if (!(memory > 0)) return asked;
+  const double fits = memory / kBytesPerOutputFace;
   MQ_CHECK(asked <= fits || !cl.has("max-faces"), InvalidInput, "--max-faces ", asked,
-           " needs about ", asked * 400 / (1 << 30), " GiB of memory; this machine has ",
-           memory / (1 << 30), " GiB");
+           " needs about ", asked * kBytesPerOutputFace / (1 << 30), " GiB of memory; the limit is ",
+           memory / (1 << 30), " GiB (--max-memory)");
   return std::min(asked, fits);
+}
+
+long peak_memory_bytes() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<long>(usage.ru_maxrss) * 1024;  // kilobytes on Linux
 }
 
 void check_output_directory(const std::string& path) {

@@ -1,5 +1,6 @@
 #include "cli/stats_json.h"
 
+#include <array>
 #include <cstdio>
 #include <string>
 
@@ -48,6 +49,25 @@ std::string histogram_text(const std::vector<int>& h) {
   return s.empty() ? "-" : s;
 }
 
+// "not ring-shaped 2, no hole 61, folded 29" (causes with none left out), or "none".
+std::string defects_text(const std::array<int, kRingDefects>& d) {
+  static const char* const names[kRingDefects] = {"", "not ring-shaped", "no hole", "folded"};
+  std::string s;
+  for (int k = 1; k < kRingDefects; ++k) {
+    if (d[static_cast<size_t>(k)] == 0) continue;
+    if (!s.empty()) s += ", ";
+    s += std::to_string(d[static_cast<size_t>(k)]) + " " + names[k];
+  }
+  return s.empty() ? "none" : s;
+}
+
+void write_defects(JsonWriter& j, const std::string& key, const std::array<int, kRingDefects>& d) {
+  j.begin_object(key);
+  for (int k = 1; k < kRingDefects; ++k)
+    j.value(ring_defect_name(static_cast<RingDefect>(k)), d[static_cast<size_t>(k)]);
+  j.end_object();
+}
+
 }  // namespace
 
 void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStructure* swatch,
@@ -60,7 +80,12 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
       .value("rings", r.rings)
       .value("interior_rings", r.interior_rings)
       .value("isolated_rings", r.isolated_rings)
-      .value("linked_pairs", static_cast<int>(r.linked_pairs.size()));
+      .value("degenerate_rings", r.degenerate_rings())
+      .value("interior_degenerate_rings", r.interior_degenerate());
+  write_defects(j, "degenerate_by_cause", r.defects);
+  write_defects(j, "interior_degenerate_by_cause", r.interior_defects);
+  j.value("linked_pairs", static_cast<int>(r.linked_pairs.size()))
+      .value("loop_linked_pairs", r.loop_linked_pairs);
   j.begin_array("interior_link_histogram");
   for (const int n : r.interior_link_histogram) j.value("", n);
   j.end_array().begin_array("link_histogram");
@@ -69,10 +94,14 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
       .value("long_elements", r.long_elements)
       .value("ends", r.ends)
       .value("interior_ends", r.interior_ends)
+      .value("closed_long_elements", r.closed_long_elements)
       .value("area", r.area > 0 ? r.area : std::nan(""))
       .value("density", r.density > 0 ? r.density : std::nan(""))
       .value("density_cells", r.density_cells)
-      .value("interior_ends_per_area", r.area > 0 ? r.interior_ends_per_area : std::nan(""));
+      .value("interior_ends_per_area", r.area > 0 ? r.interior_ends_per_area : std::nan(""))
+      .value("median_long_length", r.long_elements > 0 ? r.median_long_length : std::nan(""))
+      .value("long_length", r.long_length)
+      .value("compact_elements", r.compact_elements);
   if (self_intersecting >= 0) j.value("self_intersecting_elements", self_intersecting);
   if (swatch) {
     j.begin_object("swatch")
@@ -83,16 +112,60 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
         .value("median_element_size", swatch->report.median_size);
     j.begin_array("link_histogram");
     for (const int n : swatch->report.link_histogram) j.value("", n);
+    j.end_array().begin_array("kinds");
+    for (const SwatchKind& k : swatch->kinds) {
+      j.begin_object()
+          .value("name", k.name)
+          .value("elements", k.elements)
+          .value("rings", k.rings)
+          .value("ring_kind", k.ring)
+          .value("compact", k.compact);
+      if (k.ring) j.value("interior_links", k.interior_links);
+      j.end_object();
+    }
     j.end_array().end_object();
   }
-  if (comparison)
+  if (comparison) {
+    const ShapeSummary& s = comparison->shape;
+    const auto known = [](double v) { return v > 0 ? v : std::nan(""); };
     j.value("share_with_swatch_links", comparison->share_matching)
+        .value("share_counting_degenerate", comparison->share_counting_degenerate);
+    j.begin_array("share_per_kind");
+    for (const KindComparison& k : comparison->kinds)
+      j.begin_object()
+          .value("kind", k.kind)
+          .value("interior_links", k.interior_links)
+          .value("interior_rings", k.interior_rings)
+          .value("matching", k.matching)
+          .value("degenerate", k.degenerate)
+          .value("share", k.share)
+          .end_object();
+    j.end_array()
         .value("density_ratio",
                comparison->density_ratio > 0 ? comparison->density_ratio : std::nan(""))
         .value("linear_scale", comparison->linear_scale)
+        .value("long_length_ratio", known(comparison->long_length_ratio))
+        .value("interior_ends_per_swatch_area", known(comparison->interior_ends_per_swatch_area));
+    j.begin_object("shape")
+        .value("elements", s.elements)
+        .value("by_correspondence", s.by_correspondence);
+    j.begin_object("size_ratio")
+        .value("median", known(s.size_median))
+        .value("p90", known(s.size_p90))
+        .value("p99", known(s.size_p99))
+        .value("max", known(s.size_max))
+        .end_object();
+    j.begin_object("aspect")
+        .value("median", known(s.aspect_median))
+        .value("p90", known(s.aspect_p90))
+        .value("max", known(s.aspect_max))
+        .end_object();
+    j.end_object()
         .value("stretched_elements", comparison->stretched)
-        .value("largest_size_ratio",
-               comparison->largest_size > 0 ? comparison->largest_size : std::nan(""));
+        .value("largest_stretch", known(comparison->largest_stretch))
+        .value("largest_size_ratio", known(s.size_max))
+        .value("compact_per_length_ratio", known(comparison->compact_per_length_ratio));
+  }
   j.end_object();
 }
 
@@ -102,40 +175,87 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
               r.rings, r.interior_rings, border_name(r.border), r.isolated_rings,
               r.linked_pairs.size());
   if (r.rings > 0) {
-    std::printf("links per ring:    interior %s; all %s\n",
-                histogram_text(r.interior_link_histogram).c_str(),
-                histogram_text(r.link_histogram).c_str());
+    std::printf("degenerate rings:  %d (%s), %d of them interior; misses, linked to nothing\n",
+                r.degenerate_rings(), defects_text(r.defects).c_str(), r.interior_degenerate());
+    std::printf("links per ring:    interior %s, degenerate %d; all %s, degenerate %d\n",
+                histogram_text(r.interior_link_histogram).c_str(), r.interior_degenerate(),
+                histogram_text(r.link_histogram).c_str(), r.degenerate_rings());
   }
   if (r.long_elements > 0) {
-    std::printf("long elements:     %d, %d ends, %d away from the border", r.long_elements, r.ends,
-                r.interior_ends);
+    std::printf("long elements:     %d (%d closed on themselves), %d ends, %d away from the border",
+                r.long_elements, r.closed_long_elements, r.ends, r.interior_ends);
     if (r.area > 0) std::printf(" (%.4g per unit area)", r.interior_ends_per_area);
-    std::printf("\n");
+    std::printf("; median length %.4g\n", r.median_long_length);
   }
   if (r.density > 0)
     std::printf("density:           %.6g elements per unit area (%d closed Voronoi cells)\n",
                 r.density, r.density_cells);
   if (swatch) {
-    if (swatch->report.rings > 0)
+    if (swatch->report.rings > 0) {
       std::printf("swatch:            %d rings, links %s, interior link count %d, density %.6g\n",
                   swatch->report.rings, histogram_text(swatch->report.link_histogram).c_str(),
                   swatch->interior_links, swatch->density);
-    else
+      if (swatch->ring_kinds() > 1) {
+        std::string text;
+        for (const SwatchKind& k : swatch->kinds)
+          if (k.ring)
+            text += (text.empty() ? "" : ", ") + k.name + " " + std::to_string(k.interior_links);
+        std::printf("swatch kinds:      interior link count per ring kind: %s\n", text.c_str());
+      }
+    } else {
       std::printf("swatch:            no rings, %d long elements of %zu\n",
                   swatch->report.long_elements, swatch->report.elements.size());
+    }
   }
   if (comparison) {
-    if (comparison->interior_links >= 0)
-      std::printf("structure kept:    %.2f%% of interior rings link %d others, as in the swatch\n",
-                  100 * comparison->share_matching, comparison->interior_links);
+    const bool per_kind = swatch && swatch->ring_kinds() > 1;
+    if (comparison->interior_links >= 0) {
+      if (per_kind)
+        std::printf(
+            "structure kept:    %.2f%% of interior rings link as many others as their kind in "
+            "the swatch",
+            100 * comparison->share_matching);
+      else
+        std::printf("structure kept:    %.2f%% of interior rings link %d others, as in the swatch",
+                    100 * comparison->share_matching, comparison->interior_links);
+      std::printf(" (%.2f%% counting degenerate rings' links)\n",
+                  100 * comparison->share_counting_degenerate);
+      if (per_kind)
+        for (const KindComparison& k : comparison->kinds)
+          std::printf("  %-16s %.2f%% of %d interior link %d others (%d degenerate)\n",
+                      (k.kind + ":").c_str(), 100 * k.share, k.interior_rings, k.interior_links,
+                      k.degenerate);
+    }
     if (comparison->density_ratio > 0)
       std::printf("density ratio:     %.2f%% of the swatch's (%.6g output units per swatch unit)\n",
                   100 * comparison->density_ratio, comparison->linear_scale);
-    if (comparison->largest_size > 0)
+    if (comparison->long_length_ratio > 0) {
+      std::printf("long elements:     median %.2f swatch long elements long",
+                  comparison->long_length_ratio);
+      if (comparison->interior_ends_per_swatch_area > 0)
+        std::printf("; %.4g interior ends per swatch unit squared",
+                    comparison->interior_ends_per_swatch_area);
+      if (comparison->compact_per_length_ratio > 0)
+        std::printf("; %.3g compact elements per length, %.3f times the swatch's",
+                    r.compact_elements / r.long_length, comparison->compact_per_length_ratio);
+      std::printf(" (%.6g output units per swatch unit)\n", comparison->linear_scale);
+    }
+    const ShapeSummary& s = comparison->shape;
+    if (s.elements > 0) {
       std::printf(
-          "stretched:         %d elements over %.3gx the swatch's element size "
+          "shape:             %d compact elements (%d by vertex correspondence) against their "
+          "swatch element\n",
+          s.elements, s.by_correspondence);
+      std::printf(
+          "  size ratio:      median %.3f, 90th %.3f, 99th %.3f, largest %.3f\n"
+          "  aspect:          median %.3f, 90th %.3f, largest %.3f\n",
+          s.size_median, s.size_p90, s.size_p99, s.size_max, s.aspect_median, s.aspect_p90,
+          s.aspect_max);
+      std::printf(
+          "stretched:         %d elements over %.3gx the swatch's element along some direction "
           "(largest %.2fx)\n",
-          comparison->stretched, StructureComparison::kStretchedSize, comparison->largest_size);
+          comparison->stretched, StructureComparison::kStretchedSize, comparison->largest_stretch);
+    }
   }
 }
 

@@ -32,6 +32,9 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
   MQ_CHECK(field.direction.rows() == nf && static_cast<int>(field.matching.size()) == ne &&
                static_cast<int>(field.index.size()) == nv,
            InvalidInput, "global parameterisation: the field does not match the mesh");
+  MQ_CHECK(options.face_scale.size() == 0 || options.face_scale.size() == nf, InvalidInput,
+           "global parameterisation: ", options.face_scale.size(), " face scales for ", nf,
+           " faces");
   MQ_CHECK(
       field.N == 1 || field.N == 2, InvalidInput,
       "global parameterisation: the field must be a vector or a line field, got N = ", field.N);
@@ -142,7 +145,9 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
     const double area = 0.5 * two_a;
     Vector3d grad[3];
     for (int i = 0; i < 3; ++i) grad[i] = n.cross(x[(i + 2) % 3] - x[(i + 1) % 3]) / two_a;
-    const Vector3d d = options.target_scale * field.direction.row(f).transpose();
+    const double scale =
+        options.target_scale * (options.face_scale.size() == nf ? options.face_scale(f) : 1.0);
+    const Vector3d d = scale * field.direction.row(f).transpose();
     const Vector3d d2 = n.cross(d);
     for (int i = 0; i < 3; ++i) {
       const int wi = gp.corner_wedge(f, i);

@@ -41,8 +41,11 @@ struct GlobalParameterizationOptions {
   // transitions exactly rigid.
   double cut_weight = 1e4;
   double pin_weight = 1e4;  // of the pinned vertices
-  // The length of the gradients sought (plane units per surface unit).
+  // The length of the gradients sought (plane units per surface unit), times face_scale(f) on
+  // face f when given (#F; empty: 1): e^u of a flat cone metric (core/trivial_connection) makes
+  // the sought gradients integrable, and the map conformal.
   double target_scale = 1;
+  Eigen::VectorXd face_scale;
   // Vertices whose coordinates (of their first corner group) are fixed, with the same weight:
   // the half-turn cones placed where the texture's own half-turn centres are.
   std::vector<std::pair<int, Vector2d>> pinned;
@@ -69,7 +72,8 @@ Vector2d path_translation(const GlobalParameterization& gp, const EdgeTopology& 
 // The translation of edge k of the path (in its own face order) for the path's translation t.
 Vector2d edge_translation(const CutPath& path, size_t k, const Vector2d& t);
 
-// Solves min sum_f A_f |grad u - d_f|^2 + |grad v - n_f x d_f|^2 over corner-group values, with
+// Solves min sum_f A_f |grad u - s_f d_f|^2 + |grad v - s_f n_f x d_f|^2 (s_f the target scale
+// times face_scale) over corner-group values, with
 // the corners around a vertex grouped between cut edges and, for every cut edge (a, b) between
 // faces f and g, the constraint uv_g(a) - uv_g(b) = s (uv_f(a) - uv_f(b)) (s the half-turn
 // sign), which makes the transition across each cut path one rigid motion.

@@ -18,8 +18,6 @@ double edge_angle(const MatrixX3d& V, const EdgeTopology& topo, const FaceFrames
   return std::atan2(d.dot(fr.b2.row(f).transpose()), d.dot(fr.b1.row(f).transpose()));
 }
 
-// Transport angle across e from its first face to its second: an angle theta in the first face's
-// frame corresponds to theta + rho in the second's (the angle to the shared edge is kept).
 double transport(const MatrixX3d& V, const EdgeTopology& topo, const FaceFrames& fr, int e) {
   const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
   return edge_angle(V, topo, fr, e, g) - edge_angle(V, topo, fr, e, f);
@@ -36,6 +34,19 @@ Vector3d direction_at(double theta, const FaceFrames& fr, int f) {
 }
 
 }  // namespace
+
+double transport_angle(const MatrixX3d& V, const EdgeTopology& topo, const FaceFrames& frames,
+                       int e) {
+  return transport(V, topo, frames, e);
+}
+
+double angle_in_frame(const Vector3d& d, const FaceFrames& frames, int f) {
+  return angle_of(d, frames, f);
+}
+
+Vector3d direction_in_frame(double theta, const FaceFrames& frames, int f) {
+  return direction_at(theta, frames, f);
+}
 
 FaceFrames face_frames(const MatrixX3d& V, const MatrixX3i& F) {
   FaceFrames fr;

@@ -23,6 +23,16 @@ struct FaceFrames {
 };
 FaceFrames face_frames(const MatrixX3d& V, const MatrixX3i& F);
 
+// Levi-Civita transport across interior edge e from its first face to its second
+// (topo.edge_faces): an angle theta in the first face's frame corresponds to theta + result in
+// the second's (the angle to the shared edge is kept).
+double transport_angle(const MatrixX3d& V, const EdgeTopology& topo, const FaceFrames& frames,
+                       int e);
+
+// The angle of tangent vector d in face f's frame, and the unit vector at angle theta there.
+double angle_in_frame(const Vector3d& d, const FaceFrames& frames, int f);
+Vector3d direction_in_frame(double theta, const FaceFrames& frames, int f);
+
 // A field of N-directions given by one representative unit vector per face (the others are it
 // turned by multiples of 2 pi / N), with, for every interior manifold edge, the matching: the
 // number of 2 pi / N turns that best relates the representative of one face, transported

@@ -49,4 +49,31 @@ std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, i
 // sizes differ.
 Loop loop_from_bins(const MatrixX3d& V, const RingBins& bins);
 
+// How open and how flat a ring is: the figures that decide whether a link through it can be
+// real. A ring squeezed until its hole closes, or folded over a crease into a C, still has a
+// centre loop that other loops pass through, but no wire can pass through its hole, or it no
+// longer lies like a ring (issue 23).
+struct RingShape {
+  // Wire diameter: area / (pi * loop length). A tube of radius r around a loop of length L has
+  // area 2 pi r L whatever the loop's curvature (while the tube does not overlap itself), so this
+  // is exact for a round wire and the area-equivalent width of a squashed one.
+  double wire = 0;
+  // The free hole: the diameter of the largest disk in the loop's best-fit plane, centred inside
+  // the loop projected there, that no vertex of the ring projected there enters (the hole seen
+  // along the ring's axis; 0 when the loop encloses nothing).
+  double opening = 0;
+  // Radians in [0, pi]: the largest angle between the best-fit plane normals of the loop's two
+  // halves, over every split of the loop into two halves of consecutive points (normals turned
+  // towards the whole loop's area normal). 0 for any planar loop, whatever its outline (a
+  // crescent too); about pi/2 for a ring folded over a right-angled edge through its centre.
+  double fold = 0;
+};
+
+// The shape figures of a ring-shaped element and its centre loop (ring_centre_loop's).
+//   V  #V by 3, F  #F by 3 indices into V (one element; vertices no face uses are ignored)
+//   loop  at least 4 points
+// Throws InvalidInput for a shorter loop or an out-of-range index. O(#V + #F + #loop^2) with a
+// few dozen evaluations of the vertices' distance for the hole.
+RingShape ring_shape(const MatrixX3d& V, const MatrixX3i& F, const Loop& loop);
+
 }  // namespace mq

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "core/errors.h"
@@ -66,23 +68,36 @@ Vector3d cone_direction(const Vector3d& normal, const MatrixX3d& FN, const Adjac
   return best;
 }
 
-// Laplacian diffusion of the normals, refusing steps that leave a vertex's face cone.
-MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterations) {
+// Laplacian diffusion of the normals, refusing steps that leave a vertex's face cone. Vertices
+// with no normal, or with no direction above all their faces (the base folds there), are
+// listed in `bad` (ascending) and the directions are then not diffused; `message` names the
+// first.
+MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterations,
+                              std::vector<int>& bad, std::string& message) {
   const int n = static_cast<int>(V.rows());
   const MatrixX3d FN = face_normals(V, F);
   const Adjacency vv = vertex_adjacency(F, n);
   const Adjacency vf = vertex_faces(F, n);
   MatrixX3d D = vertex_normals(V, F);
   for (int i = 0; i < n; ++i) {
-    MQ_CHECK(vf.degree(i) == 0 || D.row(i).squaredNorm() > 0.5, TopologyError,
-             "offset surface: vertex ", i, " has no normal (its faces cancel)");
+    if (vf.degree(i) > 0 && !(D.row(i).squaredNorm() > 0.5)) {
+      if (bad.empty())
+        message = detail::concat("offset surface: vertex ", i, " has no normal (its faces cancel)");
+      bad.push_back(i);
+      continue;
+    }
     if (vf.degree(i) == 0 || min_face_cosine(D.row(i), FN, vf, i) >= kMinCosine) continue;
     D.row(i) = cone_direction(D.row(i), FN, vf, i);
-    MQ_CHECK(min_face_cosine(D.row(i), FN, vf, i) > 0.0, TopologyError, "offset surface: vertex ",
-             i, " (", V(i, 0), " ", V(i, 1), " ", V(i, 2),
-             ") has no direction above all its faces (the base folds there), so no valid "
-             "shell prism exists at any height");
+    if (!(min_face_cosine(D.row(i), FN, vf, i) > 0.0)) {
+      if (bad.empty())
+        message = detail::concat(
+            "offset surface: vertex ", i, " (", V(i, 0), " ", V(i, 1), " ", V(i, 2),
+            ") has no direction above all its faces (the base folds there), so no valid "
+            "shell prism exists at any height");
+      bad.push_back(i);
+    }
   }
+  if (!bad.empty()) return D;
   for (int it = 0; it < iterations; ++it) {
     MatrixX3d next = D;
     tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& r) {
@@ -103,10 +118,8 @@ MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterat
   return D;
 }
 
-}  // namespace
-
-MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
-                            int* steps_out) {
+// The diffusion steps offset_directions takes.
+int diffusion_steps(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
   MQ_CHECK(options.smoothing_iterations >= 0, InvalidInput,
            "offset surface: smoothing_iterations must be >= 0, got ", options.smoothing_iterations);
   MQ_CHECK(std::isfinite(options.smoothing_radius) && options.smoothing_radius >= 0, InvalidInput,
@@ -119,11 +132,44 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
     // Bounded: past 10^4 steps the reach is far beyond any shell (the base is degenerate).
     steps = std::max(steps, static_cast<int>(std::ceil(std::min(reach * reach, 1e4))));
   }
-  if (steps_out) *steps_out = steps;
-  return smoothed_directions(V, F, steps);
+  return steps;
 }
 
-OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
+}  // namespace
+
+std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F) {
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "fold vertices: face index out of range");
+  std::vector<int> bad;
+  std::string message;
+  smoothed_directions(V, F, 0, bad, message);
+  return bad;
+}
+
+MatrixX3d displacement_directions(const MatrixX3d& V, const MatrixX3i& F, double height) {
+  OffsetOptions o;
+  o.height = height;
+  try {
+    return offset_directions(V, F, o);
+  } catch (const TopologyError&) {
+    return vertex_normals(V, F);
+  }
+}
+
+MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
+                            int* steps_out) {
+  const int steps = diffusion_steps(V, F, options);
+  if (steps_out) *steps_out = steps;
+  std::vector<int> bad;
+  std::string message;
+  MatrixX3d D = smoothed_directions(V, F, steps, bad, message);
+  MQ_CHECK(bad.empty(), TopologyError, message);
+  return D;
+}
+
+bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
+                        OffsetSurface& out, OffsetFailure& failure) {
+  failure = OffsetFailure();
   MQ_CHECK(std::isfinite(options.height) && options.height > 0.0, InvalidInput,
            "offset surface: height must be finite and > 0, got ", options.height);
   MQ_CHECK(options.min_fraction > 0.0 && options.min_fraction <= 1.0, InvalidInput,
@@ -136,8 +182,19 @@ OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const Offse
   const MatrixX3i B = shell_boundary_faces(F, n);
   const Adjacency vv = vertex_adjacency(F, n);
 
-  OffsetSurface out;
-  out.directions = offset_directions(V, F, options, &out.smoothing_steps);
+  out = OffsetSurface();
+  out.smoothing_steps = diffusion_steps(V, F, options);
+  out.directions = smoothed_directions(V, F, out.smoothing_steps, failure.vertices, failure.reason);
+  if (!failure.vertices.empty()) {
+    failure.fold = true;
+    const Adjacency vf = vertex_faces(F, n);
+    for (const int v : failure.vertices)
+      failure.faces.insert(failure.faces.end(), vf.begin(v), vf.end(v));
+    std::sort(failure.faces.begin(), failure.faces.end());
+    failure.faces.erase(std::unique(failure.faces.begin(), failure.faces.end()),
+                        failure.faces.end());
+    return false;
+  }
   std::vector<char> used(n, 0);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
@@ -216,10 +273,59 @@ OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const Offse
         ++stuck;
       }
     }
-    MQ_CHECK(progress && round + 1 < options.max_rounds, TopologyError,
-             "offset surface: cannot make a valid shell (", stuck,
-             " offending vertices already at the minimum height ", floor_h, " after ", round + 1,
-             " rounds)");
+    if (!progress || round + 1 >= options.max_rounds) {
+      failure.reason = detail::concat("offset surface: cannot make a valid shell (", stuck,
+                                      " offending vertices already at the minimum height ", floor_h,
+                                      " after ", round + 1, " rounds)");
+      // Where it is stuck: the offending vertices at the floor (all of them when the rounds
+      // ran out first), and the prisms that offend: those with a flat or inverted tet, and
+      // those whose offset or side wall meets another boundary face (a base face only offends
+      // through the other face of its pair: the base is given).
+      for (int i = 0; i < n; ++i)
+        if (bad[i] && (out.heights(i) <= floor_h || progress)) failure.vertices.push_back(i);
+      std::vector<char> prism(static_cast<size_t>(F.rows()), 0);
+      for (Eigen::Index t = 0; t < T.rows(); ++t) {
+        const Vector3d p[4] = {S.row(T(t, 0)), S.row(T(t, 1)), S.row(T(t, 2)), S.row(T(t, 3))};
+        double l2 = 0.0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b) l2 = std::max(l2, (p[a] - p[b]).squaredNorm());
+        if (!(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2)))
+          prism[static_cast<size_t>(t / 3)] = 1;
+      }
+      const EdgeTopology topo = edge_topology(F, n);
+      std::map<std::pair<int, int>, int> boundary_face;  // boundary edge (a < b) -> its face
+      for (Eigen::Index f = 0; f < F.rows(); ++f)
+        for (int k = 0; k < 3; ++k) {
+          const int e = topo.FE(f, k);
+          if (topo.edge_faces.degree(e) == 1)
+            boundary_face[{topo.E(e, 0), topo.E(e, 1)}] = static_cast<int>(f);
+        }
+      const auto prism_of = [&](int row) {
+        if (row < 2 * F.rows()) return row % static_cast<int>(F.rows());
+        // A side wall: the face on its boundary edge (its two base corners, modulo n).
+        int a = -1, b = -1;
+        for (int k = 0; k < 3; ++k) {
+          const int v = B(row, k) % n;
+          if (a < 0)
+            a = v;
+          else if (v != a)
+            b = v;
+        }
+        const auto it = boundary_face.find({std::min(a, b), std::max(a, b)});
+        return it == boundary_face.end() ? -1 : it->second;
+      };
+      for (const auto& [f, g] : pairs) {
+        if (f < F.rows() && g < F.rows()) continue;
+        for (const int row : {f, g})
+          if (row >= F.rows()) {
+            const int q = prism_of(row);
+            if (q >= 0) prism[static_cast<size_t>(q)] = 1;
+          }
+      }
+      for (Eigen::Index f = 0; f < F.rows(); ++f)
+        if (prism[static_cast<size_t>(f)]) failure.faces.push_back(static_cast<int>(f));
+      return false;
+    }
     // Grade the heights: none more than twice its lowest neighbour's, so a lowered region
     // tapers off over a few rings instead of leaving a step; heights only decrease.
     for (bool changed = true; changed;) {
@@ -234,6 +340,13 @@ OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const Offse
       }
     }
   }
+  return true;
+}
+
+OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
+  OffsetSurface out;
+  OffsetFailure failure;
+  MQ_CHECK(try_offset_surface(V, F, options, out, failure), TopologyError, failure.reason);
   return out;
 }
 

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
+#include <vector>
 
 #include "core/mesh.h"
 
@@ -40,6 +42,12 @@ struct OffsetSurface {
 MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                             int* steps_out = nullptr);
 
+// The directions the texture is displaced along where no shell map places it (normal
+// displacement): offset_directions with the default smoothing for a shell of this height, or,
+// where the base folds so that none exists, the area-weighted vertex normals. #V by 3.
+// Throws InvalidInput for height <= 0 or bad input (as offset_directions).
+MatrixX3d displacement_directions(const MatrixX3d& V, const MatrixX3i& F, double height);
+
 // Offsets the base (V, F) outward.
 // Directions: area-weighted vertex normals; where one lies closer than cos = 0.1 to the plane
 // of an incident face (sharp vertices), the direction maximising the smallest cosine with the
@@ -59,5 +67,28 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
 // direction lies above all of a vertex's faces (the message names the vertex), or when the
 // shell stays invalid with every offending vertex at the height floor (or after max_rounds).
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options);
+
+// The vertices where the base folds for the shell: no normal, or no direction above all their
+// faces (offset_surface's first test; no valid prism exists there at any height). Ascending.
+//   V #V by 3 finite, F #F by 3. Throws InvalidInput for an index out of range.
+std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F);
+
+// Why no valid shell was found, and where: the message offset_surface throws; the offending
+// vertices (ascending): those with no normal or no direction above their faces, or those still
+// offending at the height floor (every offending one when max_rounds ran out); and, for the
+// latter, the faces whose prisms offend (ascending): a flat or inverted tet, or an offset face
+// or side wall meeting another boundary face of the shell.
+struct OffsetFailure {
+  std::string reason;
+  bool fold = false;  // the base folds (a vertex has no normal or no direction above)
+  std::vector<int> vertices;
+  std::vector<int> faces;
+};
+
+// offset_surface without the TopologyError: returns false with `failure` filled instead (`out`
+// is then unspecified), so that a caller can leave the offending region out of the shell and
+// try again (ShellMap's per-region fallback). Same arguments and other throws.
+bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
+                        OffsetSurface& out, OffsetFailure& failure);
 
 }  // namespace mq

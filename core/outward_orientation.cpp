@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <vector>
 
 #include "core/geometry_measures.h"
@@ -13,67 +12,67 @@
 namespace mq {
 namespace {
 
-constexpr int kVoters = 16;
+constexpr int kSamples = 32;
+constexpr double kInwardBelow = -0.05;
 
-// Distance along the ray o + t d (t > t_min) to triangle abc, or -1 (Moller-Trumbore).
-double ray_triangle(const Vector3d& o, const Vector3d& d, const Vector3d& a, const Vector3d& b,
-                    const Vector3d& c, double t_min) {
-  const Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
-  const double det = e1.dot(p);
-  if (std::abs(det) < 1e-300) return -1;
-  const double inv = 1 / det;
-  const Vector3d s = o - a;
-  const double u = s.dot(p) * inv;
-  if (u < 0 || u > 1) return -1;
-  const Vector3d q = s.cross(e1);
-  const double v = d.dot(q) * inv;
-  if (v < 0 || u + v > 1) return -1;
-  const double t = e2.dot(q) * inv;
-  return t > t_min ? t : -1;
+// Signed solid angle of triangle abc seen from p (van Oosterom and Strackee 1983): positive when
+// p lies on the side its normal (b - a) x (c - a) points away from.
+double solid_angle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  const Vector3d x = a - p, y = b - p, z = c - p;
+  const double lx = x.norm(), ly = y.norm(), lz = z.norm();
+  const double det = x.dot(y.cross(z));
+  const double div = lx * ly * lz + x.dot(y) * lz + x.dot(z) * ly + y.dot(z) * lx;
+  return 2 * std::atan2(det, div);
 }
 
 }  // namespace
+
+double mean_surface_winding(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int>& faces) {
+  if (faces.empty()) return 0.0;
+  const auto corner = [&](int f, int k) { return Vector3d(V.row(F(f, k)).transpose()); };
+  // Samples spread evenly over the area: the faces at the midpoints of kSamples equal slices of
+  // the cumulative area (in face order).
+  std::vector<double> cumulative(faces.size());
+  double total = 0;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const int f = faces[i];
+    total += 0.5 * (corner(f, 1) - corner(f, 0)).cross(corner(f, 2) - corner(f, 0)).norm();
+    cumulative[i] = total;
+  }
+  if (!(total > 0)) return 0.0;
+  const int n = static_cast<int>(std::min<size_t>(kSamples, faces.size()));
+  std::vector<int> samples;
+  for (int i = 0; i < n; ++i) {
+    const double target = (i + 0.5) / n * total;
+    const size_t at = static_cast<size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), target) - cumulative.begin());
+    const int f = faces[std::min(at, faces.size() - 1)];
+    if (samples.empty() || samples.back() != f) samples.push_back(f);
+  }
+  std::vector<double> w(samples.size(), 0.0);
+  tbb::parallel_for(size_t{0}, samples.size(), [&](size_t s) {
+    const int f = samples[s];
+    const Vector3d c = (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3;
+    double sum = 0;  // in face order: the same sum whatever the threads
+    for (const int g : faces)
+      if (g != f) sum += solid_angle(c, corner(g, 0), corner(g, 1), corner(g, 2));
+    w[s] = sum / (2 * kTwoPi);
+  });
+  double mean = 0;
+  for (const double x : w) mean += x;
+  return mean / static_cast<double>(w.size());
+}
 
 int orient_outward(TriMesh& mesh) {
   std::vector<int> fc;
   const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
   const std::vector<std::vector<int>> groups = component_faces(fc, n);
-  const double diagonal = bounding_box(mesh.V, mesh.F).extent().norm();
-  const Eigen::VectorXd area = face_areas(mesh.V, mesh.F);
-  std::vector<char> flip(static_cast<size_t>(n), 0);
-  tbb::parallel_for(0, n, [&](int c) {
-    const std::vector<int>& faces = groups[static_cast<size_t>(c)];
-    std::vector<int> voters(faces);
-    const size_t k = std::min<size_t>(kVoters, voters.size());
-    std::partial_sort(voters.begin(), voters.begin() + static_cast<long>(k), voters.end(),
-                      [&](int a, int b) { return area(a) > area(b) || (area(a) == area(b) && a < b); });
-    int inward = 0, outward = 0;
-    for (size_t i = 0; i < k; ++i) {
-      const int f = voters[i];
-      const Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
-                     cc = mesh.V.row(mesh.F(f, 2));
-      Vector3d d = (b - a).cross(cc - a);
-      if (!(d.norm() > 0)) continue;
-      d.normalize();
-      // Slightly tilted off the normal, so that a ray along a box's axis does not run exactly
-      // through the edges of the faces it crosses.
-      d = (d + Vector3d(0.0123, 0.0271, 0.0089)).normalized();
-      const Vector3d o = (a + b + cc) / 3;
-      int crossings = 0;
-      for (const int g : faces) {
-        if (g == f) continue;
-        crossings += ray_triangle(o, d, mesh.V.row(mesh.F(g, 0)), mesh.V.row(mesh.F(g, 1)),
-                                  mesh.V.row(mesh.F(g, 2)), 1e-9 * diagonal) > 0;
-      }
-      ++(crossings % 2 ? inward : outward);
-    }
-    flip[static_cast<size_t>(c)] = inward > outward;
-  });
   int flipped = 0;
   for (int c = 0; c < n; ++c) {
-    if (!flip[static_cast<size_t>(c)]) continue;
+    const std::vector<int>& faces = groups[static_cast<size_t>(c)];
+    if (!(mean_surface_winding(mesh.V, mesh.F, faces) < kInwardBelow)) continue;
     ++flipped;
-    for (const int f : groups[static_cast<size_t>(c)]) std::swap(mesh.F(f, 1), mesh.F(f, 2));
+    for (const int f : faces) std::swap(mesh.F(f, 1), mesh.F(f, 2));
   }
   return flipped;
 }

@@ -32,6 +32,7 @@ struct QuiltEmbeddingStats {
   int removed_self_intersecting = 0;  // folded through itself, and no repair possible
   int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
   int shrunk_to_fit = 0;              // elements kept at 85-95% of their size instead of removed
+  int layout_versions = 0;  // even copies that touched a neighbour, kept as the layout placed them
   int separated_rings = 0;            // rings moved apart from those they touched
   int separation_reverted = 0;        // moved, then put back: a link would have changed
   int separation_left_shell = 0;      // moved, then put back: it left the shell
@@ -41,18 +42,45 @@ struct QuiltEmbeddingStats {
   int unoptimized_elements = 0;
   // Non-empty when the shell map could not be built and normal displacement was used instead.
   std::string shell_map_failure;
+  // Where the shell map was built without some regions of the base (ShellMap's per-region
+  // fallback): the base faces left out, their share of the base's area, how many of them were
+  // left out where the base folds (the rest where the shell clashes: thin parts, parts a hair
+  // apart, a base through itself), why, and the elements placed over them by normal
+  // displacement. After a whole-base fallback (shell_map_failure) the share is 1.
+  int fallback_faces = 0;
+  double fallback_area_share = 0;
+  int fallback_fold_faces = 0;
+  std::string fallback_reason;
+  int fallback_elements = 0;
+  // The check of the result (issue 23): per output vertex its signed height over the base as
+  // given (core/placement_check). As first embedded: the share of vertices more than
+  // `placement_tolerance` shell heights under the base; elements with such a vertex are placed
+  // again by normal displacement (replaced_below), and those still under it, then or after the
+  // repairs that follow, are removed (removed_below). In the output: the shares under the base
+  // (0 by construction) and above the shell, and the lowest signed height in shell heights.
+  double placement_tolerance = 0.01;
+  double below_base_embedded = 0;
+  int replaced_below = 0;
+  int lifted_below = 0;  // pushed under the base by the repairs after embedding, lifted out whole
+  int removed_below = 0;
+  long long checked_vertices = 0;
+  double below_base = 0, above_shell = 0, lowest_height = 0;
   int faces = 0, vertices = 0, elements = 0;
   // Spread of element surface areas (how even the texture is over the surface).
   double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
-  // Fraction of the base's area with output geometry within 1.5 shell heights, sampled at the
-  // centroids of the refined base's faces.
+  // Fraction of the base's area with output geometry within 1.5 shell heights on its outer
+  // side (surface_coverage), sampled at the centroids of the refined base's faces; in [0, 1].
   double coverage = 0;
   StageTimes times;
 };
 
 // Embeds the quilt. `stretch` evaluates per-tetrahedron stretch for the shell map (CPU or
-// OpenCL); it is unused for normal displacement. When no valid shell exists over the base, falls
-// back to normal displacement and says why in stats->shell_map_failure. With stretch
+// OpenCL); it is unused for normal displacement. Where no valid shell exists over a region of
+// the base, the map is built on the rest and elements over that region are placed by normal
+// displacement (stats->fallback_*); when no valid shell exists at all, everything is, and
+// stats->shell_map_failure says why. Then the result is checked: elements under the base are
+// placed again by normal displacement, or removed (stats->replaced_below, removed_below), so
+// no output vertex lies more than 1% of the shell height under the base. With stretch
 // optimisation, elements that the optimised map makes intersect another element are mapped
 // through the map as it was before optimisation (stats->unoptimized_elements). Throws
 // DeviceError from the evaluator. Each stage (shell map, stretch optimization, fold repair,

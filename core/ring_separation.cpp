@@ -127,6 +127,28 @@ void tube_contacts(const Tube& a, const Tube& b, double clearance, std::vector<C
   }
 }
 
+// The contacts of a tube with the base: each loop point less than its radius above it, pushed
+// out along the way from its closest point on the base (the face's normal when on it).
+void ground_contacts(const Tube& t, const SignedHeight& ground, std::vector<Contact>& out) {
+  out.clear();
+  const size_t n = t.loop.size();
+  for (size_t k = 0; k < n; ++k) {
+    const Vector3d& p = t.loop[k];
+    const double r = std::max(t.radius[k], t.radius[(k + n - 1) % n]);
+    ClosestPointHit hit;
+    const double h = ground(p, &hit);
+    if (!(h < r) || hit.face < 0) continue;
+    Contact c;
+    c.on_a = p;
+    c.on_b = hit.point;
+    c.depth = r - h;
+    const Vector3d away = h > 0 ? Vector3d(p - hit.point) : Vector3d(hit.point - p);
+    c.normal = away.norm() > 1e-12 * r ? Vector3d(away.normalized())
+                                       : Vector3d(ground.query().face_normals().row(hit.face));
+    out.push_back(c);
+  }
+}
+
 Eigen::Matrix3d loop_inertia(const Tube& t) {
   Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
   for (const Vector3d& p : t.loop) {
@@ -285,10 +307,24 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
   };
   stats.overlaps_before = find_contacts();
   int overlapping = stats.overlaps_before;
+  // Contacts of the movable tubes with the base (options.ground), found again for those that
+  // moved.
+  std::vector<std::vector<Contact>> grounded(nt);
+  const auto find_ground = [&] {
+    if (!options.ground) return 0;
+    tbb::parallel_for(size_t{0}, nt, [&](size_t i) {
+      if (free[i] && stepped[i]) ground_contacts(tubes[i], *options.ground, grounded[i]);
+    });
+    int sinking = 0;
+    for (size_t i = 0; i < nt; ++i) sinking += free[i] && !grounded[i].empty();
+    return sinking;
+  };
+  // Only rings that touch another are moved; the base then keeps them out of it.
+  int sinking = overlapping > 0 ? find_ground() : 0;
   std::vector<Vector3d> dx(nt), dw(nt);
   std::vector<int> count(nt);
   std::vector<char> touched(nt, 0);
-  for (int it = 0; it < options.max_iterations && overlapping > 0; ++it) {
+  for (int it = 0; it < options.max_iterations && overlapping + sinking > 0; ++it) {
     ++stats.iterations;
     std::fill(dx.begin(), dx.end(), Vector3d::Zero());
     std::fill(dw.begin(), dw.end(), Vector3d::Zero());
@@ -317,6 +353,16 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
           dw[b] -= inverse_inertia[b] * (rb.cross(lambda * c.normal));
           ++count[b];
         }
+      }
+    }
+    for (size_t i = 0; i < nt; ++i) {
+      if (!free[i]) continue;
+      for (const Contact& c : grounded[i]) {  // the base does not move
+        const Vector3d r = c.on_a - tubes[i].centre, cr = r.cross(c.normal);
+        const double lambda = c.depth / (1 + cr.dot(inverse_inertia[i] * cr));
+        dx[i] += lambda * c.normal;
+        dw[i] += inverse_inertia[i] * (r.cross(lambda * c.normal));
+        ++count[i];
       }
     }
     std::fill(stepped.begin(), stepped.end(), 0);
@@ -356,6 +402,7 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
       t.update_box();
     });
     overlapping = find_contacts();
+    sinking = find_ground();
   }
   stats.overlaps_after = overlapping;
 

@@ -20,6 +20,7 @@
 
 #include "core/linking_number.h"
 #include "core/mesh.h"
+#include "core/signed_height.h"
 
 namespace mq {
 
@@ -35,6 +36,10 @@ struct RingSeparationOptions {
   // radii: the mail stays where the map put it, and the pairs that can meet are known at the
   // start (so are all links that could change).
   double max_travel = 2.0;
+  // The base surface, if given: a movable ring's tube may not sink into it (each loop point
+  // stays its tube's radius above it), a static obstacle like a fixed ring. Without it, rings
+  // pushed apart over a concave crease went into the base (armor job: 248 of 294 moved).
+  const SignedHeight* ground = nullptr;
 };
 
 struct RingSeparationStats {

@@ -147,7 +147,14 @@ MatrixX3d ShellEmbedding::embed(const LocalCoordinates& P, Eigen::VectorXi* tet_
 }
 
 MatrixX3d normal_displacement(const MatrixX3d& V, const MatrixX3i& F, const LocalCoordinates& P) {
+  return normal_displacement(V, F, vertex_normals(V, F), P);
+}
+
+MatrixX3d normal_displacement(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N,
+                              const LocalCoordinates& P) {
   const int np = P.size();
+  MQ_CHECK(N.rows() == V.rows(), InvalidInput, "normal displacement: ", N.rows(),
+           " directions for ", V.rows(), " vertices");
   MQ_CHECK(P.bary.rows() == np && P.height.size() == np, InvalidInput,
            "normal displacement: mismatched point arrays");
   MQ_CHECK(V.allFinite() && P.bary.allFinite() && P.height.allFinite(), InvalidInput,
@@ -157,7 +164,6 @@ MatrixX3d normal_displacement(const MatrixX3d& V, const MatrixX3i& F, const Loca
   for (int i = 0; i < np; ++i)
     MQ_CHECK(P.face(i) >= 0 && P.face(i) < F.rows(), InvalidInput, "normal displacement: point ", i,
              " has face ", P.face(i), " out of range");
-  const MatrixX3d N = vertex_normals(V, F);
   MatrixX3d out(np, 3);
   std::vector<char> bad(np, 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, np), [&](const tbb::blocked_range<int>& r) {

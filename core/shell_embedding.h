@@ -70,4 +70,9 @@ class ShellEmbedding {
 MatrixX3d normal_displacement(const MatrixX3d& V, const MatrixX3i& F,
                               const LocalCoordinates& points);
 
+// The same along given per-vertex directions N (#V by 3, any length; interpolated and
+// normalised), such as the shell's smoothed offset directions.
+MatrixX3d normal_displacement(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N,
+                              const LocalCoordinates& points);
+
 }  // namespace mq

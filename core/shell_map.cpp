@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <random>
 
 #include "core/errors.h"
+#include "core/geometry_measures.h"
 #include "core/mesh_topology.h"
 #include "core/shell_tetrahedra.h"
 
@@ -31,21 +33,93 @@ ShellMap::ShellMap(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions
            "shell map: height must be finite and > 0, got ", options.height);
   MQ_CHECK(V.allFinite(), InvalidInput, "shell map: vertices contain NaN or infinite values");
   MQ_CHECK(F.rows() > 0, InvalidInput, "shell map: the base has no faces");
+  MQ_CHECK(options.repair_max_above >= 0 && options.repair_max_below >= 0 &&
+               options.repair_max_shift >= 0 && options.exclusion_rings >= 0 &&
+               options.max_exclusion_attempts >= 1 && options.max_excluded_share >= 0 &&
+               options.max_excluded_share <= 1,
+           InvalidInput,
+           "shell map: repair bounds and exclusion rings must be >= 0, attempts >= 1 and the "
+           "excluded share in [0, 1]");
   height_ = options.height;
   F_ = F;
   base_V_ = V;
   repair_.V = V;
   OffsetOptions oo = options.offset;
   oo.height = options.height;
-  try {
-    offset_ = offset_surface(base_V_, F_, oo);
-  } catch (const TopologyError&) {
-    if (!options.repair_folds) throw;
+  OffsetFailure failure;
+  if (!try_offset_surface(base_V_, F_, oo, offset_, failure)) {
+    if (!options.repair_folds && !options.exclude_regions) MQ_THROW(TopologyError, failure.reason);
     // Section 3.2 needs a valid shell; a folded base has none, so the shell is built over a
-    // locally relaxed copy (only the few vertices of the fold move; see base_fold_repair.h).
-    repair_ = repair_folds(V, F, options.fold_repair);
-    base_V_ = repair_.V;
-    offset_ = offset_surface(base_V_, F_, oo);
+    // relaxed copy, which may slide a little along the base but not leave it (see
+    // base_fold_repair.h). What the bounded repair leaves is judged by offset_surface itself.
+    if (options.repair_folds && failure.fold) {
+      FoldRepairOptions fo = options.fold_repair;
+      fo.offset_criterion = true;
+      fo.max_above = options.repair_max_above * height_;
+      fo.max_below = options.repair_max_below * height_;
+      fo.max_shift = options.repair_max_shift * height_;
+      repair_ = repair_folds(V, F, fo);
+      base_V_ = repair_.V;
+    }
+    const int n = static_cast<int>(V.rows());
+    const Adjacency vf = vertex_faces(F, n);
+    const Eigen::VectorXd area = face_areas(V, F);
+    const double total = area.sum();
+    std::vector<char> out(static_cast<size_t>(F.rows()), 0);
+    std::vector<int> kept(static_cast<size_t>(F.rows()));  // shell face -> input face
+    std::iota(kept.begin(), kept.end(), 0);
+    // The first attempt is the failure above, unless the repair moved something.
+    const bool retry = !repair_.moved_vertices.empty();
+    for (int attempt = 0;; ++attempt) {
+      if (attempt > 0 || retry) {
+        F_.resize(static_cast<Eigen::Index>(kept.size()), 3);
+        for (size_t i = 0; i < kept.size(); ++i)
+          F_.row(static_cast<Eigen::Index>(i)) = F.row(kept[i]);
+        if (try_offset_surface(base_V_, F_, oo, offset_, failure)) break;
+      }
+      MQ_CHECK(options.exclude_regions && attempt < options.max_exclusion_attempts, TopologyError,
+               failure.reason);
+      if (exclusion_.reason.empty()) exclusion_.reason = failure.reason;
+      // The offending faces (of the shell's faces, numbered as F_) and exclusion_rings rings of
+      // faces around them are left out; one ring more from half the attempts on, so that a
+      // clash that moves on to the faces next to those left out ends in fewer attempts (each
+      // is a whole offset_surface: the 108k-face dragon at scale 0.15 took 11 without it).
+      std::vector<int> faces;
+      for (const int f : failure.faces) faces.push_back(kept[static_cast<size_t>(f)]);
+      const int rings =
+          options.exclusion_rings + (2 * attempt >= options.max_exclusion_attempts ? 1 : 0);
+      for (int ring = 0; ring < rings; ++ring) {
+        std::vector<int> grown = faces;
+        for (const int f : faces)
+          for (int k = 0; k < 3; ++k) grown.insert(grown.end(), vf.begin(F(f, k)), vf.end(F(f, k)));
+        faces.swap(grown);
+      }
+      for (const int f : faces) {
+        if (!out[static_cast<size_t>(f)]) exclusion_.fold_faces += failure.fold;
+        out[static_cast<size_t>(f)] = 1;
+      }
+      kept.clear();
+      double left = 0;
+      for (Eigen::Index f = 0; f < F.rows(); ++f) {
+        if (out[static_cast<size_t>(f)])
+          left += area(f);
+        else
+          kept.push_back(static_cast<int>(f));
+      }
+      exclusion_.area_share = total > 0 ? left / total : 1.0;
+      MQ_CHECK(!kept.empty() && exclusion_.area_share <= options.max_excluded_share, TopologyError,
+               exclusion_.reason, " (a valid shell would leave out ", 100 * exclusion_.area_share,
+               "% of the base, over the ", 100 * options.max_excluded_share, "% allowed)");
+    }
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      if (out[static_cast<size_t>(f)]) exclusion_.faces.push_back(static_cast<int>(f));
+  }
+  shell_face_.assign(static_cast<size_t>(F.rows()), -1);
+  for (Eigen::Index f = 0, i = 0; f < F.rows(); ++f) {
+    if (std::binary_search(exclusion_.faces.begin(), exclusion_.faces.end(), static_cast<int>(f)))
+      continue;
+    shell_face_[static_cast<size_t>(f)] = static_cast<int>(i++);
+    input_face_.push_back(static_cast<int>(f));
   }
   atlas_ = texture_atlas(base_V_, F_, options.atlas);
 

@@ -434,9 +434,11 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
     const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
     const double faces = static_cast<double>(swatch_mesh.num_faces()) *
                          face_areas(base_in.V, base_in.F).sum() / footprint;
+    stats.estimated_faces = faces;
     MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
              " the texture would have about ", faces, " faces, more than the limit of ",
-             options.max_faces, " (--max-faces); use a larger --scale");
+             options.max_faces, " (--max-faces, or --max-memory at 400 bytes a face); use a "
+             "larger --scale");
   }
   // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
   // small next to the swatch: the base is refined by longest-edge bisection (the surface itself

@@ -29,6 +29,15 @@ struct SurfaceElement {
   // rigidly, where the map folds the element through itself.
   MatrixX3d flat;
   int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds)
+  // Optional (empty face: none): the element as the layout alone places it, where the
+  // coordinates above are an even copy of it (core/global_quilting, adaptive placement). The
+  // embedding tries it before removing the copy for touching a neighbour: distorted, but in its
+  // place among its neighbours.
+  struct Alternative {
+    std::vector<int> face;   // #V
+    MatrixX3d barycentric;   // #V by 3
+    Eigen::VectorXd height;  // #V
+  } through_layout;
 };
 
 struct SurfaceQuilt {
@@ -92,9 +101,36 @@ struct SurfaceQuiltingOptions {
     bool seamless = true;
     // Cancel + and - cones at the two ends of one edge (cancel_singular_pairs).
     bool cancel_cone_pairs = true;
+    // Move the cones for the least change of scale (core/cone_placement) and lay the texture
+    // out conformally, by the field parallel in their flat metric scaled by e^u
+    // (core/trivial_connection); false: unit frames of the smooth line field.
+    bool conformal = true;
+    // The metric's scale is followed as e^(a u) with a <= 1 such that the lattice, normalised
+    // to the typical element's size, fills the surface at most this many times over
+    // (e^(2 a^2 E), E the mean squared log scale after the cones are placed).
+    double max_overfill = 1.2;
+    // How a lattice element is carried onto the base: through the layout vertex by vertex
+    // (kLayout: it keeps its place among its neighbours exactly, and takes the layout's
+    // distortion across it); as a copy of the layout's first-order image at its centre whose
+    // offsets are walked along the surface, a similarity (kRigid: bent by the surface only);
+    // or through the layout where that keeps its shape and as a first-order copy elsewhere
+    // (kAdaptive). The shape is kept when the layout there is nearly a similarity (aspect at
+    // most max_element_aspect), the same one across the element (its halves' scales within
+    // max_element_variation) and the element at most max_element_scale times the swatch's. A
+    // copy's size is clamped to [1 / max_element_scale, max_element_scale] times the swatch's.
+    enum class Placement { kLayout, kRigid, kAdaptive };
+    Placement placement = Placement::kAdaptive;
+    double max_element_scale = 1.3;
+    double max_element_aspect = 1.3;
+    double max_element_variation = 1.3;
     // A periodic swatch of compact elements is tiled over the parameter plane (the planar
-    // quilt it would give); else the plane is quilted.
+    // quilt it would give), one of threads by one-period pieces welded into threads
+    // (core/thread_tiling); else the plane is quilted.
     bool tile = true;
+    // The quilt will be embedded by plain normal displacement: thread pieces that it folds
+    // through themselves are left out (a folded thread would be removed whole). The shell map
+    // unfolds them, so they are kept for it.
+    bool drop_folded_pieces = false;
   } global;
 };
 
@@ -115,6 +151,9 @@ struct SurfaceQuiltingStats {
   PatchCounts counts;
   int rejected_outside_patch = 0;             // swatch elements reaching beyond the flattened patch
   int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
+  // Output faces estimated before any work (the swatch's faces per footprint area over the
+  // base's area), and, for the global layout, counted once the layout is known.
+  double estimated_faces = 0;
   StageTimes times;
 };
 

@@ -233,6 +233,75 @@ TriMesh chainmail_4in1(const ChainMailOptions& o) {
   return mail;
 }
 
+namespace {
+
+// Square mail layout in units of the flat ring radius: pitch 2.5 leaves 0.26 between flat rings of
+// wire 0.12 (0.2 at the largest wire, 0.15); a connector of radius 0.6 centred half-way crosses the
+// flat rings' plane 0.65 from each centre, 0.35 inside their wire circles, and their wires pass
+// through its hole 0.25 from its centre, 0.35 inside its wire circle: 0.35 - 2 * 0.15 = 0.05 is the
+// least clearance. Connectors along x and along y are 1.77 apart, more than their 1.5 reach.
+constexpr double kSquarePitch = 2.5;
+constexpr double kSquareConnector = 0.6;
+constexpr double kSquareMaxWire = 0.15;
+
+void check_square(const SquareMailOptions& o) {
+  MQ_CHECK(o.rows >= 1 && o.cols >= 1, InvalidInput,
+           "square chain mail: rows and cols must be >= 1");
+  MQ_CHECK(o.ring_segments >= 3 && o.wire_segments >= 3, InvalidInput,
+           "square chain mail: ring_segments and wire_segments must be >= 3");
+  MQ_CHECK(o.ring_radius > 0 && o.wire_radius > 0, InvalidInput,
+           "square chain mail: ring_radius and wire_radius must be positive");
+  MQ_CHECK(o.wire_radius <= kSquareMaxWire * o.ring_radius, InvalidInput,
+           "square chain mail: wire_radius ", o.wire_radius, " exceeds ", kSquareMaxWire,
+           " * ring_radius: rings would intersect");
+}
+
+// A ring of wire centre radius r about `centre` in the plane spanned by unit e1, e2.
+TriMesh ring_in_plane(const Vector3d& centre, const Vector3d& e1, const Vector3d& e2, double r,
+                      const SquareMailOptions& o) {
+  const int n = o.ring_segments;
+  std::vector<Vector3d> C(n), T(n);
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n;
+    C[i] = centre + r * (std::cos(t) * e1 + std::sin(t) * e2);
+    T[i] = -std::sin(t) * e1 + std::cos(t) * e2;
+  }
+  return tube_mesh(C, T, e1.cross(e2), o.wire_radius, o.wire_segments, true);
+}
+
+}  // namespace
+
+double chainmail_square_period(const SquareMailOptions& o) {
+  check_square(o);
+  return kSquarePitch * o.ring_radius;
+}
+
+TriMesh chainmail_square(const SquareMailOptions& o) {
+  check_square(o);
+  const double R = o.ring_radius, P = kSquarePitch * R, Rc = kSquareConnector * R;
+  TriMesh mail;
+  const auto add = [&](TriMesh ring, const char* kind) {
+    set_single_kind(ring, kind);
+    if (mail.empty())
+      mail = std::move(ring);
+    else
+      append_mesh(mail, ring);
+  };
+  const Vector3d x = Vector3d::UnitX(), y = Vector3d::UnitY(), z = Vector3d::UnitZ();
+  for (int k = 0; k < o.rows; ++k)
+    for (int c = 0; c < o.cols; ++c)
+      add(ring_in_plane(Vector3d(c * P, k * P, 0), x, y, R, o), "ring");
+  // Upright connectors: in the xz plane between neighbours along x, in the yz plane along y.
+  for (int k = 0; k < o.rows; ++k)
+    for (int c = 0; c + 1 < o.cols; ++c)
+      add(ring_in_plane(Vector3d((c + 0.5) * P, k * P, 0), x, z, Rc, o), "connector");
+  for (int k = 0; k + 1 < o.rows; ++k)
+    for (int c = 0; c < o.cols; ++c)
+      add(ring_in_plane(Vector3d(c * P, (k + 0.5) * P, 0), y, z, Rc, o), "connector");
+  move_to_origin(mail);
+  return mail;
+}
+
 TriMesh plain_weave(const WeaveOptions& o) {
   MQ_CHECK(o.threads_x >= 1 && o.threads_y >= 1, InvalidInput,
            "plain weave: threads_x and threads_y must be >= 1");

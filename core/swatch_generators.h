@@ -3,8 +3,8 @@
 // Every generator returns a TriMesh with outward-oriented closed manifold components (one per
 // element) placed with min corner at the origin: x-y is the footprint, z in [0, thickness].
 // Output is deterministic for the given options (seeded std::mt19937_64, raw output only).
-// Elements carry kinds (TriMesh::kinds): "ring"; "thread_x" and "thread_y"; "apple"; "vine"
-// and "leaf".
+// Elements carry kinds (TriMesh::kinds): "ring"; "ring" and "connector"; "thread_x" and
+// "thread_y"; "apple"; "vine" and "leaf".
 #pragma once
 
 #include <cstdint>
@@ -34,6 +34,31 @@ struct ChainMailOptions {
 TriMesh chainmail_4in1(const ChainMailOptions& options = {});
 double chainmail_period_x(const ChainMailOptions& options = {});  // 2.5 * ring_radius
 double chainmail_period_y(const ChainMailOptions& options = {});  // 1.25 * ring_radius
+
+struct SquareMailOptions {
+  int rows = 6;               // flat rings per column (along y)
+  int cols = 6;               // flat rings per row (along x)
+  double ring_radius = 1.0;   // radius of a flat ring's wire centre circle
+  double wire_radius = 0.12;  // of both kinds; must be <= 0.15 * ring_radius
+  int ring_segments = 48;     // segments along a ring (connectors too)
+  int wire_segments = 12;     // segments around the wire
+};
+
+// A square 4-in-1 sheet ("Japanese 4-in-1"): flat rings (kind "ring") in the z = 0 plane on a
+// square grid of pitch 2.5 R, each pair of grid neighbours joined by an upright connector ring
+// (kind "connector", radius 0.6 R) standing in the vertical plane through both centres, half-way
+// between them. Each connector passes through the holes of its two flat rings 0.65 R from their
+// centres, so an interior flat ring links 4 connectors and every connector 2 flat rings. With
+// wire_radius <= 0.15 R every two wires keep >= 0.05 R apart (closest: a flat ring's wire
+// through a connector's hole and the connector's wire through the ring's hole), so no rings
+// intersect. Only connectors between two flat rings of the sheet are made: rows * cols flat rings
+// and (rows - 1) * cols + rows * (cols - 1) connectors, all of 2 * ring_segments * wire_segments
+// faces; flat rings first (row by row), then the connectors along x, then along y.
+// The sheet repeats with period chainmail_square_period along x and y (one flat ring and two
+// connectors per cell) and is symmetric under a half turn about a flat ring's centre.
+// Throws InvalidInput for counts < 1, segments < 3, non-positive radii or too thick a wire.
+TriMesh chainmail_square(const SquareMailOptions& options = {});
+double chainmail_square_period(const SquareMailOptions& options = {});  // 2.5 * ring_radius
 
 struct WeaveOptions {
   int threads_x = 6;            // threads running along x (warp), stacked along y

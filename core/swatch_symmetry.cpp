@@ -179,11 +179,7 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
   return out;
 }
 
-namespace {
-
 Vector2d element_centre(const Element& e) { return e.V.leftCols<2>().colwise().mean().transpose(); }
-
-}  // namespace
 
 Vector2d axis_periods(const PreparedSwatch& swatch, const SwatchFaceTree& faces, double cell,
                       double tolerance) {
@@ -315,8 +311,8 @@ bool tileable(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry) {
   return !tiled.empty() && intersecting_face_pairs(tiled.V, tiled.F).empty();
 }
 
-TriMesh tile_lattice(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry,
-                     const Vector2d& lo, const Vector2d& hi, int* orbits) {
+std::vector<int> orbit_representatives(const PreparedSwatch& swatch,
+                                       const SwatchSymmetry& symmetry) {
   Eigen::Matrix2d basis;
   basis.col(0) = symmetry.a;
   basis.col(1) = symmetry.b;
@@ -349,6 +345,16 @@ TriMesh tile_lattice(const PreparedSwatch& swatch, const SwatchSymmetry& symmetr
     rep_k.push_back(k);
   }
   std::sort(reps.begin(), reps.end());
+  return reps;
+}
+
+TriMesh tile_lattice(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry,
+                     const Vector2d& lo, const Vector2d& hi, int* orbits) {
+  Eigen::Matrix2d basis;
+  basis.col(0) = symmetry.a;
+  basis.col(1) = symmetry.b;
+  const Eigen::Matrix2d inv = basis.inverse();
+  const std::vector<int> reps = orbit_representatives(swatch, symmetry);
   if (orbits) *orbits = static_cast<int>(reps.size());
   // Lattice translations whose copy of a representative meets [lo, hi].
   std::vector<const Element*> out;

@@ -46,6 +46,14 @@ bool repeating_elements(const PreparedSwatch& swatch);
 // Threads that run the whole swatch are not: their copies a period apart overlap.
 bool tileable(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry);
 
+// The elements of the swatch one per lattice orbit (elements whose centres differ by a period
+// are one orbit): the copy nearest the swatch's centre, ties by index; ascending indices.
+std::vector<int> orbit_representatives(const PreparedSwatch& swatch,
+                                       const SwatchSymmetry& symmetry);
+
+// The footprint centre of an element (mean of its vertices' x, y).
+Vector2d element_centre(const Element& e);
+
 // The planar quilt of a tileable swatch over [lo, hi] (synthesis frame, swatch coordinates):
 // one representative per lattice orbit of elements (the copy nearest the swatch's centre),
 // repeated at every lattice translation whose copy meets the region. On a periodic swatch every

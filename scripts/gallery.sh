@@ -62,4 +62,33 @@ $mq render "$work/spot.obj" --color links --base data/spot_6k.obj --crop $crop \
   -o docs/spot_quilt_crop.png --width 640 --height 480 --quiet
 $mq render "$work/spot_scatter.obj" --color links --base data/spot_6k.obj --crop $crop \
   -o docs/spot_scatter_crop.png --width 640 --height 480 --quiet
+# Issue 23: bases an artist makes (Blender's primitives, exported by headless Blender: the build's
+# blender_bases target) and close-ups at the scale of one element, coloured by shape against the
+# swatch (render --color shape: green even, yellow/orange/red larger or stretched, blue smaller,
+# magenta degenerate).
+cmake --build build --target blender_bases > /dev/null
+blender=build/blender_bases
+job uv_sphere $blender/uv_sphere_32x16.obj 0.08 chainmail --rows 3 --cols 3 --detail 16
+job cube $blender/cube.obj 0.08 chainmail --rows 3 --cols 3 --detail 16
+$mq render "$work/uv_sphere.obj" --color shape --swatch "$work/uv_sphere_swatch.obj" \
+  --base $blender/uv_sphere_32x16.obj --scale 0.08 -o docs/uv_sphere_shape.png --quiet
+# The cube's corner (2, 1, 0.5): rings over both edges and the corner.
+$mq render "$work/cube.obj" --color shape --swatch "$work/cube_swatch.obj" \
+  --base $blender/cube.obj --scale 0.08 --crop 2 1 0.5 0.7 --up z --azimuth 30 --elevation 30 \
+  -o docs/cube_corner_shape.png --width 640 --height 480 --quiet
+# Spot's left horn (narrower than a ring).
+$mq render "$work/spot.obj" --color shape --swatch "$work/spot_swatch.obj" --base data/spot_6k.obj \
+  --scale 0.08 --crop 0.12 0.88 -0.26 0.25 --azimuth 60 --elevation 20 \
+  -o docs/spot_horn_shape.png --width 640 --height 480 --quiet
+# A thread crossing the cup, from the side.
+$mq render "$work/cup_weave.obj" --base $data/cup_mug_11k.off --crop 0 -10.9 3 5 --azimuth 0 \
+  --elevation 10 -o docs/cup_thread_crop.png --width 640 --height 480 --quiet
+# The ivy wall (vines grown along the field).
+$mq swatch ivy --count 2 --length 2 -o "$work/ivy_swatch.obj" --quiet
+$mq surface --base $data/ivy_brick_wall_84.obj --swatch "$work/ivy_swatch.obj" --scale 0.016 \
+  -o "$work/ivy_wall.obj" --stats "$work/ivy_wall.json" --quiet
+echo "== ivy_wall: meshquilt swatch ivy --count 2 --length 2 ; surface --base $data/ivy_brick_wall_84.obj --scale 0.016"
+$mq info "$work/ivy_wall.obj" --links --intersections --swatch "$work/ivy_swatch.obj" \
+  --base $data/ivy_brick_wall_84.obj --scale 0.016 | tee "$work/ivy_wall.txt"
+$mq render "$work/ivy_wall.obj" -o docs/ivy_wall.png --quiet
 echo "gallery: pictures in docs/, meshes and figures in $work/"

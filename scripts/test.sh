@@ -5,7 +5,8 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/install_blender.sh
 jobs=$(nproc)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+# Warnings are errors here (issue 24): a warning fails CI, not just a log line.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHQUILT_WERROR=ON
 # What the tests need (the benchmarks are built by scripts/setup.sh and bench/); the artist
 # bases are exported by headless Blender.
 cmake --build build -j"$jobs" --target meshquilt test_core test_host test_cli test_slow \

@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
+
+#include <unistd.h>
 
 namespace mq::test {
 
@@ -29,14 +33,34 @@ void spit(const std::string& path, const std::string& text) {
 }
 
 std::string temp_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = "meshquilt_test";
-  if (info) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  // ctest runs each test in its own process, several at once: a suite's SetUpTestSuite (no
+  // current test) and parameterised tests must not share a directory across processes.
+  const auto* unit = ::testing::UnitTest::GetInstance();
+  const auto* info = unit->current_test_info();
+  const auto* suite = unit->current_test_suite();
+  std::string name = "meshquilt_test_" + std::to_string(::getpid());
+  if (info)
+    name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  else if (suite)
+    name += std::string("_") + suite->name();
   for (char& c : name)
     if (c == '/') c = '_';
   const auto dir = std::filesystem::temp_directory_path() / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  // Named by process, so removed when the process ends (MESHQUILT_KEEP_TEST_DIRS=1 keeps them
+  // to look at a failure).
+  struct Cleanup {
+    std::vector<std::filesystem::path> dirs;
+    ~Cleanup() {
+      const char* keep = std::getenv("MESHQUILT_KEEP_TEST_DIRS");
+      if (keep && std::string(keep) == "1") return;
+      std::error_code ec;
+      for (const auto& d : dirs) std::filesystem::remove_all(d, ec);
+    }
+  };
+  static Cleanup cleanup;
+  cleanup.dirs.push_back(dir);
   return dir.string();
 }
 
@@ -85,6 +109,38 @@ TriMesh plane_grid(double w, double h, int nx, int ny) {
       g.F.row(f++) << a, c, d;
     }
   return g;
+}
+
+TriMesh uv_sphere(double r, int segments, int rings) {
+  TriMesh m;
+  const int rows = rings - 1;  // vertex rows between the poles
+  m.V.resize(rows * segments + 2, 3);
+  for (int i = 0; i < rows; ++i) {
+    const double phi = M_PI * (i + 1) / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double theta = 2 * M_PI * j / segments;
+      m.V.row(i * segments + j) << r * std::sin(phi) * std::cos(theta),
+          r * std::sin(phi) * std::sin(theta), r * std::cos(phi);
+    }
+  }
+  const int north = rows * segments, south = north + 1;
+  m.V.row(north) << 0, 0, r;
+  m.V.row(south) << 0, 0, -r;
+  std::vector<Eigen::Vector3i> f;
+  for (int j = 0; j < segments; ++j) {
+    const int k = (j + 1) % segments;
+    f.emplace_back(north, j, k);
+    f.emplace_back(south, (rows - 1) * segments + k, (rows - 1) * segments + j);
+    for (int i = 0; i + 1 < rows; ++i) {
+      const int a = i * segments + j, b = i * segments + k, c = (i + 1) * segments + j,
+                d = (i + 1) * segments + k;
+      f.emplace_back(a, c, d);
+      f.emplace_back(a, d, b);
+    }
+  }
+  m.F.resize(static_cast<Eigen::Index>(f.size()), 3);
+  for (size_t i = 0; i < f.size(); ++i) m.F.row(static_cast<Eigen::Index>(i)) = f[i].transpose();
+  return m;
 }
 
 TriMesh open_cylinder(double r, double h, int n, int m) {

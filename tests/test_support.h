@@ -40,6 +40,11 @@ TriMesh torus(double R, double r, int n, int m);
 // Open regular grid in the z = 0 plane over [0,w]x[0,h], nx by ny quads split in two.
 TriMesh plane_grid(double w, double h, int nx, int ny);
 
+// A UV sphere as Blender's "Add > UV Sphere" makes it: `segments` around the z axis, `rings`
+// from pole to pole, quads split in two and a fan of triangles at each pole (where `segments`
+// thin triangles meet), radius r, closed and outward.
+TriMesh uv_sphere(double r, int segments, int rings);
+
 // Open cylinder of radius r around the z axis over [0, h], n segments around, m along, faces
 // counter-clockwise seen from outside.
 TriMesh open_cylinder(double r, double h, int n, int m);

@@ -38,11 +38,14 @@ bool opencl_platform_present() {
 
 TEST(Cli, HelpOfEveryCommand) {
   const std::string dir = test::temp_dir();
-  for (const std::string cmd : {"", "plane", "swatch", "info", "render"}) {
+  for (const std::string cmd : {"", "plane", "surface", "swatch", "info", "render"}) {
     const CliRun r = meshquilt(dir, cmd + " --help");
     EXPECT_EQ(r.status, 0) << cmd;
     EXPECT_NE(r.out.find("usage: meshquilt " + cmd), std::string::npos) << cmd << ":\n" << r.out;
     EXPECT_TRUE(r.err.empty()) << cmd << ": " << r.err;
+    // The exit statuses, which a farm scheduler's retry rule needs (issue 24).
+    for (const char* status : {"exit status: 0 done; 1 bad input", "2 bad usage", "3 internal error"})
+      EXPECT_NE(r.out.find(status), std::string::npos) << cmd << " --help lacks '" << status << "'";
   }
   const CliRun v = meshquilt(dir, "--version");
   EXPECT_EQ(v.status, 0);
@@ -372,7 +375,8 @@ TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
   EXPECT_NEAR(std::stod(json_value(i.out, "density_ratio")), 1.0, 0.08);
   const std::string csv = slurp(dir + "/e.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends");
+            "element,x,y,z,size,area,ring,links,interior,long,length,interior_ends,kind,defect,"
+            "loop_links,wire,opening,fold_degrees,size_ratio,aspect,stretch,by_correspondence");
   EXPECT_EQ(static_cast<int>(std::count(csv.begin(), csv.end(), '\n')) - 1,
             std::stoi(json_value(i.out, "rings")));
   EXPECT_EQ(meshquilt(dir, "info a.obj --links --swatch sw.obj --scale 0.07").status, 2);
@@ -389,6 +393,99 @@ TEST(Cli, SurfaceMethodsAndRenderWithTheBase) {
   EXPECT_EQ(c.status, 1);
   EXPECT_EQ(c.err_lines().size(), 1u);
   EXPECT_FALSE(fs::exists(dir + "/none.png"));
+}
+
+// The ivy section grows as vines (issue 23 item 4): auto takes them, the stems climb (+Y by
+// default on this upright plane) many swatch vines long with the swatch's leaves per length,
+// and nothing intersects; --method vines refuses a swatch that is not a vine.
+TEST(Cli, SurfaceGrowsIvyAsVines) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(meshquilt(dir, "swatch ivy --count 2 --length 2 -o ivy.obj --quiet").status, 0);
+  ASSERT_EQ(meshquilt(dir, "swatch apples --count 4 -o apples.obj --quiet").status, 0);
+  const TriMesh grid = test::plane_grid(2, 1.5, 20, 15);
+  std::ostringstream obj;
+  for (int v = 0; v < grid.num_vertices(); ++v)
+    obj << "v " << grid.V(v, 0) << " " << grid.V(v, 1) << " " << grid.V(v, 2) << "\n";
+  for (int f = 0; f < grid.num_faces(); ++f)
+    obj << "f " << grid.F(f, 0) + 1 << " " << grid.F(f, 1) + 1 << " " << grid.F(f, 2) + 1 << "\n";
+  spit(dir + "/grid.obj", obj.str());
+  const CliRun a = meshquilt(
+      dir, "surface --base grid.obj --swatch ivy.obj --scale 0.06 -o a.obj --stats a.json");
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_NE(a.out.find(" stems (spacing "), std::string::npos) << a.out;
+  const std::string stats = slurp(dir + "/a.json");
+  EXPECT_NE(stats.find("\"method\": \"vines\""), std::string::npos);
+  EXPECT_GE(std::stod(json_value(stats, "long_length_ratio")), 3.0);
+  EXPECT_NEAR(std::stod(json_value(stats, "compact_per_length_ratio")), 1.0, 0.15);
+  const CliRun i = meshquilt(dir, "info a.obj --intersections --links --swatch ivy.obj --json");
+  ASSERT_EQ(i.status, 0) << i.err;
+  EXPECT_EQ(json_value(i.out, "intersecting_face_pairs"), "0");
+  EXPECT_GE(std::stod(json_value(i.out, "long_length_ratio")), 3.0);
+  const CliRun v = meshquilt(
+      dir, "surface --base grid.obj --swatch apples.obj --scale 0.06 --method vines -o v.obj");
+  EXPECT_EQ(v.status, 1);
+  EXPECT_EQ(v.err_lines().size(), 1u);
+  EXPECT_FALSE(fs::exists(dir + "/v.obj"));
+}
+
+// Issue 23's honest measure as a user runs it, on the square 4-in-1 sheet quilted on a plane:
+// each ring judged against its own kind's count (flat rings 4, connectors 2) keeps 100%, no ring
+// is degenerate, every element is a copy of its swatch element's size and shape; the figures
+// are in the text, the JSON and the elements CSV, and render --color shape draws them.
+TEST(Cli, InfoLinksJudgesEachKindAndMeasuresShapes) {
+  const std::string dir = test::temp_dir();
+  const CliRun h = meshquilt(dir, "swatch --help");
+  EXPECT_NE(h.out.find("chainmail-square"), std::string::npos) << h.out;
+  ASSERT_EQ(
+      meshquilt(dir, "swatch chainmail-square --rows 4 --cols 4 --detail 16 -o sw.obj --quiet")
+          .status,
+      0);
+  ASSERT_EQ(meshquilt(dir, "plane --swatch sw.obj --size 20 20 -o p.obj --quiet").status, 0);
+  const CliRun t = meshquilt(dir, "info p.obj --links --swatch sw.obj --elements e.csv");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("interior link count per ring kind: ring 4, connector 2"), std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("structure kept:    100.00% of interior rings link as many others as their "
+                       "kind in the swatch"),
+            std::string::npos)
+      << t.out;
+  EXPECT_NE(t.out.find("ring:            100.00% of"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("connector:       100.00% of"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("degenerate rings:  0 (none)"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("size ratio:      median 1.000, 90th 1.000, 99th 1.000, largest 1.000"),
+            std::string::npos)
+      << t.out;
+  const CliRun j = meshquilt(dir, "info p.obj --links --swatch sw.obj --json");
+  ASSERT_EQ(j.status, 0) << j.err;
+  EXPECT_EQ(std::stod(json_value(j.out, "share_with_swatch_links")), 1.0);
+  EXPECT_EQ(json_value(j.out, "kind"), "\"ring\"");
+  EXPECT_EQ(std::stod(json_value(j.out, "share")), 1.0);
+  EXPECT_EQ(json_value(j.out, "degenerate_rings"), "0");
+  EXPECT_NEAR(std::stod(json_value(j.out, "p99")), 1.0, 1e-6);
+  EXPECT_EQ(json_value(j.out, "stretched_elements"), "0");
+  // One CSV line per element, each a copy of a swatch element of its kind.
+  const std::string csv = slurp(dir + "/e.csv");
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  int rows = 0, connectors = 0;
+  while (std::getline(lines, line)) {
+    ++rows;
+    connectors += line.find(",connector,none,") != std::string::npos;
+    EXPECT_EQ(line.substr(line.size() - 2), ",1") << line;  // by correspondence
+  }
+  EXPECT_EQ(rows, std::stoi(json_value(j.out, "rings")));
+  EXPECT_GT(connectors, rows / 2);
+  // render --color shape needs the swatch; with it, a picture.
+  EXPECT_EQ(meshquilt(dir, "render p.obj --color shape -o s.png").status, 2);
+  EXPECT_FALSE(fs::exists(dir + "/s.png"));
+  const CliRun r = meshquilt(
+      dir, "render p.obj --color shape --swatch sw.obj -o s.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(slurp(dir + "/s.png").substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const CliRun l = meshquilt(
+      dir, "render p.obj --color links --swatch sw.obj -o l.png --width 64 --height 48 --quiet");
+  ASSERT_EQ(l.status, 0) << l.err;
 }
 
 TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {

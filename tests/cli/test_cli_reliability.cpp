@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/mesh_io.h"
 #include "tests/cli/cli_support.h"
 #include "tests/test_support.h"
 
@@ -161,6 +162,29 @@ TEST_F(Reliability, SizesThatCannotFitAreRefusedBeforeWork) {
   // The override lets a job through that the default would also allow.
   const CliRun ok = meshquilt(dir_, "plane --swatch sw.obj --size 5 5 --max-faces 1e6 -o o.obj");
   EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+// Issue 23: Blender's UV sphere (triangle fans at the poles) with the sample chain mail drove
+// the engine to 23.5 GB. The estimate covers the global layout (counted before it is built),
+// a memory limit refuses a job up front, and the peak stays within 1.5x of the estimate.
+TEST_F(Reliability, MemoryIsEstimatedAndBounded) {
+  write_mesh(dir_ + "/uv.obj", test::uv_sphere(1.0, 32, 16));
+  expect_refused("surface --base uv.obj --swatch sw.obj --scale 0.05 --max-memory 0.02 -o o.obj",
+                 "--max-memory");
+  const CliRun r =
+      meshquilt(dir_, "surface --base uv.obj --swatch sw.obj --scale 0.1 -o o.obj --stats s.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string stats = slurp(dir_ + "/s.json");
+  const auto number = [&](const std::string& key) {
+    const size_t at = stats.find("\"" + key + "\":");
+    EXPECT_NE(at, std::string::npos) << key;
+    return std::stod(stats.substr(at + key.size() + 3));
+  };
+  const double estimated = number("estimated_bytes"), peak = number("peak_bytes");
+  std::printf("[ measure  ] UV sphere: estimated %.0f MiB, peak %.0f MiB\n", estimated / (1 << 20),
+              peak / (1 << 20));
+  EXPECT_GT(number("estimated_faces"), 0.5 * number("faces"));
+  EXPECT_LE(peak, 1.5 * estimated);
 }
 
 TEST_F(Reliability, MessagesInTheUsersTerms) {

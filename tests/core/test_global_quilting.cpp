@@ -42,23 +42,42 @@ GlobalRun run(const TriMesh& base, double ring, const MatrixX3d& field = MatrixX
   return r;
 }
 
-void expect_mail(const GlobalRun& r, double share, const char* what) {
+// What a run must keep: links (the honest measure: degenerate rings are misses, and
+// isolated), density, and the elements' shape against the swatch's (issue 23: even elements
+// wherever the surface allows). The size is measured on the embedded element, heights
+// included: over a convex base the shell's outer layer is wider than the base by the height
+// over the radius (rings a fifth of a sphere's radius: about 7%), hence the size's margin.
+struct Keep {
+  double share = 0.95;     // interior rings with the swatch's 4 links
+  double isolated = 0.01;  // share of rings linked to nothing
+  double size = 0.08;      // median size ratio within 1 +- this
+  double aspect = 1.1;     // median aspect at most
+};
+
+void expect_mail(const GlobalRun& r, const Keep& keep, const char* what) {
   SCOPED_TRACE(what);
   const StructureComparison& c = r.structure.comparison;
   const StructureReport& s = r.structure.output;
   std::printf(
       "[ measure  ] %s: %d rings (%d interior), %.2f%% with 4 links, %d isolated, "
-      "density %.1f%%, %d cones, %d off the surface, %d folded, %d intersecting\n",
+      "density %.1f%%, %d cones, %d off the surface, %d folded, %d intersecting; size median "
+      "%.3f, 99th %.3f, largest %.3f; aspect median %.3f\n",
       what, s.rings, s.interior_rings, 100 * c.share_matching, s.isolated_rings,
       100 * c.density_ratio, r.global.singular_vertices, r.global.off_surface,
-      r.embedding.removed_self_intersecting, r.embedding.removed_intersecting);
+      r.embedding.removed_self_intersecting, r.embedding.removed_intersecting,
+      c.shape.size_median, c.shape.size_p99, c.shape.size_max, c.shape.aspect_median);
   EXPECT_TRUE(r.global.periodic);
   EXPECT_TRUE(r.global.tiled);
   ASSERT_EQ(c.interior_links, 4);
   ASSERT_GT(s.interior_rings, 100);
-  EXPECT_GE(c.share_matching, share);
-  EXPECT_LE(s.isolated_rings, 0.01 * s.rings);
+  EXPECT_GE(c.share_matching, keep.share);
+  EXPECT_LE(s.isolated_rings, keep.isolated * s.rings);
   EXPECT_GE(c.density_ratio, 0.9);
+  EXPECT_LE(c.density_ratio, 1.1);
+  EXPECT_NEAR(c.shape.size_median, 1.0, keep.size);
+  EXPECT_LE(c.shape.size_p99, 1.35);
+  EXPECT_LE(c.shape.size_max, 1.65);
+  EXPECT_LE(c.shape.aspect_median, keep.aspect);
   // Nothing reaches the output intersecting itself or another element.
   EXPECT_TRUE(intersecting_face_pairs(r.output.V, r.output.F).empty());
   EXPECT_TRUE(self_intersecting_components(r.output.V, r.output.F).empty());
@@ -69,7 +88,7 @@ TEST(GlobalQuilting, FlatSquareIsThePlane) {
   const TriMesh base = test::plane_grid(12, 12, 24, 24);
   const GlobalRun r =
       run(base, 1.0, tangent_field_from_direction(base.V, base.F, Vector3d::UnitX()));
-  expect_mail(r, 0.98, "flat square");
+  expect_mail(r, {0.98, 0.01, 0.01, 1.01}, "flat square");
   EXPECT_EQ(r.global.singular_vertices, 0);
   EXPECT_EQ(r.global.cut_edges, 0);
   EXPECT_NEAR(r.structure.comparison.density_ratio, 1.0, 0.02);
@@ -79,7 +98,7 @@ TEST(GlobalQuilting, CylinderAlongItsAxis) {
   const TriMesh base = test::open_cylinder(2.0, 3.0, 48, 12);
   const GlobalRun r =
       run(base, 0.2, tangent_field_from_direction(base.V, base.F, Vector3d::UnitZ()));
-  expect_mail(r, 0.95, "cylinder, rings a tenth of the radius");
+  expect_mail(r, {0.95, 0.01, 0.03, 1.05}, "cylinder, rings a tenth of the radius");
   EXPECT_EQ(r.global.singular_vertices, 0);
   EXPECT_TRUE(r.global.seamless);
   EXPECT_LT(r.global.worst_transition_error, 0.05);
@@ -89,7 +108,8 @@ TEST(GlobalQuilting, SphereWithItsFourCones) {
   TriMesh base = test::icosphere(4);
   base.V *= 3.0;
   const GlobalRun r = run(base, 0.6);
-  expect_mail(r, 0.95, "sphere, rings a fifth of the radius");
+  // Rings a fifth of the radius: about 5% of them lie around the four cones.
+  expect_mail(r, {0.93}, "sphere, rings a fifth of the radius");
   EXPECT_EQ(r.global.singular_vertices, 4);
   EXPECT_EQ(r.global.pinned_cones, 3);  // the fourth is where the other three put it
   EXPECT_TRUE(r.global.seamless);
@@ -110,7 +130,33 @@ TEST(GlobalQuilting, SpikySphereTransitionsAreSymmetries) {
   EXPECT_GT(r.global.singular_vertices, 4);
   EXPECT_TRUE(r.global.seamless);
   EXPECT_LT(r.global.worst_transition_error, 0.01);
-  expect_mail(r, 0.9, "spiky sphere");
+  // Twelve spikes narrower than a ring: the rings on their tips are folded over them
+  // (degenerate: misses, and isolated, by the honest measure).
+  expect_mail(r, {0.84, 0.05, 0.08, 1.15}, "spiky sphere");
+}
+
+// Blender's default UV sphere: at each pole 32 thin triangles meet, and the smooth line field
+// puts an index-1 pole there (around which the half-turn lattice cannot close: before, no
+// cut, a layout collapsed 20-fold, 33 elements, and at larger rings the box of the charts
+// tiled until memory ran out). The poles are split into the sphere's four half-turn cones.
+TEST(GlobalQuilting, UvSpherePolesAreSplitIntoFourCones) {
+  TriMesh base = test::uv_sphere(3.0, 32, 16);
+  base.V.col(2) *= 1.0001;  // the guidance follows the longest box axis: the poles' one
+  double volume = 0;  // outward: positive
+  for (int f = 0; f < base.num_faces(); ++f)
+    volume += base.V.row(base.F(f, 0)).dot(
+        base.V.row(base.F(f, 1)).cross(base.V.row(base.F(f, 2))));
+  ASSERT_GT(volume, 0);
+  const GlobalRun r = run(base, 0.6);
+  std::printf("[ measure  ] UV sphere: %d poles split, %d cones, %d copies, E %.3f -> %.3f\n",
+              r.global.split_poles, r.global.singular_vertices, r.global.copied_elements,
+              r.global.scale_energy_before, r.global.scale_energy);
+  EXPECT_EQ(r.global.split_poles, 2);
+  EXPECT_EQ(r.global.singular_vertices, 4);
+  EXPECT_LT(r.global.scale_energy, 0.5 * r.global.scale_energy_before);
+  // As many rings as the sphere's area holds (not a box around the charts).
+  EXPECT_LE(r.structure.comparison.density_ratio, 1.3);
+  expect_mail(r, {0.9}, "UV sphere");
 }
 
 TEST(GlobalQuilting, SameInputSameBytesWhateverTheThreadCount) {

@@ -4,10 +4,12 @@
 #include <cmath>
 #include <random>
 
+#include "core/errors.h"
 #include "core/linking_number.h"
 #include "core/mesh_topology.h"
 #include "core/quilt_elements.h"
 #include "core/swatch_generators.h"
+#include "tests/core/ring_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -169,6 +171,76 @@ TEST(RingCentreLoop, FourInOneCellLinksItsDiagonalNeighbours) {
       }
     EXPECT_EQ(pairs, 10) << "a 3 x 3 sheet has 10 linked pairs";
   }
+}
+
+RingShape shape_of(const TriMesh& ring) {
+  const std::optional<Loop> loop = ring_centre_loop(ring.V, ring.F);
+  EXPECT_TRUE(loop.has_value());
+  return loop ? ring_shape(ring.V, ring.F, *loop) : RingShape{};
+}
+
+// A torus of centre radius 1 and wire 0.15: its wire 0.3 across, its free hole 2 (1 - 0.15) =
+// 1.7 across, flat; so whatever its tessellation or placement.
+TEST(RingShape, TorusHasItsWireItsHoleAndNoFold) {
+  for (const auto& [n, m] : {std::pair<int, int>{48, 12}, {16, 4}}) {
+    SCOPED_TRACE(testing::Message() << n << " x " << m);
+    const TriMesh ring = test::torus(1.0, 0.15, n, m);
+    const RingShape s = shape_of(ring);
+    // The area of a polygonal tube is a little under 2 pi r L (a square section: 2 sqrt 2 / pi).
+    EXPECT_NEAR(s.wire, 0.3, m == 4 ? 0.04 : 0.005);
+    EXPECT_NEAR(s.opening, 1.7, 0.005);
+    EXPECT_NEAR(s.fold, 0.0, 1e-9);
+    std::mt19937_64 rng(3);
+    const RingShape t =
+        shape_of(test::mapped(ring, [&, R = random_rotation(rng)](const Vector3d& p) {
+          return Vector3d(2.0 * (R * p) + Vector3d(1, -2, 3));
+        }));
+    EXPECT_NEAR(t.wire, 2 * s.wire, 1e-9);
+    EXPECT_NEAR(t.opening, 2 * s.opening, 2e-3) << "the search stops at 1e-3 of the hole";
+    EXPECT_NEAR(t.fold, 0.0, 1e-9);
+  }
+}
+
+// Squeezed: a tube around an ellipse keeps its hole as wide as the ellipse's minor axis less the
+// wire; a stadium pressed until its sides are 0.32 apart leaves a slit of 0.02 between walls
+// of wire 0.15. The figure is the free disk between the projected edges, so a coarse ring's
+// sections, a third of its radius apart, do not let it slip through the slit.
+TEST(RingShape, SqueezedRingsOpeningFollowsItsWalls) {
+  EXPECT_NEAR(shape_of(test::ellipse_ring(0.6, 0.15)).opening, 2 * (0.6 - 0.15), 0.01);
+  EXPECT_NEAR(shape_of(test::stadium_ring(0.3, 0.15)).opening, 0.3, 0.005);
+  EXPECT_NEAR(shape_of(test::stadium_ring(0.16, 0.15)).opening, 0.02, 0.015);
+  // 16 sections: the walls touch along the sides, small pockets stay at the ends.
+  const RingShape coarse = shape_of(test::stadium_ring(0.16, 0.15, 16, 4));
+  EXPECT_LT(coarse.opening, 0.5 * coarse.wire);
+  // Planar outlines, however squeezed, are not folded.
+  EXPECT_NEAR(shape_of(test::stadium_ring(0.16, 0.15)).fold, 0.0, 1e-6);
+}
+
+// Bent: the angle between the halves' planes grows from a gentle cylinder to an edge.
+TEST(RingShape, FoldIsTheTurnBetweenTheRingsHalves) {
+  const TriMesh ring = test::torus(1.0, 0.15, 48, 12);
+  const auto over_cylinder = [&](double rho) {
+    return shape_of(
+        test::mapped(ring, [rho](const Vector3d& p) { return test::over_cylinder(p, rho); }));
+  };
+  const auto over_edge = [&](double shift) {
+    return shape_of(test::mapped(ring, [shift](const Vector3d& p) {
+      return test::over_edge(p + Vector3d(shift, 0, 0), 0.2);
+    }));
+  };
+  const double deg = M_PI / 180;
+  EXPECT_LT(over_cylinder(10).fold, 8 * deg);
+  EXPECT_NEAR(over_cylinder(2).fold, 29 * deg, 2 * deg);
+  EXPECT_GT(over_cylinder(1).fold, over_cylinder(2).fold);
+  EXPECT_NEAR(over_edge(0).fold, 75 * deg, 3 * deg) << "folded through its middle";
+  EXPECT_LT(over_edge(0.7).fold, over_edge(0.5).fold) << "less of it beyond the edge";
+  // The hole stays open when bent: folding is a cause of its own.
+  EXPECT_GT(over_edge(0).opening, 3 * over_edge(0).wire);
+}
+
+TEST(RingShape, ShortLoopThrows) {
+  const TriMesh ring = test::torus(1.0, 0.15, 16, 4);
+  EXPECT_THROW(ring_shape(ring.V, ring.F, Loop(3, Vector3d::Zero())), InvalidInput);
 }
 
 }  // namespace

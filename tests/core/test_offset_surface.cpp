@@ -88,6 +88,13 @@ TEST(OffsetSurface, CupBaseFoldIsReported) {
   } catch (const TopologyError& e) {
     EXPECT_NE(std::string(e.what()).find("vertex 5099"), std::string::npos) << e.what();
   }
+  // Without the throw: the folded vertices and their faces.
+  OffsetSurface out;
+  OffsetFailure failure;
+  EXPECT_FALSE(try_offset_surface(base.V, base.F, opt, out, failure));
+  EXPECT_TRUE(failure.fold);
+  EXPECT_TRUE(std::binary_search(failure.vertices.begin(), failure.vertices.end(), 5099));
+  EXPECT_FALSE(failure.faces.empty());
 }
 
 TEST(OffsetSurface, ConcaveFoldIsLoweredConvexSideIsNot) {
@@ -172,6 +179,19 @@ TEST(OffsetSurface, ImpossibleShellThrows) {
   opt.smoothing_iterations = 0;
   opt.min_fraction = 0.9;
   EXPECT_THROW(offset_surface(g.V, g.F, opt), TopologyError);
+  // Without the throw: where (the offending prisms, here on both walls), and why.
+  OffsetSurface out;
+  OffsetFailure failure;
+  EXPECT_FALSE(try_offset_surface(g.V, g.F, opt, out, failure));
+  EXPECT_FALSE(failure.fold);
+  EXPECT_NE(failure.reason.find("cannot make a valid shell"), std::string::npos);
+  ASSERT_FALSE(failure.faces.empty());
+  ASSERT_FALSE(failure.vertices.empty());
+  EXPECT_TRUE(std::is_sorted(failure.faces.begin(), failure.faces.end()));
+  // A valid shell: true, nothing reported.
+  const TriMesh flat = test::plane_grid(4.0, 1.0, 16, 4);
+  EXPECT_TRUE(try_offset_surface(flat.V, flat.F, opt, out, failure));
+  EXPECT_TRUE(failure.faces.empty() && failure.reason.empty());
 }
 
 TEST(OffsetSurface, InvalidInputThrows) {

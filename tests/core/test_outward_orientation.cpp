@@ -20,6 +20,12 @@ double signed_volume(const TriMesh& m) {
   return v;
 }
 
+std::vector<int> all_faces(const TriMesh& m) {
+  std::vector<int> f(static_cast<size_t>(m.num_faces()));
+  for (size_t i = 0; i < f.size(); ++i) f[i] = static_cast<int>(i);
+  return f;
+}
+
 TriMesh flipped(TriMesh m) {
   for (int f = 0; f < m.num_faces(); ++f) std::swap(m.F(f, 1), m.F(f, 2));
   return m;
@@ -62,6 +68,36 @@ TEST(OutwardOrientation, TheIvyWallsBoxesFaceOutwardAfterwards) {
   int outward = 0;
   for (const auto& g : groups) outward += signed_volume(extract_faces(wall, g)) > 0;
   EXPECT_EQ(outward, n);
+}
+
+TEST(OutwardOrientation, OpenSurfacesByTheirWindingNumber) {
+  // An open tube facing outward stays; facing inward it turns (rays from its faces escaped
+  // through the open ends, so ray parity could not tell).
+  TriMesh tube = test::open_cylinder(1.0, 3.0, 48, 12);
+  const TriMesh out = tube;
+  EXPECT_GT(mean_surface_winding(tube.V, tube.F, all_faces(tube)), 0.1);
+  EXPECT_EQ(orient_outward(tube), 0);
+  TriMesh in = flipped(tube);
+  EXPECT_LT(mean_surface_winding(in.V, in.F, all_faces(in)), -0.1);
+  EXPECT_EQ(orient_outward(in), 1);
+  EXPECT_TRUE(in.F == out.F);
+  // A flat plane either way: no inside, left alone.
+  TriMesh plane = test::plane_grid(3, 2, 12, 8), back = flipped(plane);
+  EXPECT_NEAR(mean_surface_winding(plane.V, plane.F, all_faces(plane)), 0, 1e-12);
+  EXPECT_EQ(orient_outward(plane), 0);
+  EXPECT_EQ(orient_outward(back), 0);
+}
+
+TEST(OutwardOrientation, TheOpenQuadrupedStaysAndTurnsWhenGivenInsideOut) {
+  // Headless Blender's quadruped: legs and tail end in open loops, faces outward.
+  const TriMesh quadruped = read_mesh(test::blender_base("quadruped_open.obj"));
+  TriMesh as_given = quadruped;
+  EXPECT_EQ(orient_outward(as_given), 0);
+  EXPECT_TRUE(as_given.F == quadruped.F);
+  TriMesh inside_out = flipped(quadruped);
+  EXPECT_EQ(orient_outward(inside_out), 1);
+  EXPECT_TRUE(inside_out.F == quadruped.F);
+  EXPECT_GT(signed_volume(inside_out), 0);
 }
 
 }  // namespace

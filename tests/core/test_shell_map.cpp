@@ -284,12 +284,18 @@ TEST(ShellMap, CupFoldIsRepairedLocally) {
   EXPECT_FALSE(folded_faces(base.V, base.F).empty());
   ShellMapOptions o = options_for(base);
   o.repair_folds = false;
+  o.exclude_regions = false;
   EXPECT_THROW(ShellMap(base.V, base.F, o), TopologyError);
   o.repair_folds = true;
   const ShellMap map(base.V, base.F, o);
   const FoldRepair& r = map.fold_repair();
   EXPECT_FALSE(r.folded_faces.empty());
   EXPECT_LT(r.moved_vertices.size(), 200u);
+  // Repaired within the bounds: the whole base keeps its shell.
+  EXPECT_TRUE(map.exclusion().faces.empty());
+  EXPECT_LE(r.max_above, o.repair_max_above * o.height * (1 + 1e-9));
+  EXPECT_LE(r.max_below, o.repair_max_below * o.height * (1 + 1e-9));
+  EXPECT_LE(r.max_displacement, o.repair_max_shift * o.height * (1 + 1e-9));
   EXPECT_TRUE(std::binary_search(r.moved_vertices.begin(), r.moved_vertices.end(), 5099));
   EXPECT_TRUE(folded_faces(map.base_vertices(), map.faces()).empty());
   std::printf(
@@ -297,6 +303,78 @@ TEST(ShellMap, CupFoldIsRepairedLocally) {
       "diagonal\n",
       r.folded_faces.size(), r.moved_vertices.size(),
       100 * r.max_displacement / test::bbox_diagonal(base));
+}
+
+// A flat 1 x 1 grid of 10 x 10 squares with its middle vertex pushed `by` along x: past its
+// neighbour (0.1 away) its star folds over itself.
+TriMesh pushed_grid(double by) {
+  TriMesh g = test::plane_grid(1, 1, 10, 10);
+  for (int v = 0; v < g.num_vertices(); ++v)
+    if ((g.V.row(v) - Vector3d(0.5, 0.5, 0).transpose()).norm() < 1e-9) g.V(v, 0) += by;
+  return g;
+}
+
+TEST(ShellMap, FoldTheBoundedRepairCannotUndoIsLeftOut) {
+  // Pushed 0.05 past its neighbour, under a shell 0.02 high: the repair may move it by 0.02.
+  const TriMesh g = pushed_grid(0.15);
+  ShellMapOptions o;
+  o.height = 0.02;
+  const ShellMap map(g.V, g.F, o);
+  const ShellExclusion& e = map.exclusion();
+  ASSERT_FALSE(e.faces.empty());
+  EXPECT_GT(e.fold_faces, 0);
+  EXPECT_GT(e.area_share, 0);
+  EXPECT_LT(e.area_share, 0.1);
+  EXPECT_NE(e.reason.find("no direction above"), std::string::npos) << e.reason;
+  // The shell's faces are the others, in input order, and the map is valid over them.
+  ASSERT_EQ(map.faces().rows() + static_cast<Eigen::Index>(e.faces.size()), g.F.rows());
+  for (int i = 0; i < map.faces().rows(); ++i) {
+    const int f = map.input_faces()[static_cast<size_t>(i)];
+    EXPECT_EQ(map.shell_face(f), i);
+    EXPECT_TRUE(map.faces().row(i) == g.F.row(f));
+  }
+  for (const int f : e.faces) EXPECT_EQ(map.shell_face(f), -1);
+  EXPECT_TRUE(std::isfinite(map.stretch()));
+  // The faces far from the fold are in the shell; a point over one is embedded at its height.
+  LocalCoordinates p;
+  p.face = Eigen::VectorXi::Constant(1, map.shell_face(0));
+  p.bary = MatrixX3d::Constant(1, 3, 1.0 / 3.0);
+  p.height = Eigen::VectorXd::Constant(1, 0.01);
+  EXPECT_NEAR(ShellEmbedding(map).embed(p)(0, 2), 0.01, 1e-9);
+  // Refused when regions may not be left out, or when they would be too large.
+  o.exclude_regions = false;
+  EXPECT_THROW(ShellMap(g.V, g.F, o), TopologyError);
+  o.exclude_regions = true;
+  o.max_excluded_share = 0.001;
+  EXPECT_THROW(ShellMap(g.V, g.F, o), TopologyError);
+}
+
+TEST(ShellMap, PartsAHairApartAreLeftOutOfTheShell) {
+  // Two unit cubes 0.01 apart under a shell 0.1 high: their shells clash even at the height
+  // floor (0.01 + 0.01 > 0.01). The facing sides are left out; the rest keeps its shell.
+  TriMesh two = test::midpoint_split(test::midpoint_split(test::unit_cube()));
+  TriMesh other = two;
+  other.V.col(0).array() += 1.01;
+  append_mesh(two, other);
+  ShellMapOptions o;
+  o.height = 0.1;
+  const ShellMap map(two.V, two.F, o);
+  const ShellExclusion& e = map.exclusion();
+  ASSERT_FALSE(e.faces.empty());
+  EXPECT_EQ(e.fold_faces, 0);
+  EXPECT_NE(e.reason.find("cannot make a valid shell"), std::string::npos) << e.reason;
+  EXPECT_LT(e.area_share, 0.4);  // the facing sides are 1/6 of it; the corners' clash more
+  // The facing sides (x = 1 and x = 1.01) are among those left out, the far ones are not.
+  for (int f = 0; f < two.F.rows(); ++f) {
+    const Vector3d c =
+        (two.V.row(two.F(f, 0)) + two.V.row(two.F(f, 1)) + two.V.row(two.F(f, 2))).transpose() / 3;
+    if (std::abs(c.x() - 1) < 1e-9 || std::abs(c.x() - 1.01) < 1e-9) {
+      EXPECT_EQ(map.shell_face(f), -1) << f;
+    }
+    if (std::abs(c.x()) < 1e-9 || std::abs(c.x() - 2.01) < 1e-9) {
+      EXPECT_GE(map.shell_face(f), 0) << f;
+    }
+  }
 }
 
 TEST(ShellMap, IndependentOfThreadCount) {

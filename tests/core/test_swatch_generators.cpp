@@ -4,11 +4,14 @@
 #include <cmath>
 #include <vector>
 
+#include "core/element_kinds.h"
 #include "core/errors.h"
 #include "core/geometry_measures.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
+#include "core/planar_quilting.h"
 #include "core/swatch_generators.h"
+#include "core/swatch_symmetry.h"
 
 namespace mq {
 namespace {
@@ -70,7 +73,9 @@ int disc_crossings(const Circle& a, const Circle& b) {
   int crossings = 0;
   const int N = 720;
   for (int i = 0; i < N; ++i) {
-    const double t0 = 2 * M_PI * i / N, t1 = 2 * M_PI * (i + 1) / N;
+    // Samples a quarter step off the axes: a crossing exactly at a sample (an upright ring's
+    // lowest point on the sheet's plane) would otherwise be lost to sin(2 pi) != 0.
+    const double t0 = 2 * M_PI * (i + 0.25) / N, t1 = 2 * M_PI * (i + 1.25) / N;
     const Vector3d p = b.c + b.R * (std::cos(t0) * b.e1 + std::sin(t0) * b.e2);
     const Vector3d q = b.c + b.R * (std::cos(t1) * b.e1 + std::sin(t1) * b.e2);
     const double dp = n.dot(p - a.c), dq = n.dot(q - a.c);
@@ -143,6 +148,102 @@ TEST(SwatchGenerators, ChainMailRejectsBadOptions) {
   o = {};
   o.ring_segments = 2;
   EXPECT_THROW(chainmail_4in1(o), InvalidInput);
+}
+
+// The square 4-in-1 sheet: closed, disjoint rings (at the thickest wire allowed too); each
+// connector threaded through exactly the two flat rings it joins and nothing else; flat rings
+// linked to no flat ring; a periodic lattice of separate elements with a half turn, so that
+// surface --method auto takes the global layout.
+TEST(SwatchGenerators, SquareMailConnectorsJoinTwoFlatRingsEach) {
+  for (const double wire : {0.12, 0.15}) {
+    SCOPED_TRACE(testing::Message() << "wire " << wire);
+    SquareMailOptions o;
+    o.rows = 3;
+    o.cols = 4;
+    o.wire_radius = wire;
+    o.ring_segments = 32;
+    o.wire_segments = 8;
+    const TriMesh mail = chainmail_square(o);
+    check_placement(mail);
+    const auto rings = check_elements(mail);
+    const int flat = o.rows * o.cols;
+    const int connectors = (o.rows - 1) * o.cols + o.rows * (o.cols - 1);
+    ASSERT_EQ(static_cast<int>(rings.size()), flat + connectors);
+    EXPECT_TRUE(intersecting_face_pairs(mail.V, mail.F).empty());
+    ASSERT_EQ(mail.kinds, (std::vector<std::string>{"ring", "connector"}));
+    std::vector<int> fc;
+    connected_components(mail.F, mail.num_vertices(), fc);
+    const std::vector<int> kind = component_kinds(mail, fc, flat + connectors);
+    std::vector<Circle> circles;
+    for (const auto& r : rings) circles.push_back(fit_circle(r));
+    for (int e = 0; e < flat + connectors; ++e) {
+      EXPECT_EQ(kind[e], e < flat ? 0 : 1) << e;
+      EXPECT_NEAR(circles[e].R, e < flat ? 1.0 : 0.6, 1e-2) << e;
+      // Flat rings lie in the sheet's plane, connectors stand upright.
+      EXPECT_NEAR(std::abs(circles[e].e1.cross(circles[e].e2).z()), e < flat ? 1.0 : 0.0, 1e-6);
+    }
+    // Grid position of a flat ring (c, k): index k * cols + c.
+    const double pitch = chainmail_square_period(o);
+    EXPECT_DOUBLE_EQ(pitch, 2.5);
+    const Vector3d origin = circles[0].c;
+    std::vector<int> links(static_cast<size_t>(flat), 0);
+    for (int a = flat; a < flat + connectors; ++a) {
+      int partners = 0;
+      for (int b = 0; b < flat + connectors; ++b) {
+        if (b == a) continue;
+        const bool linked = disc_crossings(circles[b], circles[a]) % 2 == 1;
+        if (b >= flat) {
+          EXPECT_FALSE(linked) << "connectors " << a << ", " << b;
+          continue;
+        }
+        // Linked exactly to the flat rings half a pitch away.
+        const double d = ((circles[a].c - origin) - (circles[b].c - origin)).head<2>().norm();
+        EXPECT_EQ(linked, std::abs(d - 0.5 * pitch) < 1e-6) << a << " " << b;
+        partners += linked;
+        links[static_cast<size_t>(b)] += linked;
+      }
+      EXPECT_EQ(partners, 2) << "connector " << a;
+    }
+    for (int a = 0; a < flat; ++a) {
+      const int c = a % o.cols, k = a / o.cols;
+      const int expected = (c > 0) + (c + 1 < o.cols) + (k > 0) + (k + 1 < o.rows);
+      EXPECT_EQ(links[static_cast<size_t>(a)], expected) << "flat ring " << a;
+      for (int b = a + 1; b < flat; ++b) EXPECT_EQ(disc_crossings(circles[a], circles[b]), 0);
+    }
+  }
+  // A lattice of separate elements (one flat ring and two connectors per cell), half-turn
+  // symmetric: what the global layout needs.
+  SquareMailOptions o;
+  o.rows = o.cols = 3;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  const PreparedSwatch swatch = prepare_swatch(chainmail_square(o));
+  const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
+  const SwatchSymmetry sym = detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch));
+  ASSERT_TRUE(sym.periodic);
+  EXPECT_NEAR(std::abs(sym.a.x() * sym.b.y() - sym.a.y() * sym.b.x()), 2.5 * 2.5, 1e-3);
+  EXPECT_NEAR(std::min(sym.a.norm(), sym.b.norm()), 2.5, 1e-3);
+  EXPECT_TRUE(sym.half_turn);
+  EXPECT_TRUE(repeating_elements(swatch));
+  EXPECT_TRUE(tileable(swatch, sym));
+  int orbits = 0;
+  tile_lattice(swatch, sym, Vector2d::Zero(), Vector2d(10, 10), &orbits);
+  EXPECT_EQ(orbits, 3);
+}
+
+TEST(SwatchGenerators, SquareMailRejectsBadOptions) {
+  SquareMailOptions o;
+  o.wire_radius = 0.16;
+  EXPECT_THROW(chainmail_square(o), InvalidInput);
+  o = {};
+  o.cols = 0;
+  EXPECT_THROW(chainmail_square(o), InvalidInput);
+  o = {};
+  o.wire_segments = 2;
+  EXPECT_THROW(chainmail_square(o), InvalidInput);
+  o = {};
+  o.ring_radius = 0;
+  EXPECT_THROW(chainmail_square_period(o), InvalidInput);
 }
 
 TEST(SwatchGenerators, WeaveThreadsClosedDisjointAndAlternating) {

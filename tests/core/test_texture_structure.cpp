@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 
+#include "core/element_kinds.h"
 #include "core/mesh_intersections.h"
 #include "core/mesh_topology.h"
 #include "core/swatch_generators.h"
 #include "core/texture_structure.h"
+#include "tests/core/ring_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -115,39 +119,288 @@ TEST(TextureStructure, RingsMissingFromASheetLowerTheShareAndTheDensity) {
   EXPECT_NEAR(ch.linear_scale, 1.0, 1e-9);
 }
 
-// A ring the map stretched is counted against the swatch's element size at the output's
-// scale: one ring of a sheet stretched 2x along x, the sheet itself scaled by 3.
-TEST(TextureStructure, StretchedElementsAreCountedAgainstTheSwatchSize) {
+// The same mesh with its faces in another order: its vertices, numbered by first use, no longer
+// follow any swatch element's.
+TriMesh reordered(const TriMesh& m) {
+  const int n = m.num_faces();
+  TriMesh out = m;
+  for (int f = 0; f < n; ++f) out.F.row((f * 7 + 3) % n) = m.F.row(f);  // n is even, 7 odd
+  return out;
+}
+
+// Shapes are judged against the swatch element at the output's scale: a sheet turned, moved and
+// scaled by 3 is all copies of size 1 and aspect 1; one ring stretched 2x along x has size
+// sqrt(2), aspect 2 and stretch 2, by its vertex correspondence and, renumbered, by its principal
+// extents; a ring shrunk to 0.8 has size 0.8 and aspect 1.
+TEST(TextureStructure, ShapeFiguresAgainstTheSwatchElementAtTheOutputScale) {
   ChainMailOptions o;
   o.rows = 6;
   o.cols = 6;
   const TriMesh sheet = chainmail_4in1(o);
   const SwatchStructure s = measure_swatch_structure(sheet);
-  TriMesh out = moved(sheet, 3.0 * Eigen::Matrix3d::Identity(), Vector3d::Zero());
-  const StructureComparison plain = compare_structure(measure_structure(out), s, 3.0);
+  ASSERT_EQ(s.kinds.size(), 1u);
+  EXPECT_EQ(s.kinds[0].shapes.size(), 1u) << "the sheet's rings are one shape up to rotation";
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const TriMesh out = moved(sheet, 3.0 * R, Vector3d(5, -2, 1));
+  StructureOptions so;
+  so.swatch = &s;
+  so.linear_scale = 3.0;
+  const StructureComparison plain = compare_structure(measure_structure(out, so), s);
+  EXPECT_EQ(plain.shape.elements, 36);
+  EXPECT_EQ(plain.shape.by_correspondence, 36);
+  EXPECT_NEAR(plain.shape.size_median, 1.0, 1e-9);
+  EXPECT_NEAR(plain.shape.size_max, 1.0, 1e-9);
+  EXPECT_NEAR(plain.shape.aspect_max, 1.0, 1e-9);
   EXPECT_EQ(plain.stretched, 0);
-  EXPECT_NEAR(plain.largest_size, 1.0, 0.02);  // every ring has the swatch's size
+  EXPECT_NEAR(plain.largest_stretch, 1.0, 1e-9);
+  EXPECT_NEAR(plain.linear_scale, 3.0, 1e-12);
+
   std::vector<int> fc;
-  const int n = connected_components(out.F, out.num_vertices(), fc);
+  const int n = connected_components(sheet.F, sheet.num_vertices(), fc);
   const auto groups = component_faces(fc, n);
-  TriMesh ring = extract_faces(out, groups[14]);
-  const double cx = ring.V.col(0).mean();
-  ring.V.col(0) = ((ring.V.col(0).array() - cx) * 2.0 + cx).matrix();
-  std::vector<int> others;
-  for (int c = 0; c < n; ++c)
-    if (c != 14) others.insert(others.end(), groups[c].begin(), groups[c].end());
-  out = extract_faces(out, others);
-  append_mesh(out, ring);
-  const StructureComparison one = compare_structure(measure_structure(out), s, 3.0);
-  EXPECT_EQ(one.stretched, 1);
-  EXPECT_GT(one.largest_size, 1.7);
-  EXPECT_LT(one.largest_size, 2.05);
-  // Threads are not compact elements: a weave reports no stretch.
+  const auto with_ring = [&](const std::function<TriMesh(TriMesh)>& change) {
+    TriMesh ring = change(extract_faces(sheet, groups[14]));
+    std::vector<int> others;
+    for (int c = 0; c < n; ++c)
+      if (c != 14) others.insert(others.end(), groups[c].begin(), groups[c].end());
+    TriMesh m = extract_faces(sheet, others);
+    append_mesh(m, ring);
+    set_single_kind(m, "ring");
+    return moved(m, 3.0 * Eigen::Matrix3d::Identity(), Vector3d::Zero());
+  };
+  const auto stretch_x = [](TriMesh ring) {
+    const double cx = ring.V.col(0).mean();
+    ring.V.col(0) = ((ring.V.col(0).array() - cx) * 2.0 + cx).matrix();
+    return ring;
+  };
+  for (const bool copy : {true, false}) {
+    SCOPED_TRACE(copy ? "by correspondence" : "by principal extents");
+    const StructureReport r =
+        measure_structure(with_ring([&](TriMesh ring) {
+                            return copy ? stretch_x(ring) : reordered(stretch_x(ring));
+                          }),
+                          so);
+    const ElementStructure& e = r.elements.back();
+    EXPECT_EQ(e.by_correspondence, copy);
+    EXPECT_NEAR(e.size_ratio, std::sqrt(2.0), copy ? 1e-9 : 0.02);
+    EXPECT_NEAR(e.aspect, 2.0, copy ? 1e-9 : 0.04);
+    EXPECT_NEAR(e.stretch, 2.0, copy ? 1e-9 : 0.04);
+    const StructureComparison c = compare_structure(r, s);
+    EXPECT_EQ(c.stretched, 1);
+    EXPECT_NEAR(c.largest_stretch, 2.0, copy ? 1e-9 : 0.04);
+    EXPECT_NEAR(c.shape.size_max, std::sqrt(2.0), copy ? 1e-9 : 0.02);
+    EXPECT_NEAR(c.shape.size_median, 1.0, 1e-9);
+    EXPECT_NEAR(c.shape.aspect_median, 1.0, 1e-9);
+  }
+  const StructureReport small = measure_structure(
+      with_ring([](TriMesh ring) {
+        const Vector3d c = ring.V.colwise().mean().transpose();
+        ring.V = ((ring.V.rowwise() - c.transpose()) * 0.8).rowwise() + c.transpose();
+        return ring;
+      }),
+      so);
+  EXPECT_NEAR(small.elements.back().size_ratio, 0.8, 1e-9);
+  EXPECT_NEAR(small.elements.back().aspect, 1.0, 1e-9);
+  EXPECT_NEAR(compare_structure(small, s).shape.size_p99, 1.0, 1e-9) << "one of 36: under the 99th";
+  // Without the scale it is estimated from the median areas: the copies still measure 1.
+  so.linear_scale = 0;
+  EXPECT_NEAR(compare_structure(measure_structure(out, so), s).shape.size_median, 1.0, 1e-6);
+  // Threads are not compact elements: a weave has no shape figures.
   const TriMesh weave = plain_weave();
-  const StructureComparison w =
-      compare_structure(measure_structure(weave), measure_swatch_structure(weave), 1.0);
+  const SwatchStructure ws = measure_swatch_structure(weave);
+  StructureOptions wo;
+  wo.swatch = &ws;
+  const StructureComparison w = compare_structure(measure_structure(weave, wo), ws, 1.0);
+  EXPECT_EQ(w.shape.elements, 0);
   EXPECT_EQ(w.stretched, 0);
-  EXPECT_EQ(w.largest_size, 0.0);
+}
+
+// Ring T (flat, xy plane, at the origin) between two rings in the xz plane threaded through its
+// hole at x = +-0.6 (a piece of chain), with T changed by `shape` (T's own coordinates).
+TriMesh chain_through(const TriMesh& t) {
+  const TriMesh ring = test::torus(1.0, 0.15, 48, 12);
+  const Eigen::Matrix3d up = Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitX()).toRotationMatrix();
+  TriMesh out = moved(ring, up, Vector3d(-1.6, 0, 0));
+  append_mesh(out, t);
+  append_mesh(out, moved(ring, up, Vector3d(1.6, 0, 0)));
+  return out;
+}
+
+// The same map with x and y exchanged: bends along x (through the partners' crossings) rather
+// than across.
+std::function<Vector3d(const Vector3d&)> along_x(std::function<Vector3d(const Vector3d&)> f) {
+  return [f](const Vector3d& p) {
+    const Vector3d q = f(Vector3d(p.y(), p.x(), p.z()));
+    return Vector3d(q.y(), q.x(), q.z());
+  };
+}
+
+// Issue 23: a ring squeezed until its hole closes, or folded over an edge into a C, keeps a centre
+// loop its partners' loops pass through, but it is degenerate: a miss, linking nothing, so its
+// partners lose that link. Mildly squeezed, or bent gently over a cylinder, it stays linked.
+TEST(TextureStructure, DegenerateRingsAreMissesAndLinkNothing) {
+  const TriMesh torus = test::torus(1.0, 0.15, 48, 12);
+  struct Case {
+    const char* name;
+    TriMesh ring;
+    RingDefect defect;
+  };
+  const std::vector<Case> cases = {
+      {"flat", torus, RingDefect::None},
+      {"squeezed mildly (ellipse 1 x 0.6)", test::ellipse_ring(0.6, 0.15), RingDefect::None},
+      {"squeezed shut (sides 0.32 apart)", test::stadium_ring(0.16, 0.15), RingDefect::NoHole},
+      {"bent over a cylinder of 10 radii",
+       test::mapped(torus, along_x([](const Vector3d& p) { return test::over_cylinder(p, 10); })),
+       RingDefect::None},
+      {"bent over a right-angled edge into a C",
+       test::mapped(torus, along_x([](const Vector3d& p) { return test::over_edge(p, 0.2); })),
+       RingDefect::Folded},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    StructureOptions so;
+    so.interior_margin = 1e-9;  // a closed piece of chain: every ring judged
+    so.automatic_border = false;
+    const StructureReport r = measure_structure(chain_through(c.ring), so);
+    ASSERT_EQ(r.rings, 3);
+    const ElementStructure& t = r.elements[1];
+    EXPECT_EQ(t.defect, c.defect);
+    EXPECT_EQ(t.loop_links, 2) << "its centre loop is threaded by both partners";
+    EXPECT_EQ(r.loop_linked_pairs, 2);
+    const bool degenerate = c.defect != RingDefect::None;
+    EXPECT_EQ(t.links, degenerate ? 0 : 2);
+    EXPECT_EQ(r.elements[0].links, degenerate ? 0 : 1);
+    EXPECT_EQ(r.elements[2].links, degenerate ? 0 : 1);
+    EXPECT_EQ(r.linked_pairs.size(), degenerate ? 0u : 2u);
+    EXPECT_EQ(r.isolated_rings, degenerate ? 3 : 0);
+    EXPECT_EQ(r.degenerate_rings(), degenerate ? 1 : 0);
+    EXPECT_EQ(r.defects[static_cast<size_t>(c.defect)], degenerate ? 1 : 3);
+    // Histograms hold the rings that are not degenerate; the share counts degenerate as misses.
+    int counted = 0;
+    for (const int h : r.interior_link_histogram) counted += h;
+    EXPECT_EQ(counted + r.interior_degenerate(), r.interior_rings);
+    EXPECT_NEAR(r.share_with_links(2), degenerate ? 0.0 : 1.0 / 3, 1e-12);
+  }
+}
+
+// A ring of a ring kind that is not ring-shaped (torn open) is a degenerate ring, not a thread:
+// its partners lose their link to it, and the kind says so whether the mesh names kinds or not.
+TEST(TextureStructure, TornRingOfARingKindIsADegenerateRing) {
+  ChainMailOptions o;
+  o.rows = o.cols = 6;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  const TriMesh sheet = chainmail_4in1(o);
+  std::vector<int> fc;
+  const int n = connected_components(sheet.F, sheet.num_vertices(), fc);
+  const auto groups = component_faces(fc, n);
+  std::vector<int> keep;
+  for (int c = 0; c < n; ++c)
+    for (size_t k = 0; k < groups[c].size(); ++k)
+      if (c != 14 || k % 8 != 0)
+        keep.push_back(groups[c][k]);  // ring 14 loses an eighth of its faces
+  TriMesh torn = extract_faces(sheet, keep);
+  const StructureReport full = measure_structure(sheet);
+  for (const bool named : {true, false}) {
+    SCOPED_TRACE(named ? "kinds named" : "no kinds");
+    if (!named) {
+      torn.kinds.clear();
+      torn.face_kind.clear();
+    }
+    const StructureReport r = measure_structure(torn);
+    std::vector<int> tc;
+    connected_components(torn.F, torn.num_vertices(), tc);
+    int element = -1;
+    for (size_t f = 0; f < keep.size(); ++f)
+      if (fc[keep[f]] == 14) element = tc[f];
+    ASSERT_GE(element, 0);
+    const ElementStructure& e = r.elements[static_cast<size_t>(element)];
+    EXPECT_TRUE(e.ring);
+    EXPECT_FALSE(e.ring_shaped);
+    EXPECT_FALSE(e.long_element);
+    EXPECT_EQ(e.defect, RingDefect::NotRing);
+    EXPECT_EQ(r.rings, 36);
+    EXPECT_EQ(r.long_elements, 0);
+    EXPECT_EQ(r.defects[static_cast<size_t>(RingDefect::NotRing)], 1);
+    // Its partners each lost that one link.
+    EXPECT_EQ(static_cast<int>(r.linked_pairs.size()),
+              static_cast<int>(full.linked_pairs.size()) - full.elements[14].links);
+  }
+}
+
+// The square 4-in-1 sheet: flat rings hold 4 connectors, connectors 2 flat rings. Judged per
+// kind it keeps all of its structure against itself; a single count (4) would call every
+// connector a miss. An output without kind names is matched by its elements' shapes.
+TEST(TextureStructure, TwoRingKindsAreJudgedEachByItsOwnCount) {
+  SquareMailOptions o;
+  o.rows = o.cols = 7;
+  o.ring_segments = 24;
+  o.wire_segments = 6;
+  const TriMesh sheet = chainmail_square(o);
+  const SwatchStructure s = measure_swatch_structure(sheet);
+  ASSERT_EQ(s.kinds.size(), 2u);
+  EXPECT_EQ(s.kinds[0].name, "ring");
+  EXPECT_EQ(s.kinds[1].name, "connector");
+  EXPECT_TRUE(s.kinds[0].ring && s.kinds[1].ring);
+  EXPECT_EQ(s.kinds[0].interior_links, 4);
+  EXPECT_EQ(s.kinds[1].interior_links, 2);
+  EXPECT_EQ(s.ring_kinds(), 2);
+  for (const bool named : {true, false}) {
+    SCOPED_TRACE(named ? "kinds named" : "no kinds");
+    TriMesh out = moved(sheet, 2.0 * Eigen::Matrix3d::Identity(), Vector3d(3, 1, 0));
+    if (!named) {
+      out.kinds.clear();
+      out.face_kind.clear();
+    }
+    StructureOptions so;
+    so.swatch = &s;
+    const StructureReport r = measure_structure(out, so);
+    const StructureComparison c = compare_structure(r, s);
+    ASSERT_GT(r.interior_rings, 10);
+    EXPECT_EQ(c.share_matching, 1.0);
+    ASSERT_EQ(c.kinds.size(), 2u);
+    EXPECT_EQ(c.kinds[0].kind, "ring");
+    EXPECT_EQ(c.kinds[0].interior_links, 4);
+    EXPECT_EQ(c.kinds[0].share, 1.0);
+    EXPECT_EQ(c.kinds[1].kind, "connector");
+    EXPECT_EQ(c.kinds[1].interior_links, 2);
+    EXPECT_EQ(c.kinds[1].share, 1.0);
+    EXPECT_EQ(c.kinds[0].interior_rings + c.kinds[1].interior_rings, r.interior_rings);
+    // Against the one count of 4 only the flat rings would match.
+    EXPECT_EQ(r.share_with_links(4),
+              static_cast<double>(c.kinds[0].interior_rings) / r.interior_rings);
+    EXPECT_NEAR(c.shape.size_max, 1.0, 1e-9);
+  }
+}
+
+// Every figure is the same whatever the thread count.
+TEST(TextureStructure, SameFiguresWhateverTheThreadCount) {
+  SquareMailOptions o;
+  o.rows = o.cols = 4;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  const TriMesh sheet = chainmail_square(o);
+  const SwatchStructure s = measure_swatch_structure(sheet);
+  TriMesh out = test::mapped(sheet, [](const Vector3d& p) { return test::over_cylinder(p, 6); });
+  StructureOptions so;
+  so.swatch = &s;
+  std::vector<StructureReport> r;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    r.push_back(measure_structure(out, so));
+  }
+  ASSERT_EQ(r[0].elements.size(), r[1].elements.size());
+  EXPECT_EQ(r[0].linked_pairs, r[1].linked_pairs);
+  for (size_t e = 0; e < r[0].elements.size(); ++e) {
+    const ElementStructure &a = r[0].elements[e], &b = r[1].elements[e];
+    EXPECT_EQ(a.links, b.links);
+    EXPECT_EQ(a.defect, b.defect);
+    EXPECT_EQ(a.opening, b.opening);
+    EXPECT_EQ(a.fold, b.fold);
+    EXPECT_EQ(a.size_ratio, b.size_ratio);
+    EXPECT_EQ(a.aspect, b.aspect);
+  }
 }
 
 TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
@@ -194,6 +447,83 @@ TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
   const StructureReport apples = measure_structure(apple_layer({}));
   EXPECT_EQ(apples.long_elements, 0);
   EXPECT_EQ(apples.rings, 0);
+}
+
+// Vines in swatch-sized pieces measure 1 swatch vine; a section three times as long with three
+// times the leaves measures about 3, at the swatch's leaves per length; one of its leaves
+// taken away shows in that ratio.
+TEST(TextureStructure, VineLengthsAreMeasuredInSwatchVines) {
+  IvyOptions o;
+  o.length = 2;
+  o.leaves = 2;
+  const TriMesh swatch = ivy_section(o);
+  const SwatchStructure ref = measure_swatch_structure(swatch);
+  EXPECT_EQ(ref.report.long_elements, 1);
+  EXPECT_EQ(ref.report.compact_elements, 2);
+  EXPECT_GT(ref.report.median_long_length, 2.0);  // along its wave
+  const StructureComparison same = compare_structure(ref.report, ref, 1.0);
+  EXPECT_DOUBLE_EQ(same.long_length_ratio, 1.0);
+  EXPECT_DOUBLE_EQ(same.compact_per_length_ratio, 1.0);
+  o.length = 6;
+  o.leaves = 6;
+  const TriMesh longer = ivy_section(o);
+  const StructureComparison three = compare_structure(measure_structure(longer), ref, 1.0);
+  EXPECT_NEAR(three.long_length_ratio, 3.0, 0.3);
+  EXPECT_NEAR(three.compact_per_length_ratio, 1.0, 0.1);
+  o.leaves = 5;
+  const StructureComparison fewer = compare_structure(measure_structure(ivy_section(o)), ref, 1.0);
+  EXPECT_NEAR(fewer.compact_per_length_ratio / three.compact_per_length_ratio, 5.0 / 6, 0.02);
+  // Twice the size, measured at that scale: the same figures.
+  TriMesh big = longer;
+  big.V *= 2;
+  const StructureComparison scaled = compare_structure(measure_structure(big), ref, 2.0);
+  EXPECT_NEAR(scaled.long_length_ratio, three.long_length_ratio, 1e-9);
+  EXPECT_NEAR(scaled.compact_per_length_ratio, three.compact_per_length_ratio, 1e-9);
+  // Without long elements there is nothing to compare.
+  EXPECT_EQ(compare_structure(measure_structure(apple_layer({})), ref, 1.0).long_length_ratio, 0.0);
+}
+
+// A thread closed on itself (round a cup's body) is a long element without ends, as long as its
+// loop, and not a ring; threads are measured in swatch threads, at a scale found from their
+// widths when not given (the areas of welded threads follow their lengths, not the scale).
+TEST(TextureStructure, ClosedThreadsHaveNoEndsAndLengthsCountInSwatchThreads) {
+  WeaveOptions o;
+  o.threads_x = o.threads_y = 6;
+  const TriMesh weave = plain_weave(o);
+  const SwatchStructure swatch = measure_swatch_structure(weave);
+  TriMesh loop = test::planar_tube(
+      [](double t) { return Vector2d(30 + 20 * std::cos(t), 20 * std::sin(t)); }, 0.15, 512, 10);
+  set_single_kind(loop, "thread_x");
+  TriMesh mesh = weave;
+  append_mesh(mesh, loop);
+  StructureOptions so;
+  so.automatic_border = false;  // every end counts
+  so.swatch = &swatch;
+  const StructureReport r = measure_structure(mesh, so);
+  EXPECT_EQ(r.rings, 0);
+  EXPECT_EQ(r.long_elements, 13);
+  EXPECT_EQ(r.closed_long_elements, 1);
+  EXPECT_EQ(r.ends, 24);
+  EXPECT_EQ(r.interior_ends, 24);
+  ASSERT_EQ(r.elements.size(), 13u);
+  const ElementStructure& closed = r.elements.back();
+  EXPECT_TRUE(closed.closed);
+  EXPECT_FALSE(closed.ring);
+  EXPECT_NEAR(closed.length, 2 * M_PI * 20, 0.5);
+  EXPECT_NEAR(closed.width, 0.3, 0.01);
+  EXPECT_EQ(closed.interior_ends, 0);
+  // The sheet against itself is one swatch thread long, and so it is twice as large.
+  so.automatic_border = true;
+  const StructureComparison self = compare_structure(measure_structure(weave, so), swatch);
+  EXPECT_NEAR(self.long_length_ratio, 1.0, 1e-6);
+  TriMesh twice = weave;
+  twice.V *= 2;
+  const StructureReport big = measure_structure(twice, so);
+  EXPECT_NEAR(big.linear_scale, 2.0, 1e-6);
+  const StructureComparison c = compare_structure(big, swatch);
+  EXPECT_NEAR(c.long_length_ratio, 1.0, 1e-6);
+  // Interior ends per swatch unit squared: the same as the sheet's own.
+  EXPECT_NEAR(c.interior_ends_per_swatch_area, self.interior_ends_per_swatch_area, 1e-9);
 }
 
 TEST(TextureStructure, BaseBoundaryDecidesTheInteriorOfACurvedResult) {
