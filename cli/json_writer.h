@@ -75,7 +75,22 @@ class JsonWriter {
   }
   void quote(const std::string& s) {
     out_ += '"';
-    for (const char c : s) {
+    for (size_t i = 0; i < s.size(); ++i) {
+      const char c = s[i];
+      // JSON is UTF-8: a byte outside a well-formed sequence (a file name in another encoding)
+      // is written as the code point of the same number, so the file stays valid JSON.
+      if (static_cast<unsigned char>(c) >= 0x80) {
+        const size_t n = utf8_sequence_length(s, i);
+        if (n == 0) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+          out_ += buf;
+        } else {
+          out_.append(s, i, n);
+          i += n - 1;
+        }
+        continue;
+      }
       switch (c) {
         case '"': out_ += "\\\""; break;
         case '\\': out_ += "\\\\"; break;
@@ -92,6 +107,26 @@ class JsonWriter {
       }
     }
     out_ += '"';
+  }
+
+  // The length of the well-formed UTF-8 sequence starting at s[i] (Unicode Table 3-7), 0 if
+  // there is none.
+  static size_t utf8_sequence_length(const std::string& s, size_t i) {
+    const auto byte = [&](size_t k) {
+      return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u;
+    };
+    const unsigned b0 = byte(i), b1 = byte(i + 1);
+    const auto cont = [&](size_t k) { return (byte(k) & 0xC0u) == 0x80u; };
+    if (b0 >= 0xC2 && b0 <= 0xDF) return cont(i + 1) ? 2 : 0;
+    if (b0 >= 0xE0 && b0 <= 0xEF) {
+      const unsigned lo = b0 == 0xE0 ? 0xA0 : 0x80, hi = b0 == 0xED ? 0x9F : 0xBF;
+      return b1 >= lo && b1 <= hi && cont(i + 2) ? 3 : 0;
+    }
+    if (b0 >= 0xF0 && b0 <= 0xF4) {
+      const unsigned lo = b0 == 0xF0 ? 0x90 : 0x80, hi = b0 == 0xF4 ? 0x8F : 0xBF;
+      return b1 >= lo && b1 <= hi && cont(i + 2) && cont(i + 3) ? 4 : 0;
+    }
+    return 0;
   }
 
   std::string out_;

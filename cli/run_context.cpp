@@ -124,6 +124,16 @@ void check_paths(const std::vector<std::string>& outputs, const std::vector<std:
   for (size_t i = 0; i < outputs.size(); ++i) {
     const std::string& out = outputs[i];
     if (out.empty()) continue;
+    // An OBJ names its .mtl by the output's name on one text line (mtllib), and --stats records
+    // it in JSON: a name with a line break or another control character, or bytes that are not
+    // UTF-8, would break them (issue 28).
+    for (const char c : out)
+      MQ_CHECK(static_cast<unsigned char>(c) >= 0x20 && c != 0x7f, InvalidInput,
+               detail::printable(out),
+               ": the output name contains a line break or another control character; choose "
+               "another name");
+    MQ_CHECK(detail::printable(out) == out, InvalidInput, detail::printable(out),
+             ": the output name is not UTF-8 text; choose a name in UTF-8");
     check_output_directory(out);
     std::error_code ec;
     MQ_CHECK(!fs::is_directory(out, ec), InvalidInput, out, ": is a directory");

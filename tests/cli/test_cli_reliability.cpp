@@ -225,6 +225,25 @@ TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
   }
 }
 
+// Issue 28: an output name with a line break would split the OBJ's `mtllib` line; one that is not
+// UTF-8 cannot be written into --stats' JSON. Both are refused in words before any work; an
+// input named so is recorded in --stats as valid JSON (the byte as the code point of its value).
+TEST_F(Reliability, OutputNamesMustBeText) {
+  expect_refused("plane --swatch sw.obj --size 5 5 -o \"$(printf 'a\\nb.obj')\"", "line break");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o \"$(printf 'a\\377.obj')\"", "not UTF-8");
+  expect_refused("plane --swatch sw.obj --size 5 5 -o o.obj --stats \"$(printf 's\\377.json')\"",
+                 "not UTF-8");
+  fs::copy_file(dir_ + "/sw.obj", dir_ + "/sw\xff.obj");
+  const CliRun r = meshquilt(
+      dir_, "plane --swatch \"$(printf 'sw\\377.obj')\" --size 5 5 -o o.obj --stats s.json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string stats = slurp(dir_ + "/s.json");
+  EXPECT_NE(stats.find("sw\\u00ff.obj"), std::string::npos);
+  EXPECT_EQ(stats.find('\xff'), std::string::npos) << "a byte that is not UTF-8 in the JSON";
+  fs::remove(dir_ + "/sw\xff.obj");
+  for (const char* f : {"o.obj", "o.mtl", "s.json"}) fs::remove(dir_ + "/" + f);
+}
+
 // A full disk, simulated by a file size limit (RLIMIT_FSIZE, with SIGXFSZ ignored so that the
 // write fails with EFBIG as it would with ENOSPC): exit 1, one line naming the output, the old
 // file at the path untouched and no temporary file left (issue 14).
