@@ -7,11 +7,13 @@
 #include <atomic>
 #include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
 #include "core/errors.h"
+#include "core/fnv1a.h"
 
 namespace mq {
 namespace {
@@ -47,11 +49,25 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
   std::raise(sig);
 }
 
+// The "NAME" part of a temporary's name ".NAME.tmp-PID-XXXXXX": NAME itself when the whole fits
+// in a file name (NAME_MAX, 255 bytes), else NAME cut short and told apart by a hash of it, so a
+// legal output name of up to 255 bytes can still be written (issue 28).
+std::string temporary_stem(const std::string& name) {
+  constexpr size_t kNameMax = 255;
+  constexpr size_t kDecoration = 1 + 5 + 10 + 1 + 6;  // ".", ".tmp-", a pid, "-", XXXXXX
+  if (name.size() + kDecoration <= kNameMax) return name;
+  std::uint64_t h = kFnv1aOffset;
+  fnv1a(h, name.data(), name.size());
+  char hash[18];
+  std::snprintf(hash, sizeof hash, "~%016llx", static_cast<unsigned long long>(h));
+  return name.substr(0, kNameMax - kDecoration - 17) + hash;
+}
+
 // Removes ".NAME.tmp-PID-*" files in dir left by writers that no longer run (killed by SIGKILL
 // or a power cut); a running writer's file is kept.
 void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& name) {
   namespace fs = std::filesystem;
-  const std::string prefix = "." + name + ".tmp-";
+  const std::string prefix = "." + temporary_stem(name) + ".tmp-";
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string f = it->path().filename().string();
@@ -86,7 +102,8 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path) : path_(path) {
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   remove_stale_temporaries(dir, target.filename().string());
   std::string pattern =
-      (dir / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-XXXXXX"))
+      (dir / ("." + temporary_stem(target.filename().string()) + ".tmp-" +
+              std::to_string(::getpid()) + "-XXXXXX"))
           .string();
   const int fd = ::mkstemp(pattern.data());
   if (fd < 0)

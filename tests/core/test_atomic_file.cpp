@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,53 @@ TEST(AtomicOutputFile, RunningWritersTemporaryIsKept) {
   EXPECT_EQ(names_in(dir).size(), 2u);
   first.commit();
   EXPECT_EQ(names_in(dir).size(), 1u);
+}
+
+// Every legal file name can be written, up to NAME_MAX (255 bytes): the temporary's name is cut
+// short with a hash when ".NAME.tmp-PID-XXXXXX" would be longer (issue 28: 244-255 bytes were
+// refused), two long names that share their first 200 bytes do not share a temporary, and a
+// leftover of a killed writer of such a name is still found and removed.
+TEST(AtomicOutputFile, NamesUpToNameMaxAreWritten) {
+  const std::string dir = test::temp_dir();
+  for (const size_t length : {200u, 240u, 244u, 250u, 255u}) {
+    const std::string name = std::string(length - 4, 'n') + ".obj";
+    {
+      AtomicOutputFile out(dir + "/" + name);
+      out.append(std::string_view("v 0 0 0\n"));
+      out.commit();
+    }
+    EXPECT_TRUE(fs::exists(dir + "/" + name)) << length;
+    EXPECT_EQ(names_in(dir).size(), 1u) << length;
+    fs::remove(dir + "/" + name);
+  }
+  const std::string a = std::string(240, 'a') + "1.obj", b = std::string(240, 'a') + "2.obj";
+  std::string stem_a;
+  {
+    AtomicOutputFile first(dir + "/" + a);
+    const std::vector<std::string> one = names_in(dir);
+    ASSERT_EQ(one.size(), 1u);
+    stem_a = one[0].substr(0, one[0].find(".tmp-"));
+    AtomicOutputFile second(dir + "/" + b);
+    const std::vector<std::string> two = names_in(dir);
+    ASSERT_EQ(two.size(), 2u);
+    for (const std::string& t : two) {
+      EXPECT_LE(t.size(), 255u);
+      if (t.rfind(stem_a + ".tmp-", 0) != 0) {
+        EXPECT_NE(t.substr(0, t.find(".tmp-")), stem_a);
+      }
+    }
+  }  // not committed: both temporaries removed
+  EXPECT_TRUE(names_in(dir).empty());
+  // A leftover of a writer of `a` that no longer runs (a child that has ended).
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);
+  const std::string leftover = dir + "/" + stem_a + ".tmp-" + std::to_string(child) + "-abcdef";
+  { std::ofstream(leftover) << "partial"; }
+  ASSERT_TRUE(fs::exists(leftover));
+  AtomicOutputFile again(dir + "/" + a);
+  EXPECT_FALSE(fs::exists(leftover));
 }
 
 }  // namespace
