@@ -280,9 +280,19 @@ MatrixX3d tangent_field_from_direction(const MatrixX3d& V, const MatrixX3i& F,
   MQ_CHECK(direction.allFinite() && direction.norm() > 0, InvalidInput,
            "tangent field: the direction must be finite and non-zero");
   const Vector3d d = direction.normalized();
+  // A direction along every face's normal (0 0 1 over a base in the z = 0 plane) has no part
+  // along the surface: the field would be the unguided one, silently (issue 28).
+  const MatrixX3d N = face_normals(V, F);
+  bool along_surface = false;
+  for (int f = 0; f < F.rows() && !along_surface; ++f)
+    along_surface = (d - d.dot(N.row(f).transpose()) * N.row(f).transpose()).norm() > 1e-3;
+  MQ_CHECK(along_surface, InvalidInput, "the guidance direction (", direction.x(), " ",
+           direction.y(), " ", direction.z(),
+           ") is normal to the base everywhere, so it gives no direction along the surface; "
+           "give one along the surface");
   MatrixX3d raw(F.rows(), 3);
   raw.rowwise() = d.transpose();
-  return finish_field(V, F, face_normals(V, F), raw, 1.0);
+  return finish_field(V, F, N, raw, 1.0);
 }
 
 MatrixX3d read_vertex_vector_field(const std::string& path, int num_vertices) {

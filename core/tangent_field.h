@@ -21,7 +21,8 @@ namespace mq {
 
 // (a) A constant world direction projected onto each face plane.
 //   V #V by 3, F #F by 3, direction finite and non-zero
-// Returns #F by 3. Throws InvalidInput for a zero or non-finite direction or a bad index.
+// Returns #F by 3. Throws InvalidInput for a zero or non-finite direction, one normal to every
+// face (no part along the surface), or a bad index.
 MatrixX3d tangent_field_from_direction(const MatrixX3d& V, const MatrixX3i& F,
                                        const Vector3d& direction);
 

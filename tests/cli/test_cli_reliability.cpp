@@ -225,6 +225,15 @@ TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
   }
 }
 
+// Issue 28, item 8: a guidance direction normal to a flat base everywhere guides nothing; it is
+// refused like an all-zero field, in words, not replaced by the unguided field.
+TEST_F(Reliability, GuidanceWithNothingAlongTheSurfaceIsRefused) {
+  expect_refused("surface --base grid.off --swatch sw.obj --field 0 0 1 -o o.obj",
+                 "normal to the base everywhere");
+  expect_refused("surface --base grid.off --swatch sw.obj --field 0 0 -3 -o o.obj",
+                 "normal to the base everywhere");
+}
+
 // Issue 28: an output name with a line break would split the OBJ's `mtllib` line; one that is not
 // UTF-8 cannot be written into --stats' JSON. Both are refused in words before any work; an
 // input named so is recorded in --stats as valid JSON (the byte as the code point of its value).

@@ -70,9 +70,19 @@ TEST(TangentField, ConstantDirectionOnAPlane) {
   // An oblique direction is projected.
   const MatrixX3d P = tangent_field_from_direction(grid.V, grid.F, Vector3d(0, 3, 4));
   for (int f = 0; f < P.rows(); ++f) EXPECT_LT((row3(P, f) - Vector3d(0, 1, 0)).norm(), 1e-12);
-  // Parallel to the normal everywhere: the longest bounding-box axis (x) is used.
-  const MatrixX3d Z = tangent_field_from_direction(grid.V, grid.F, Vector3d(0, 0, -2));
-  for (int f = 0; f < Z.rows(); ++f) EXPECT_LT((row3(Z, f) - Vector3d(1, 0, 0)).norm(), 1e-12);
+  // Parallel to the normal everywhere: no direction along the surface, refused in words (issue
+  // 28; it used to fall back to the longest bounding-box axis without a word).
+  try {
+    tangent_field_from_direction(grid.V, grid.F, Vector3d(0, 0, -2));
+    ADD_FAILURE() << "a direction normal to the base everywhere was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("normal to the base everywhere"), std::string::npos)
+        << e.what();
+  }
+  // Normal to some faces only (a box's top, with a direction along z): followed on the others.
+  const MatrixX3d B = tangent_field_from_direction(test::unit_cube().V, test::unit_cube().F,
+                                                   Vector3d(0, 0, 1));
+  EXPECT_TRUE(B.allFinite());
   EXPECT_THROW(tangent_field_from_direction(grid.V, grid.F, Vector3d::Zero()), InvalidInput);
 }
 
