@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <unordered_set>
 #include <utility>
 
 #include "core/errors.h"
@@ -87,6 +88,30 @@ std::string sanitized_kind(const std::string& name) {
   std::string s;
   for (const char c : name) s += (c > ' ' && c < 127 && c != '#') ? c : '_';
   return s.empty() ? std::string(kDefaultKind) : s;
+}
+
+std::vector<std::string> unique_kind_names(const std::vector<std::string>& kinds) {
+  std::vector<std::string> names;
+  names.reserve(kinds.size());
+  std::unordered_set<std::string> taken;
+  for (const std::string& kind : kinds) taken.insert(sanitized_kind(kind));
+  std::unordered_set<std::string> used;
+  for (const std::string& kind : kinds) {
+    std::string name = sanitized_kind(kind);
+    if (used.count(name)) {
+      // A suffix no kind has as its own name, nor an earlier suffixed one.
+      for (int n = 2;; ++n) {
+        const std::string candidate = name + "_" + std::to_string(n);
+        if (!taken.count(candidate) && !used.count(candidate)) {
+          name = candidate;
+          break;
+        }
+      }
+    }
+    used.insert(name);
+    names.push_back(name);
+  }
+  return names;
 }
 
 ElementLabels element_labels(const TriMesh& mesh) {

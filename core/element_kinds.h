@@ -44,6 +44,11 @@ int kind_index(std::vector<std::string>& kinds, const std::string& name);
 // spaces ('_' replaces anything else); an empty name becomes kDefaultKind.
 std::string sanitized_kind(const std::string& name);
 
+// The kinds' names as files write them: each sanitized_kind, and those equal after that (two
+// unnamed kinds, "a b" beside "a_b", "kind_1" beside an unnamed kind) told apart by a suffix
+// "_2", "_3", ... in order, so that every format names #kinds distinct materials (issue 28).
+std::vector<std::string> unique_kind_names(const std::vector<std::string>& kinds);
+
 // The elements of a mesh as files label them: element e is connected component e (in order of
 // first face, as split_elements numbers them), of kind element_kind[e] in kinds.
 struct ElementLabels {

@@ -128,9 +128,10 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
 
   tinygltf::Mesh gm;
   gm.name = std::filesystem::path(path).stem().string();
+  const std::vector<std::string> names = unique_kind_names(labels.kinds);
   for (size_t k = 0; k < by_kind.size(); ++k) {
     if (by_kind[k].empty()) continue;
-    const std::string name = sanitized_kind(labels.kinds[k]);
+    const std::string& name = names[k];
     const KindMaterial look = kind_material(name);
     tinygltf::Material m;
     m.name = name;

@@ -1142,7 +1142,7 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
   const bool elements = options.write_elements && format != MeshFormat::Off;
   if (elements) {
     labels = element_labels(mesh);
-    for (std::string& kind : labels.kinds) kind = sanitized_kind(kind);
+    labels.kinds = unique_kind_names(labels.kinds);
   }
 
   AtomicOutputFile out(path);

@@ -271,5 +271,43 @@ TEST(ElementKinds, PlanarQuiltingKeepsKindsOfIvyAndWeave) {
   EXPECT_LT(max_leaf, min_vine);
 }
 
+// Kinds whose names are equal once written (two named "element", one of them the default for an
+// unnamed kind; "a b" beside "a_b"; "kind_1" beside "kind" and a second "kind") get distinct
+// names in every format, so an OBJ reads back with as many kinds as were written (issue 28).
+TEST(ElementKinds, NamesStayDistinctInEveryFormat) {
+  EXPECT_EQ(unique_kind_names({"element", ""}), (std::vector<std::string>{"element", "element_2"}));
+  EXPECT_EQ(unique_kind_names({"a b", "a_b"}), (std::vector<std::string>{"a_b", "a_b_2"}));
+  EXPECT_EQ(unique_kind_names({"kind", "kind_2", "kind"}),
+            (std::vector<std::string>{"kind", "kind_2", "kind_3"}));
+  EXPECT_EQ(unique_kind_names({"ring", "leaf"}), (std::vector<std::string>{"ring", "leaf"}));
+
+  const std::string dir = test::temp_dir();
+  // Three separate triangles, one per kind; two kinds named alike once sanitised.
+  TriMesh mesh;
+  mesh.V.resize(9, 3);
+  mesh.F.resize(3, 3);
+  for (int t = 0; t < 3; ++t) {
+    mesh.V.row(3 * t) << 3.0 * t, 0, 0;
+    mesh.V.row(3 * t + 1) << 3.0 * t + 1, 0, 0;
+    mesh.V.row(3 * t + 2) << 3.0 * t, 1, 0;
+    mesh.F.row(t) << 3 * t, 3 * t + 1, 3 * t + 2;
+  }
+  mesh.kinds = {"a b", "a_b", "element"};
+  mesh.face_kind = {0, 1, 2};
+  WriteOptions o;
+  o.write_elements = true;
+  for (const char* name : {"k.obj", "k.ply"}) {
+    write_mesh(dir + "/" + name, mesh, o);
+    const TriMesh back = read_mesh(dir + "/" + name);
+    EXPECT_EQ(std::set<std::string>(back.kinds.begin(), back.kinds.end()).size(), 3u) << name;
+    EXPECT_EQ(faces_per_kind(back).size(), 3u) << name;
+  }
+  const std::string mtl = test::slurp(dir + "/k.mtl");
+  EXPECT_NE(mtl.find("newmtl a_b\n"), std::string::npos);
+  EXPECT_NE(mtl.find("newmtl a_b_2\n"), std::string::npos);
+  const std::string ply = test::slurp(dir + "/k.ply");
+  EXPECT_NE(ply.find("comment kind 1 a_b_2\n"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace mq

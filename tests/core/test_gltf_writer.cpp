@@ -187,6 +187,21 @@ TEST(GltfWriter, IvyIsValidWithAMaterialPerKindAndElementIds) {
                 1.0, 1e-5);
 }
 
+// Two kinds named alike once sanitised ("a b", "a_b") are two materials of different names
+// (issue 28).
+TEST(GltfWriter, KindsNamedAlikeAreDistinctMaterials) {
+  IvyOptions o;
+  o.leaves = 2;
+  TriMesh ivy = ivy_section(o);
+  ivy.kinds = {"a b", "a_b"};
+  const std::string path = test::temp_dir() + "/alike.glb";
+  write_glb(path, ivy);
+  const tinygltf::Model m = check_glb(path);
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].name, "a_b");
+  EXPECT_EQ(m.materials[1].name, "a_b_2");
+}
+
 TEST(GltfWriter, MeshWithoutKindsAndSameBytesEveryTime) {
   const TriMesh t = test::torus(1.0, 0.25, 32, 12);
   const std::string dir = test::temp_dir();
