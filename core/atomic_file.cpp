@@ -1,6 +1,8 @@
 #include "core/atomic_file.h"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -146,13 +148,60 @@ void AtomicOutputFile::append(const char* s, size_t n) {
   used_ += n;
 }
 
-void AtomicOutputFile::commit() {
+void AtomicOutputFile::finish() {
+  if (!file_) return;
   flush();
   const bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
   const int err = errno;
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
   if (!ok || !closed) MQ_THROW(Error, path_, ": cannot write: ", std::strerror(ok ? errno : err));
+}
+
+void commit_together(AtomicOutputFile& first, AtomicOutputFile& second) {
+  namespace fs = std::filesystem;
+  first.finish();
+  second.finish();
+  const fs::path dir = fs::path(second.path_).has_parent_path()
+                           ? fs::path(second.path_).parent_path()
+                           : fs::path(".");
+  // flock on the directory itself: no lock file to leave behind; released by close().
+  const int lock = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock >= 0) ::flock(lock, LOCK_EX);
+  struct Unlock {
+    int fd;
+    ~Unlock() {
+      if (fd >= 0) ::close(fd);
+    }
+  } unlock{lock};
+  // A hard link keeps first's old file while first's new one takes its name.
+  const std::string kept = first.temp_ + "-old";
+  const bool had_old = ::link(first.path_.c_str(), kept.c_str()) == 0;
+  if (std::rename(first.temp_.c_str(), first.path_.c_str()) != 0) {
+    const int err = errno;
+    if (had_old) ::unlink(kept.c_str());
+    MQ_THROW(Error, first.path_, ": cannot write: rename failed: ", std::strerror(err));
+  }
+  first.committed_ = true;
+  release_slot(first.slot_);
+  first.slot_ = -1;
+  if (std::rename(second.temp_.c_str(), second.path_.c_str()) != 0) {
+    const int err = errno;
+    if (had_old)
+      std::rename(kept.c_str(), first.path_.c_str());
+    else
+      ::unlink(first.path_.c_str());
+    MQ_THROW(Error, second.path_, ": cannot write: rename failed: ", std::strerror(err),
+             " (", first.path_, " left as it was)");
+  }
+  if (had_old) ::unlink(kept.c_str());
+  second.committed_ = true;
+  release_slot(second.slot_);
+  second.slot_ = -1;
+}
+
+void AtomicOutputFile::commit() {
+  finish();
   if (std::rename(temp_.c_str(), path_.c_str()) != 0)
     MQ_THROW(Error, path_, ": cannot write: rename failed: ", std::strerror(errno));
   committed_ = true;

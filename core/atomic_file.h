@@ -31,6 +31,10 @@ class AtomicOutputFile {
   static constexpr size_t kSlack = 1024;
 
  private:
+  friend void commit_together(AtomicOutputFile& first, AtomicOutputFile& second);
+  // Flushes, syncs and closes the temporary file (the part of commit() that can fail on a full
+  // disk), leaving the rename.
+  void finish();
   static constexpr size_t kChunk = size_t(1) << 22;
   void flush();
   void write_raw(const char* s, size_t n);
@@ -49,6 +53,13 @@ class AtomicOutputFile {
 // main(). A SIGKILL cannot be caught: its temporary file (".NAME.tmp-PID-XXXXXX", PID the
 // writer's) is removed by the next AtomicOutputFile for the same NAME once no process PID runs.
 void install_temporary_file_cleanup();
+
+// Commits two files that belong together (an OBJ and its .mtl) so that readers find both new
+// or both old: both are written out before either is renamed (a full disk changes neither);
+// the renames run under an exclusive lock on their directory (two runs writing the same pair
+// do not interleave), first's then second's; if second's fails (an immutable old file), first's
+// old file is put back. Throws Error naming the file that failed.
+void commit_together(AtomicOutputFile& first, AtomicOutputFile& second);
 
 // Writes `bytes` to `path` atomically (an AtomicOutputFile written at once).
 void write_file_atomically(const std::string& path, std::string_view bytes);

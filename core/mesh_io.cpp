@@ -1152,10 +1152,12 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
       write_obj(out, mesh, obj_normals, options.precision, elements ? &labels : nullptr,
                 options.groups, std::filesystem::path(mtl).filename().string());
       if (elements) {
-        // The .mtl lands first: the OBJ never names a material file that is not there.
+        // The pair lands together (the .mtl's rename first): the OBJ never names a material
+        // file that is not there, or one of another run's kinds (issue 28).
         AtomicOutputFile materials(mtl);
         write_mtl(materials, labels.kinds);
-        materials.commit();
+        commit_together(materials, out);
+        return;
       }
       break;
     }

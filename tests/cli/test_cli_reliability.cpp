@@ -274,6 +274,7 @@ TEST_F(Reliability, AFullDiskLeavesTheOldFileAndNoTemporary) {
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
   EXPECT_NE(message.find("big."), std::string::npos) << message;
   EXPECT_EQ(slurp(dir_ + "/big.obj"), "old\n");
+  EXPECT_EQ(slurp(dir_ + "/big.mtl"), "old mtl\n") << "the .mtl of the old OBJ was replaced";
   EXPECT_EQ(listing(dir_), before);
 }
 
