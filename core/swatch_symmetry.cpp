@@ -68,6 +68,11 @@ Vector2d refine(const SwatchFaceTree& faces, const Sample& s, double sign, Vecto
 
 }  // namespace
 
+// Shifts a grid search may evaluate (each 128 nearest-face queries): beyond it the search tries
+// the shifts that map one element onto another, or a coarser grid. The Table 1 swatches need
+// at most a few thousand.
+constexpr double kMaxGridShifts = 16384;
+
 SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
                                       double cell, double tolerance) {
   SwatchSymmetry out;
@@ -98,14 +103,64 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
 
   // Whole-step shifts in both directions for the periods, shifts over [0, 2 size] for the half
   // turn (which maps [0, size] to [-size, 0] before the shift).
+  // Element centres (footprint box centres), and the one nearest the footprint's middle.
+  std::vector<Vector2d> centre;
+  for (const Element& e : swatch.elements) centre.push_back(0.5 * (e.lo + e.hi));
+  size_t middle = 0;
+  for (size_t i = 1; i < centre.size(); ++i)
+    if ((centre[i] - 0.5 * size).squaredNorm() < (centre[middle] - 0.5 * size).squaredNorm())
+      middle = i;
   auto search = [&](double sign, const Vector2d& from, const Vector2d& to,
                     std::vector<std::pair<double, Vector2d>>& found) {
-    const int nx = static_cast<int>(std::floor((to.x() - from.x()) / step)) + 1;
-    const int ny = static_cast<int>(std::floor((to.y() - from.y()) / step)) + 1;
+    const double grid_shifts = std::floor((to.x() - from.x()) / step + 1) *
+                               std::floor((to.y() - from.y()) / step + 1);
+    if (grid_shifts > kMaxGridShifts && centre.size() >= 2) {
+      // Many small elements (a 20 x 20 swatch of boxes: 260,000 shifts, minutes): a symmetry
+      // maps the middle element onto another one, so only such shifts are tried, refined as
+      // below, instead of a grid over the footprint (issue 28).
+      // The shortest periods, and half turns about the nearest centres, map it onto one of its
+      // nearest elements: the 64 nearest are tried.
+      std::vector<size_t> near;
+      for (size_t j = 0; j < centre.size(); ++j)
+        if (j != middle || sign < 0) near.push_back(j);
+      const size_t count = std::min<size_t>(64, near.size());
+      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(count), near.end(),
+                        [&](size_t a, size_t b) {
+                          const double da = (centre[a] - centre[middle]).squaredNorm();
+                          const double db = (centre[b] - centre[middle]).squaredNorm();
+                          return da < db || (da == db && a < b);
+                        });
+      near.resize(count);
+      std::vector<Vector2d> tries;
+      for (const size_t j : near) {
+        const Vector2d t = sign > 0 ? Vector2d(centre[j] - centre[middle])
+                                    : Vector2d(centre[j] + centre[middle]);
+        if ((t.array() < from.array()).any() || (t.array() > to.array()).any()) continue;
+        if (sign > 0 && t.norm() < 0.5 * cell) continue;
+        tries.push_back(t);
+      }
+      std::vector<std::pair<double, Vector2d>> refined(tries.size());
+      tbb::parallel_for(size_t(0), tries.size(), [&](size_t i) {
+        double c = mean_cost(faces, s, sign, tries[i], size, margin, lambda, min_points);
+        Vector2d t = tries[i];
+        if (c < 2.0)
+          t = refine(faces, s, sign, t, size, margin, lambda, min_points, 0.5 * step, 1e-7 * cell,
+                     c);
+        refined[i] = {c, t};
+      });
+      for (const auto& [c, t] : refined)
+        if (c <= 1 + tolerance) found.emplace_back(c, t);
+      return;
+    }
+    // One large element on a fine grid: the grid coarsened to the budget.
+    const double grid_step =
+        grid_shifts > kMaxGridShifts ? step * std::sqrt(grid_shifts / kMaxGridShifts) : step;
+    const int nx = static_cast<int>(std::floor((to.x() - from.x()) / grid_step)) + 1;
+    const int ny = static_cast<int>(std::floor((to.y() - from.y()) / grid_step)) + 1;
     if (nx <= 0 || ny <= 0) return;
     std::vector<double> cost(static_cast<size_t>(nx) * ny);
     tbb::parallel_for(0, nx * ny, [&](int k) {
-      const Vector2d t = from + step * Vector2d(k % nx, k / nx);
+      const Vector2d t = from + grid_step * Vector2d(k % nx, k / nx);
       cost[static_cast<size_t>(k)] =
           (sign > 0 && t.norm() < 0.5 * cell)
               ? std::numeric_limits<double>::infinity()
@@ -130,10 +185,10 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
     std::vector<std::pair<double, Vector2d>> refined(seeds.size());
     tbb::parallel_for(size_t(0), seeds.size(), [&](size_t i) {
       const int k = seeds[i];
-      const Vector2d t0 = from + step * Vector2d(k % nx, k / nx);
+      const Vector2d t0 = from + grid_step * Vector2d(k % nx, k / nx);
       double c = 0;
-      const Vector2d t =
-          refine(faces, s, sign, t0, size, margin, lambda, min_points, 0.5 * step, 1e-7 * cell, c);
+      const Vector2d t = refine(faces, s, sign, t0, size, margin, lambda, min_points,
+                                0.5 * grid_step, 1e-7 * cell, c);
       refined[i] = {c, t};
     });
     for (const auto& [c, t] : refined) {

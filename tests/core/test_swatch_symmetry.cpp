@@ -91,6 +91,36 @@ TEST(SwatchSymmetry, WeaveIsPeriodicButNotTileableApplesAndIvyAreNeither) {
 // The quick pre-check agrees with the full test on every sample swatch: true for the chain
 // mail sheets (tileable), false for the weave, apples and ivy (not tileable), and false for
 // a sheet whose rings were moved off the lattice.
+// A swatch of 20 x 20 small separate boxes (a lattice of period 1 by 1.5): its grid search would
+// be 260,000 shifts (minutes; issue 28, item 3), so the shifts between its elements are tried
+// instead. The lattice and the half turn are found all the same, and it tiles.
+TEST(SwatchSymmetry, ManySmallElementsFindTheirLatticeFromElementShifts) {
+  TriMesh boxes;
+  const int n = 20;
+  boxes.V.resize(8 * n * n, 3);
+  boxes.F.resize(12 * n * n, 3);
+  const int quads[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                           {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int b = 8 * (j * n + i), f = 12 * (j * n + i);
+      for (int c = 0; c < 8; ++c)
+        boxes.V.row(b + c) << i + 0.3 * (c & 1), 1.5 * j + 0.3 * ((c >> 1) & 1), 0.3 * (c >> 2);
+      for (int q = 0; q < 6; ++q) {
+        boxes.F.row(f + 2 * q) << b + quads[q][0], b + quads[q][1], b + quads[q][2];
+        boxes.F.row(f + 2 * q + 1) << b + quads[q][0], b + quads[q][2], b + quads[q][3];
+      }
+    }
+  const Detected d = detect(boxes);
+  ASSERT_TRUE(d.symmetry.periodic);
+  EXPECT_TRUE(in_lattice(d.symmetry, Vector2d(1, 0)));
+  EXPECT_TRUE(in_lattice(d.symmetry, Vector2d(0, 1.5)));
+  EXPECT_NEAR(std::abs(d.symmetry.a.x() * d.symmetry.b.y() - d.symmetry.a.y() * d.symmetry.b.x()),
+              1.5, 1e-4);
+  EXPECT_TRUE(d.symmetry.half_turn);
+  EXPECT_TRUE(tileable(d.swatch, d.symmetry));
+}
+
 TEST(SwatchSymmetry, RepeatingElementsComesBeforeTileable) {
   for (const auto& [rows, cols] : {std::pair{2, 4}, std::pair{3, 3}, std::pair{5, 6}}) {
     ChainMailOptions o;
