@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/global_quilting.h"
 #include "core/mesh_io.h"
+#include "core/mesh_topology.h"
 #include "core/quilt_embedding.h"
 #include "core/surface_coverage.h"
 #include "core/surface_quilting.h"
@@ -359,6 +360,12 @@ int run_surface(int argc, char** argv, int first) {
         "covered\n",
         out_path.c_str(), embedding_stats.faces, embedding_stats.vertices, embedding_stats.elements,
         stats.shell_height, 100.0 * embedding_stats.coverage);
+    // Faces meeting three or more at an edge (fins, flaps): the layout ends there as at a
+    // border, which the user should know of rather than find (issue 28, item 7).
+    if (const int fins = topology_report(base).num_non_manifold_edges; fins > 0)
+      std::printf("base: %d non-manifold edges (three or more faces meeting) are borders: the "
+                  "texture ends at them on every side\n",
+                  fins);
     if (stats.flipped_components > 0)
       std::printf("base: %d components faced inward and were turned outward "
                   "(--keep-orientation keeps them)\n",

@@ -234,6 +234,20 @@ TEST_F(Reliability, GuidanceWithNothingAlongTheSurfaceIsRefused) {
                  "normal to the base everywhere");
 }
 
+// Issue 28, item 7: faces meeting three at an edge (a fin) are borders for the layout; the run
+// says so in its summary rather than leaving the user to find the texture ending there.
+TEST_F(Reliability, NonManifoldEdgesAreSaid) {
+  // The grid's interior edges 1-4 and 4-8 get a third face: a fin folded back over the grid.
+  spit(dir_ + "/fin.off", grid_off("3 1 4 8\n", 1));
+  const CliRun r = meshquilt(dir_, "surface --base fin.off --swatch sw.obj --scale 0.3 -o f.obj "
+                                   "--min-coverage 0");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("base: 2 non-manifold edges (three or more faces meeting) are borders"),
+            std::string::npos)
+      << r.out;
+  for (const char* f : {"f.obj", "f.mtl", "fin.off"}) fs::remove(dir_ + "/" + f);
+}
+
 // Issue 28: an output name with a line break would split the OBJ's `mtllib` line; one that is not
 // UTF-8 cannot be written into --stats' JSON. Both are refused in words before any work; an
 // input named so is recorded in --stats as valid JSON (the byte as the code point of its value).
