@@ -262,6 +262,22 @@ int run_surface(int argc, char** argv, int first) {
   const auto start = std::chrono::steady_clock::now();
   const TriMesh base = read_mesh(cl.get("base"));
   const TriMesh swatch = read_mesh(cl.get("swatch"));
+  // Finite coordinates whose extent overflows (1e300) would make every size estimate NaN.
+  for (const auto& [mesh, name] : {std::pair<const TriMesh*, std::string>{&base, cl.get("base")},
+                                   {&swatch, cl.get("swatch")}})
+    MQ_CHECK(mesh->num_vertices() == 0 ||
+                 std::isfinite((mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff())
+                                   .squaredNorm()),
+             InvalidInput, name,
+             ": coordinates too large (the bounding box's diagonal overflows); scale the mesh "
+             "down");
+  // The swatch's thickness is the shell's height (section 3.2): a flat swatch has none.
+  if (swatch.num_vertices() > 0) {
+    const Vector3d extent = swatch.V.colwise().maxCoeff() - swatch.V.colwise().minCoeff();
+    MQ_CHECK(extent.minCoeff() > 1e-9 * extent.maxCoeff(), InvalidInput, cl.get("swatch"),
+             ": the swatch is flat (no thickness along its smallest side), and surface grows it "
+             "in a shell as thick as the swatch; give it thickness, or use plane");
+  }
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));

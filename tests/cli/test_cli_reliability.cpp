@@ -203,6 +203,15 @@ TEST_F(Reliability, MessagesInTheUsersTerms) {
                                "0 0 0\n0 0 0\n0 0 0\n0 0 0\n");
   expect_refused("surface --base grid.off --swatch sw.obj --field-file zero.txt -o o.obj",
                  "all zero");
+  // Issue 28, also weak: a flat swatch is named and explained, not "shell map: height must be
+  // finite and > 0"; coordinates whose extent overflows give no "about -nan faces".
+  spit(dir_ + "/flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expect_refused("surface --base grid.off --swatch flat.obj -o o.obj",
+                 "flat.obj: the swatch is flat");
+  spit(dir_ + "/huge.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\n"
+                           "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  expect_refused("surface --base huge.obj --swatch sw.obj -o o.obj",
+                 "huge.obj: coordinates too large");
 }
 
 TEST_F(Reliability, OutputPathsAreCheckedBeforeWork) {
