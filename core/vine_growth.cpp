@@ -1112,6 +1112,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     for (const SwatchLeaf& l : model.leaves) leaf_faces += static_cast<double>(l.F.rows());
     const double faces =
         length * (2.0 * model.segments / model.ring_spacing + leaf_faces / model.period);
+    stats.estimated_faces = faces;  // the memory estimate's (--stats `memory`), not the patches'
     MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
              " the vines would have about ", faces, " faces, more than the limit of ",
              options.max_faces, " (--max-faces); use a larger --scale");
