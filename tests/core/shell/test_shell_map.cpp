@@ -307,7 +307,7 @@ TEST(ShellMap, CupFoldIsRepairedLocally) {
 
 // A flat 1 x 1 grid of 10 x 10 squares with its middle vertex pushed `by` along x: past its
 // neighbour (0.1 away) its star folds over itself.
-TriMesh pushed_grid(double by) {
+TriMesh folded_grid(double by) {
   TriMesh g = test::plane_grid(1, 1, 10, 10);
   for (int v = 0; v < g.num_vertices(); ++v)
     if ((g.V.row(v) - Vector3d(0.5, 0.5, 0).transpose()).norm() < 1e-9) g.V(v, 0) += by;
@@ -316,7 +316,7 @@ TriMesh pushed_grid(double by) {
 
 TEST(ShellMap, FoldTheBoundedRepairCannotUndoIsLeftOut) {
   // Pushed 0.05 past its neighbour, under a shell 0.02 high: the repair may move it by 0.02.
-  const TriMesh g = pushed_grid(0.15);
+  const TriMesh g = folded_grid(0.15);
   ShellMapOptions o;
   o.height = 0.02;
   const ShellMap map(g.V, g.F, o);

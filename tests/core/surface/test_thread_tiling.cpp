@@ -267,7 +267,7 @@ struct WeaveRun {
 
 // The weave at `spacing` base units between threads, method auto, embedded by normal
 // displacement (the layout decides the threads; the shell map is tested on its own).
-WeaveRun run(const TriMesh& base, double spacing, const MatrixX3d& field = MatrixX3d()) {
+WeaveRun run_weave(const TriMesh& base, double spacing, const MatrixX3d& field = MatrixX3d()) {
   WeaveRun r;
   const TriMesh swatch = weave();
   const double diagonal = bounding_box(base.V, base.F).extent().norm();
@@ -315,7 +315,7 @@ TEST(ThreadTiling, OverACylinderThreadsRunItsLengthAndCloseRoundIt) {
   const TriMesh base = test::open_cylinder(2.0, 6.0, 64, 24);
   const double spacing = 0.35;
   const WeaveRun r =
-      run(base, spacing, tangent_field_from_direction(base.V, base.F, Vector3d::UnitZ()));
+      run_weave(base, spacing, tangent_field_from_direction(base.V, base.F, Vector3d::UnitZ()));
   report("cylinder", r);
   expect_whole_threads(r);
   const StructureReport& s = r.structure.output;
@@ -335,7 +335,7 @@ TEST(ThreadTiling, OverACylinderThreadsRunItsLengthAndCloseRoundIt) {
 TEST(ThreadTiling, OverASphereThreadsEndOnlyAtItsCones) {
   TriMesh base = test::icosphere(4);
   base.V *= 3.0;
-  const WeaveRun r = run(base, 0.3);
+  const WeaveRun r = run_weave(base, 0.3);
   report("sphere", r);
   expect_whole_threads(r);
   EXPECT_EQ(r.global.singular_vertices, 4);
@@ -381,7 +381,7 @@ TEST(ThreadTiling, SameInputSameBytesWhateverTheThreadCount) {
   std::vector<TriMesh> outs;
   for (const int threads : {1, 2}) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    outs.push_back(run(base, 0.3).output);
+    outs.push_back(run_weave(base, 0.3).output);
   }
   ASSERT_GT(outs[0].num_faces(), 0);
   EXPECT_EQ(outs[0].V, outs[1].V);
