@@ -5,10 +5,10 @@
 #include <random>
 #include <string>
 
-#include "core/closest_point_query.h"
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/point_triangle.h"
+#include "core/mesh/closest_point_query.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/point_triangle.h"
 
 namespace {
 

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <random>
 
-#include "core/geometry_measures.h"
-#include "core/laplacian_deformation.h"
-#include "core/mesh_io.h"
-#include "core/mesh_topology.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/laplacian_deformation.h"
 
 namespace {
 

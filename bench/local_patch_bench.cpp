@@ -5,10 +5,10 @@
 
 #include <string>
 
-#include "core/geometry_measures.h"
-#include "core/local_patch.h"
-#include "core/lscm.h"
-#include "core/mesh_io.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/surface/local_patch.h"
+#include "core/surface/lscm.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/mesh_io.h"
+#include "core/mesh/mesh_io.h"
 
 namespace {
 

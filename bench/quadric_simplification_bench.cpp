@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "core/mesh_io.h"
-#include "core/quadric_simplification.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/quadric_simplification.h"
 #include "tests/core/shell_fixtures.h"
 
 namespace {

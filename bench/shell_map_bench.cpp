@@ -6,10 +6,10 @@
 #include <memory>
 #include <random>
 
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/shell_embedding.h"
-#include "core/shell_map.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/shell/shell_embedding.h"
+#include "core/shell/shell_map.h"
 #include "host/tet_stretch_evaluator.h"
 
 namespace mq {

@@ -7,11 +7,11 @@
 #include <memory>
 #include <random>
 
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/offset_surface.h"
-#include "core/shell_tetrahedra.h"
-#include "core/tet_stretch.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/shell/offset_surface.h"
+#include "core/shell/shell_tetrahedra.h"
+#include "core/shell/tet_stretch.h"
 #include "host/opencl_runtime.h"
 #include "host/tet_stretch_opencl.h"
 

@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/translation_cost.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/translation_cost.h"
 #include "host/opencl_runtime.h"
 #include "host/translation_cost_opencl.h"
 

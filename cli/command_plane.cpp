@@ -7,11 +7,11 @@
 #include "cli/json_writer.h"
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
-#include "core/atomic_file.h"
-#include "core/errors.h"
-#include "core/mesh_io.h"
-#include "core/planar_quilting.h"
-#include "core/texture_structure.h"
+#include "core/common/errors.h"
+#include "core/mesh/atomic_file.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/planar_quilting.h"
+#include "core/structure/texture_structure.h"
 #include "host/translation_cost_evaluator.h"
 
 namespace mq::cli {

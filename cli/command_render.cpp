@@ -6,13 +6,13 @@
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/run_context.h"
-#include "core/errors.h"
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/mesh_topology.h"
-#include "core/render.h"
-#include "core/surface_quilting.h"
-#include "core/texture_structure.h"
+#include "core/common/errors.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/output/render.h"
+#include "core/structure/texture_structure.h"
+#include "core/surface/surface_quilting.h"
 
 namespace mq::cli {
 

@@ -4,10 +4,10 @@
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/run_context.h"
-#include "core/errors.h"
-#include "core/mesh_io.h"
-#include "core/mesh_topology.h"
-#include "core/swatch_generators.h"
+#include "core/common/errors.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/swatch_generators.h"
 
 namespace mq::cli {
 

@@ -8,7 +8,7 @@
 #include <chrono>
 #include <string>
 
-#include "core/progress.h"
+#include "core/common/progress.h"
 
 namespace mq::cli {
 

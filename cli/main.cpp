@@ -7,8 +7,8 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
-#include "core/atomic_file.h"
-#include "core/errors.h"
+#include "core/common/errors.h"
+#include "core/mesh/atomic_file.h"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 
 namespace mq::cli {
 

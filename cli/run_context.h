@@ -9,7 +9,7 @@
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
-#include "core/mesh_io.h"
+#include "core/mesh/mesh_io.h"
 #include "host/device.h"
 
 namespace mq::cli {

@@ -2,8 +2,8 @@
 #pragma once
 
 #include "cli/json_writer.h"
-#include "core/patch_quilting.h"
-#include "core/texture_structure.h"
+#include "core/planar/patch_quilting.h"
+#include "core/structure/texture_structure.h"
 
 namespace mq::cli {
 

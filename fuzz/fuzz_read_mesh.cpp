@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string>
 
-#include "core/errors.h"
-#include "core/mesh_io.h"
+#include "core/common/errors.h"
+#include "core/mesh/mesh_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   constexpr mq::MeshFormat kFormats[] = {mq::MeshFormat::Obj, mq::MeshFormat::Ply,

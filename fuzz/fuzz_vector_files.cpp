@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <string>
 
-#include "core/errors.h"
-#include "core/tangent_field.h"
+#include "core/common/errors.h"
+#include "core/surface/tangent_field.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string path = [] {

@@ -1,6 +1,6 @@
 #include "host/opencl_check.h"
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 
 namespace mq::cl {
 

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/opencl_check.h"
 
 namespace mq::cl {

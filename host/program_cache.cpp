@@ -3,7 +3,7 @@
 #include <functional>
 #include <vector>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/opencl_check.h"
 
 namespace mq::cl {

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "core/tet_stretch.h"
+#include "core/shell/tet_stretch.h"
 #include "host/device.h"
 #include "host/opencl_runtime.h"
 

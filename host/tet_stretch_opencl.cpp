@@ -2,7 +2,7 @@
 
 #include <limits>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/opencl_buffers.h"
 #include "kernels/tet_stretch_cl.h"
 

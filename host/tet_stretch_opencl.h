@@ -1,11 +1,11 @@
 // OpenCL path of the per-tet shell-map stretch (paper section 3.2, Eq. 8); see
-// core/tet_stretch.h for the maths and kernels/tet_stretch.cl for the kernel.
+// core/shell/tet_stretch.h for the maths and kernels/tet_stretch.cl for the kernel.
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include "core/tet_stretch.h"
+#include "core/shell/tet_stretch.h"
 #include "host/opencl_handles.h"
 #include "host/opencl_runtime.h"
 

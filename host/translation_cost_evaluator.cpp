@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/translation_cost_opencl.h"
 
 namespace mq {

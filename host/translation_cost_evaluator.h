@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "core/translation_cost.h"
+#include "core/planar/translation_cost.h"
 #include "host/device.h"
 #include "host/opencl_runtime.h"
 

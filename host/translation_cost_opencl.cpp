@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/opencl_buffers.h"
 #include "kernels/translation_cost_cl.h"
 

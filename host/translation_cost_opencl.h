@@ -1,5 +1,5 @@
 // OpenCL path of the translation cost (paper section 2.4, Eqs. (1)-(3)); see
-// core/translation_cost.h for the maths and kernels/translation_cost.cl for the kernel.
+// core/planar/translation_cost.h for the maths and kernels/translation_cost.cl for the kernel.
 #pragma once
 
 #include <cstdint>
@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-#include "core/translation_cost.h"
+#include "core/planar/translation_cost.h"
 #include "host/opencl_handles.h"
 #include "host/opencl_runtime.h"
 

@@ -1,6 +1,6 @@
 // Per-tet L2 stretch of the shell map, paper section 3.2, Eq. (8), with J = d(shell) /
-// d(texture) (see core/tet_stretch.h for the convention): one work-item per tet. The closed
-// form mirrors stretch_closed_form in core/tet_stretch.cpp operation for operation.
+// d(texture) (see core/shell/tet_stretch.h for the convention): one work-item per tet. The closed
+// form mirrors stretch_closed_form in core/shell/tet_stretch.cpp operation for operation.
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
 

@@ -2,9 +2,9 @@
 // one work-item per (point p, offset t) writes min over faces f of
 //   (1 + lambda * Dist(v_p - t, f)) * (1 + |n_p - n_f|)
 // to out[t_local * num_points + p]; the host sums each offset's row in point order (Eq. 3).
-// The tree traversal and the point-triangle region tests mirror core/translation_cost.cpp and
-// core/point_triangle.h (Ericson, Real-Time Collision Detection 5.1.5); the CPU path scans a
-// leaf in blocks (normal bound first), which examines the same entries as the scan here.
+// The tree traversal and the point-triangle region tests mirror core/planar/translation_cost.cpp
+// and core/mesh/point_triangle.h (Ericson, Real-Time Collision Detection 5.1.5); the CPU path
+// scans a leaf in blocks (normal bound first), which examines the same entries as the scan here.
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
 

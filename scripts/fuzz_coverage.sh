@@ -12,9 +12,9 @@ cmake -S . -B build-fuzz-coverage -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYP
 cmake --build build-fuzz-coverage -j"$(nproc)" >> build-fuzz-coverage.log 2>&1 ||
   { tail -50 build-fuzz-coverage.log; exit 1; }
 rm -f build-fuzz-coverage.log
-# The functions that parse each format (core/mesh_io.cpp, core/tangent_field.cpp), matched
-# against demangled names: each reader's own code, its lambdas and (PLY) its helper types; the
-# text cursor the text formats share is not counted (each format uses only part of it).
+# The functions that parse each format (core/mesh/mesh_io.cpp, core/surface/tangent_field.cpp),
+# matched against demangled names: each reader's own code, its lambdas and (PLY) its helper types;
+# the text cursor the text formats share is not counted (each format uses only part of it).
 declare -A parsers=(
   [obj]='::read_obj\('
   [ply]='::read_ply\(|::Ply|::parse_ply|::ply_'
@@ -32,7 +32,7 @@ for target in ${FUZZ_TARGETS:-obj ply off keys field}; do
   files=$(find "$corpus" -type f | wc -l)
   # One row per function: name, regions..., lines, missed lines, cover.
   llvm-cov-14 report build-fuzz-coverage/fuzz_$target -instr-profile="$out/merged.profdata" \
-    -show-functions core/mesh_io.cpp core/tangent_field.cpp 2>/dev/null | c++filt -n |
+    -show-functions core/mesh/mesh_io.cpp core/surface/tangent_field.cpp 2>/dev/null | c++filt -n |
     awk -v re="${parsers[$target]}" -v t="$target" -v n="$files" '
       $0 ~ re && NF >= 10 { lines += $(NF-5); missed += $(NF-4); fns++ }
       END { if (lines > 0) printf "fuzz coverage: %s: %d corpus files, %d parser functions, %d of %d lines (%.1f%%)\n", t, n, fns, lines - missed, lines, 100 * (lines - missed) / lines;

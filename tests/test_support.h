@@ -5,7 +5,7 @@
 #include <random>
 #include <string>
 
-#include "core/mesh.h"
+#include "core/mesh/mesh.h"
 
 namespace mq::test {
 

@@ -211,7 +211,7 @@ class Run:
 
 
 def _engine_kind_name(name):
-    """A kind name as the engine writes it (core/element_kinds.cpp sanitized_kind)."""
+    """A kind name as the engine writes it (core/mesh/element_kinds.cpp sanitized_kind)."""
     s = "".join(c if " " < c < "\x7f" and c != "#" else "_" for c in name)
     return s or "element"
 

@@ -2,7 +2,7 @@
 
 The engine writes its results with per-vertex `element_id` and `kind` properties and names the
 kinds in "comment kind K NAME" and "comment kind_material K R G B METALLIC ROUGHNESS" header
-lines (core/mesh_io.h); the add-on sends bases and swatches the same way (a swatch's kinds are
+lines (core/mesh/mesh_io.h); the add-on sends bases and swatches the same way (a swatch's kinds are
 its material names).
 """
 

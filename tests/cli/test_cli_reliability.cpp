@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh_io.h"
+#include "core/mesh/mesh_io.h"
 #include "tests/cli/cli_support.h"
 #include "tests/test_support.h"
 

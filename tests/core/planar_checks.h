@@ -8,12 +8,12 @@
 #include <cmath>
 #include <vector>
 
-#include "core/geometry_measures.h"
-#include "core/mesh_intersections.h"
-#include "core/mesh_topology.h"
-#include "core/planar_quilting.h"
-#include "core/quilt_elements.h"
-#include "core/swatch_generators.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/planar_quilting.h"
+#include "core/planar/quilt_elements.h"
+#include "core/planar/swatch_generators.h"
 
 namespace mq::test {
 

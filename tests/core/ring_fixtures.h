@@ -7,7 +7,7 @@
 #include <functional>
 #include <vector>
 
-#include "core/mesh.h"
+#include "core/mesh/mesh.h"
 
 namespace mq::test {
 

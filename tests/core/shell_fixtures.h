@@ -5,10 +5,10 @@
 #include <map>
 #include <utility>
 
-#include "core/geometry_measures.h"
-#include "core/mesh.h"
-#include "core/mesh_io.h"
-#include "core/offset_surface.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh.h"
+#include "core/mesh/mesh_io.h"
+#include "core/shell/offset_surface.h"
 #include "tests/test_support.h"
 
 namespace mq::test {

@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/errors.h"
+#include "core/common/errors.h"
 #include "host/opencl_runtime.h"
 #include "host/program_cache.h"
 

@@ -5,9 +5,9 @@
 #include <limits>
 #include <random>
 
-#include "core/errors.h"
-#include "core/shell_tetrahedra.h"
-#include "core/tet_stretch.h"
+#include "core/common/errors.h"
+#include "core/shell/shell_tetrahedra.h"
+#include "core/shell/tet_stretch.h"
 #include "host/opencl_runtime.h"
 #include "host/tet_stretch_evaluator.h"
 #include "host/tet_stretch_opencl.h"

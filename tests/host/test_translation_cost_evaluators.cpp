@@ -5,10 +5,10 @@
 #include <numeric>
 #include <random>
 
-#include "core/errors.h"
-#include "core/geometry_measures.h"
-#include "core/mesh_io.h"
-#include "core/translation_cost.h"
+#include "core/common/errors.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/translation_cost.h"
 #include "host/opencl_runtime.h"
 #include "host/translation_cost_evaluator.h"
 #include "host/translation_cost_opencl.h"

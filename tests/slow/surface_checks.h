@@ -7,15 +7,15 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "core/closest_point_query.h"
-#include "core/geometry_measures.h"
-#include "core/mesh_intersections.h"
-#include "core/mesh_topology.h"
-#include "core/quilt_embedding.h"
-#include "core/surface_coverage.h"
-#include "core/surface_quilting.h"
-#include "core/tet_stretch.h"
-#include "core/translation_cost.h"
+#include "core/mesh/closest_point_query.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/translation_cost.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/shell/surface_coverage.h"
+#include "core/shell/tet_stretch.h"
+#include "core/surface/surface_quilting.h"
 #include "tests/core/planar_checks.h"
 
 namespace mq::test {

@@ -17,11 +17,11 @@
 #include <cstdio>
 #include <string>
 
-#include "core/longest_edge_bisection.h"
-#include "core/mesh_io.h"
-#include "core/placement_check.h"
-#include "core/surface_coverage.h"
-#include "core/weld_vertices.h"
+#include "core/mesh/longest_edge_bisection.h"
+#include "core/mesh/mesh_io.h"
+#include "core/mesh/weld_vertices.h"
+#include "core/shell/placement_check.h"
+#include "core/shell/surface_coverage.h"
 #include "tests/cli/cli_support.h"
 #include "tests/test_support.h"
 

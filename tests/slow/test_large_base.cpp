@@ -6,9 +6,9 @@
 
 #include <cstdio>
 
-#include "core/closest_point_query.h"
-#include "core/mesh_io.h"
-#include "core/swatch_generators.h"
+#include "core/mesh/closest_point_query.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/swatch_generators.h"
 #include "tests/core/shell_fixtures.h"
 #include "tests/slow/surface_checks.h"
 #include "tests/test_support.h"

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <string>
 
-#include "core/errors.h"
-#include "core/mesh_io.h"
-#include "core/planar_quilting.h"
+#include "core/common/errors.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/planar_quilting.h"
 #include "tests/core/planar_checks.h"
 #include "tests/test_support.h"
 

@@ -17,8 +17,8 @@
 #include <cstdio>
 #include <string>
 
-#include "core/mesh_io.h"
-#include "core/tangent_field.h"
+#include "core/mesh/mesh_io.h"
+#include "core/surface/tangent_field.h"
 #include "tests/core/planar_checks.h"
 #include "tests/slow/surface_checks.h"
 #include "tests/test_support.h"

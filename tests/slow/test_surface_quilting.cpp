@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "core/errors.h"
-#include "core/mesh_io.h"
-#include "core/tangent_field.h"
+#include "core/common/errors.h"
+#include "core/mesh/mesh_io.h"
+#include "core/surface/tangent_field.h"
 #include "tests/core/planar_checks.h"
 #include "tests/slow/surface_checks.h"
 #include "tests/test_support.h"

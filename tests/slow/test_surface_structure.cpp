@@ -8,13 +8,13 @@
 #include <cstdio>
 #include <string>
 
-#include "core/global_quilting.h"
-#include "core/mesh_intersections.h"
-#include "core/mesh_io.h"
-#include "core/planar_quilting.h"
-#include "core/quilt_embedding.h"
-#include "core/swatch_generators.h"
-#include "core/texture_structure.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_io.h"
+#include "core/planar/planar_quilting.h"
+#include "core/planar/swatch_generators.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/structure/texture_structure.h"
+#include "core/surface/global_quilting.h"
 #include "host/translation_cost_evaluator.h"
 #include "tests/core/shell_fixtures.h"
 #include "tests/test_support.h"

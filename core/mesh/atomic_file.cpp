@@ -1,0 +1,228 @@
+#include "core/mesh/atomic_file.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "core/common/errors.h"
+#include "core/common/fnv1a.h"
+
+namespace mq {
+namespace {
+
+// Temporary files open now, for the signal handler: fixed slots of fixed buffers, claimed and
+// released with atomics, so that the handler reads them without locks or allocation.
+constexpr int kSlots = 16;
+constexpr size_t kPathMax = 4096;
+char g_temp_path[kSlots][kPathMax];
+std::atomic<int> g_temp_state[kSlots];  // 0 free, 1 being written, 2 a path to remove
+
+int claim_slot(const std::string& temp) {
+  if (temp.size() >= kPathMax) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (g_temp_state[i].compare_exchange_strong(expected, 1)) {
+      std::memcpy(g_temp_path[i], temp.c_str(), temp.size() + 1);
+      g_temp_state[i].store(2);
+      return i;
+    }
+  }
+  return -1;  // more than kSlots files open at once: that one is cleaned on the next run
+}
+
+void release_slot(int i) {
+  if (i >= 0) g_temp_state[i].store(0);
+}
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+  for (int i = 0; i < kSlots; ++i)
+    if (g_temp_state[i].load() == 2) ::unlink(g_temp_path[i]);  // async-signal-safe
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+// The "NAME" part of a temporary's name ".NAME.tmp-PID-XXXXXX": NAME itself when the whole fits
+// in a file name (NAME_MAX, 255 bytes), else NAME cut short and told apart by a hash of it, so a
+// legal output name of up to 255 bytes can still be written (issue 28).
+std::string temporary_stem(const std::string& name) {
+  constexpr size_t kNameMax = 255;
+  constexpr size_t kDecoration = 1 + 5 + 10 + 1 + 6;  // ".", ".tmp-", a pid, "-", XXXXXX
+  if (name.size() + kDecoration <= kNameMax) return name;
+  std::uint64_t h = kFnv1aOffset;
+  fnv1a(h, name.data(), name.size());
+  char hash[18];
+  std::snprintf(hash, sizeof hash, "~%016llx", static_cast<unsigned long long>(h));
+  return name.substr(0, kNameMax - kDecoration - 17) + hash;
+}
+
+// Removes ".NAME.tmp-PID-*" files in dir left by writers that no longer run (killed by SIGKILL
+// or a power cut); a running writer's file is kept.
+void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& name) {
+  namespace fs = std::filesystem;
+  const std::string prefix = "." + temporary_stem(name) + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    if (f.rfind(prefix, 0) != 0) continue;
+    const std::string rest = f.substr(prefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == std::string::npos || dash == 0) continue;
+    char* stop = nullptr;
+    const long pid = std::strtol(rest.c_str(), &stop, 10);
+    if (stop != rest.c_str() + dash || pid <= 0) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // still running
+    fs::remove(it->path(), ec);
+  }
+}
+
+}  // namespace
+
+void install_temporary_file_cleanup() {
+  struct sigaction sa {};
+  sa.sa_handler = remove_temporaries_and_reraise;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(sig, &sa, nullptr);
+}
+
+AtomicOutputFile::AtomicOutputFile(const std::string& path) : path_(path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  MQ_CHECK(!target.filename().empty(), InvalidInput, path, ": not a file name");
+  std::error_code ec;
+  MQ_CHECK(!fs::is_directory(target, ec), InvalidInput, path, ": is a directory");
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  remove_stale_temporaries(dir, target.filename().string());
+  std::string pattern =
+      (dir / ("." + temporary_stem(target.filename().string()) + ".tmp-" +
+              std::to_string(::getpid()) + "-XXXXXX"))
+          .string();
+  const int fd = ::mkstemp(pattern.data());
+  if (fd < 0)
+    MQ_THROW(Error, path, ": cannot write: cannot create a file in '", dir.string(),
+             "': ", std::strerror(errno));
+  temp_ = pattern;
+  slot_ = claim_slot(temp_);
+  // mkstemp creates 0600; keep an existing file's mode, else the usual 0644.
+  struct stat st;
+  const mode_t mode = ::stat(path.c_str(), &st) == 0 ? (st.st_mode & 07777) : 0644;
+  ::fchmod(fd, mode);
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    ::close(fd);
+    std::remove(temp_.c_str());
+    release_slot(slot_);
+    MQ_THROW(Error, path, ": cannot write: ", std::strerror(errno));
+  }
+  buffer_.resize(kChunk + kSlack);
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (file_) std::fclose(file_);
+  if (!committed_) std::remove(temp_.c_str());
+  release_slot(slot_);
+}
+
+void AtomicOutputFile::commit_bytes(char* end) {
+  used_ = static_cast<size_t>(end - buffer_.data());
+  if (used_ >= kChunk) flush();
+}
+
+void AtomicOutputFile::append(const char* s, size_t n) {
+  if (used_ + n > buffer_.size()) flush();
+  if (n > buffer_.size()) {
+    write_raw(s, n);
+    return;
+  }
+  std::memcpy(buffer_.data() + used_, s, n);
+  used_ += n;
+}
+
+void AtomicOutputFile::finish() {
+  if (!file_) return;
+  flush();
+  const bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
+  const int err = errno;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed) MQ_THROW(Error, path_, ": cannot write: ", std::strerror(ok ? errno : err));
+}
+
+void commit_together(AtomicOutputFile& first, AtomicOutputFile& second) {
+  namespace fs = std::filesystem;
+  first.finish();
+  second.finish();
+  const fs::path dir = fs::path(second.path_).has_parent_path()
+                           ? fs::path(second.path_).parent_path()
+                           : fs::path(".");
+  // flock on the directory itself: no lock file to leave behind; released by close().
+  const int lock = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock >= 0) ::flock(lock, LOCK_EX);
+  struct Unlock {
+    int fd;
+    ~Unlock() {
+      if (fd >= 0) ::close(fd);
+    }
+  } unlock{lock};
+  // A hard link keeps first's old file while first's new one takes its name.
+  const std::string kept = first.temp_ + "-old";
+  const bool had_old = ::link(first.path_.c_str(), kept.c_str()) == 0;
+  if (std::rename(first.temp_.c_str(), first.path_.c_str()) != 0) {
+    const int err = errno;
+    if (had_old) ::unlink(kept.c_str());
+    MQ_THROW(Error, first.path_, ": cannot write: rename failed: ", std::strerror(err));
+  }
+  first.committed_ = true;
+  release_slot(first.slot_);
+  first.slot_ = -1;
+  if (std::rename(second.temp_.c_str(), second.path_.c_str()) != 0) {
+    const int err = errno;
+    if (had_old)
+      std::rename(kept.c_str(), first.path_.c_str());
+    else
+      ::unlink(first.path_.c_str());
+    MQ_THROW(Error, second.path_, ": cannot write: rename failed: ", std::strerror(err),
+             " (", first.path_, " left as it was)");
+  }
+  if (had_old) ::unlink(kept.c_str());
+  second.committed_ = true;
+  release_slot(second.slot_);
+  second.slot_ = -1;
+}
+
+void AtomicOutputFile::commit() {
+  finish();
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+    MQ_THROW(Error, path_, ": cannot write: rename failed: ", std::strerror(errno));
+  committed_ = true;
+  release_slot(slot_);  // the name is the output's now: a signal must not remove it
+  slot_ = -1;
+}
+
+void AtomicOutputFile::flush() {
+  write_raw(buffer_.data(), used_);
+  used_ = 0;
+}
+
+void AtomicOutputFile::write_raw(const char* s, size_t n) {
+  if (n > 0 && std::fwrite(s, 1, n, file_) != n)
+    MQ_THROW(Error, path_, ": cannot write: ", std::strerror(errno));
+}
+
+void write_file_atomically(const std::string& path, std::string_view bytes) {
+  AtomicOutputFile out(path);
+  out.append(bytes);
+  out.commit();
+}
+
+}  // namespace mq

@@ -1,0 +1,93 @@
+#include "core/mesh/corner_normals.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/common/errors.h"
+
+namespace mq {
+namespace {
+constexpr long kMaxValence = 256;
+}  // namespace
+
+CornerNormals corner_normals(const MatrixX3d& V, const MatrixX3i& F, double crease_degrees) {
+  MQ_CHECK(crease_degrees >= 0 && crease_degrees <= 180, InvalidInput,
+           "the crease angle must be in [0, 180] degrees, got ", crease_degrees);
+  const Eigen::Index nv = V.rows(), nf = F.rows();
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k)
+      MQ_CHECK(F(f, k) >= 0 && F(f, k) < nv, InvalidInput, "face ", f, " has vertex index ",
+               F(f, k), " out of range (", nv, " vertices)");
+  // Area-weighted (twice the area) and unit face normals.
+  MatrixX3d W(nf, 3), U(nf, 3);
+  tbb::parallel_for(Eigen::Index(0), nf, [&](Eigen::Index f) {
+    const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Vector3d w = (b - a).cross(c - a);
+    W.row(f) = w.transpose();
+    const double len = w.norm();
+    U.row(f) = (len > 0 ? Vector3d(w / len) : Vector3d::Zero()).transpose();
+  });
+  // Faces around each vertex (CSR), in face order.
+  std::vector<int> start(static_cast<size_t>(nv) + 1, 0), faces(static_cast<size_t>(3 * nf));
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) ++start[static_cast<size_t>(F(f, k)) + 1];
+  for (size_t v = 0; v < static_cast<size_t>(nv); ++v) start[v + 1] += start[v];
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (Eigen::Index f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) faces[static_cast<size_t>(fill[F(f, k)]++)] = static_cast<int>(f);
+  }
+  // 180 degrees must take every face, even exactly opposite ones.
+  const double min_cos =
+      crease_degrees >= 180 ? -2.0 : std::cos(crease_degrees * M_PI / 180.0);
+  // Per vertex: its distinct corner normals, numbered locally; FN holds local numbers first.
+  std::vector<std::vector<Vector3d>> local(static_cast<size_t>(nv));
+  MatrixX3i FN(nf, 3);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, nv), [&](const auto& range) {
+    for (Eigen::Index v = range.begin(); v != range.end(); ++v) {
+      const int* b = faces.data() + start[static_cast<size_t>(v)];
+      const int* e = faces.data() + start[static_cast<size_t>(v) + 1];
+      Vector3d all = Vector3d::Zero();
+      for (const int* g = b; g != e; ++g) all += W.row(*g).transpose();
+      std::vector<Vector3d>& mine = local[static_cast<size_t>(v)];
+      for (const int* f = b; f != e; ++f) {
+        Vector3d n = Vector3d::Zero();
+        const Vector3d uf = U.row(*f).transpose();
+        // Past kMaxValence faces the quadratic test is skipped (one smooth normal): a huge fan
+        // must not make writing a file quadratic.
+        if (uf.squaredNorm() > 0 && e - b <= kMaxValence)
+          for (const int* g = b; g != e; ++g)
+            if (uf.dot(U.row(*g).transpose()) >= min_cos) n += W.row(*g).transpose();
+        if (!(n.norm() > 0)) n = all;
+        n = n.norm() > 0 ? Vector3d(n.normalized()) : Vector3d::UnitZ();
+        int id = -1;
+        for (size_t i = 0; i < mine.size() && id < 0; ++i)
+          if (mine[i] == n) id = static_cast<int>(i);
+        if (id < 0) {
+          id = static_cast<int>(mine.size());
+          mine.push_back(n);
+        }
+        for (int k = 0; k < 3; ++k)
+          if (F(*f, k) == v) FN(*f, k) = id;  // a face repeating v takes one normal for both
+      }
+    }
+  });
+  // Global numbering in vertex order.
+  std::vector<int> first(static_cast<size_t>(nv) + 1, 0);
+  for (size_t v = 0; v < static_cast<size_t>(nv); ++v)
+    first[v + 1] = first[v] + static_cast<int>(local[v].size());
+  CornerNormals out;
+  out.N.resize(first.back(), 3);
+  for (size_t v = 0; v < static_cast<size_t>(nv); ++v)
+    for (size_t i = 0; i < local[v].size(); ++i)
+      out.N.row(first[v] + static_cast<int>(i)) = local[v][i].transpose();
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) FN(f, k) += first[static_cast<size_t>(F(f, k))];
+  out.FN = std::move(FN);
+  return out;
+}
+
+}  // namespace mq

@@ -1,0 +1,382 @@
+#include "core/mesh/mesh_intersections.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "core/common/errors.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_topology.h"
+
+namespace mq {
+namespace {
+
+int sign(double x) { return (x > 0) - (x < 0); }
+
+// Sign of det[b-a, c-a, d-a]: positive when d lies on the side of plane abc that its
+// counter-clockwise normal points to.
+int orient3d(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& d) {
+  return sign((b - a).cross(c - a).dot(d - a));
+}
+
+int orient2d(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+  return sign((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x()));
+}
+
+// Is c, known collinear with segment ab, within its bounding box (hence on the segment)?
+bool on_segment(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+  return std::min(a.x(), b.x()) <= c.x() && c.x() <= std::max(a.x(), b.x()) &&
+         std::min(a.y(), b.y()) <= c.y() && c.y() <= std::max(a.y(), b.y());
+}
+
+bool segments_intersect_2d(const Vector2d& p1, const Vector2d& p2, const Vector2d& q1,
+                           const Vector2d& q2) {
+  const int d1 = orient2d(p1, p2, q1), d2 = orient2d(p1, p2, q2);
+  const int d3 = orient2d(q1, q2, p1), d4 = orient2d(q1, q2, p2);
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  return (d1 == 0 && on_segment(p1, p2, q1)) || (d2 == 0 && on_segment(p1, p2, q2)) ||
+         (d3 == 0 && on_segment(q1, q2, p1)) || (d4 == 0 && on_segment(q1, q2, p2));
+}
+
+// Closed point-in-triangle test; the triangle may have either orientation.
+bool point_in_triangle_2d(const Vector2d& p, const Vector2d& a, const Vector2d& b,
+                          const Vector2d& c) {
+  const int s1 = orient2d(a, b, p), s2 = orient2d(b, c, p), s3 = orient2d(c, a, p);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3<0, has_pos = s1> 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+// Index of the axis dropped when projecting onto the plane with normal n.
+int dominant_axis(const Vector3d& n) {
+  int k = 0;
+  n.cwiseAbs().maxCoeff(&k);
+  return k;
+}
+
+Vector2d project(const Vector3d& p, int drop) {
+  return drop == 0   ? Vector2d(p.y(), p.z())
+         : drop == 1 ? Vector2d(p.z(), p.x())
+                     : Vector2d(p.x(), p.y());
+}
+
+// Plane normal for the coplanar tests: of the first triangle, or the second if it is degenerate.
+int coplanar_axis(const Vector3d& a0, const Vector3d& a1, const Vector3d& a2, const Vector3d& b0,
+                  const Vector3d& b1, const Vector3d& b2) {
+  Vector3d n = (a1 - a0).cross(a2 - a0);
+  if (n.squaredNorm() == 0) n = (b1 - b0).cross(b2 - b0);
+  return dominant_axis(n);
+}
+
+bool coplanar_triangles_intersect(const std::array<Vector2d, 3>& a,
+                                  const std::array<Vector2d, 3>& b) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (segments_intersect_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3])) return true;
+  return point_in_triangle_2d(a[0], b[0], b[1], b[2]) ||
+         point_in_triangle_2d(b[0], a[0], a[1], a[2]);
+}
+
+// Closed segment pq against closed triangle abc.
+bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vector3d& a,
+                                const Vector3d& b, const Vector3d& c) {
+  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+  if (op * oq > 0) return false;
+  // The predicates are not exact: a segment in a tilted plane with the triangle (the fan that
+  // caps a thread's end) gets signs from rounding, and the line test below then reports
+  // sectors of the fan on opposite sides of its centre as overlapping. Within a relative 1e-9
+  // of the plane the segment is taken to lie in it.
+  const Vector3d n = (b - a).cross(c - a);
+  const double tolerance =
+      1e-9 * n.norm() * std::max({(q - p).norm(), (b - a).norm(), (c - a).norm(), (c - b).norm()});
+  const bool in_plane = (op == 0 && oq == 0) || (std::abs(n.dot(p - a)) <= tolerance &&
+                                                 std::abs(n.dot(q - a)) <= tolerance);
+  if (in_plane) {  // segment in the triangle's plane
+    const int k = dominant_axis(n);
+    const Vector2d p2 = project(p, k), q2 = project(q, k);
+    const Vector2d a2 = project(a, k), b2 = project(b, k), c2 = project(c, k);
+    return point_in_triangle_2d(p2, a2, b2, c2) || segments_intersect_2d(p2, q2, a2, b2) ||
+           segments_intersect_2d(p2, q2, b2, c2) || segments_intersect_2d(p2, q2, c2, a2);
+  }
+  // The segment meets the plane in one point; it is in the triangle iff the line pq passes
+  // on the same side of all three edges.
+  const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+  const bool has_neg = s1 < 0 || s2 < 0 || s3<0, has_pos = s1> 0 || s2 > 0 || s3 > 0;
+  return !(has_neg && has_pos);
+}
+
+// Face pair test with combinatorial sharing taken into account (see IntersectionOptions).
+bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
+  std::array<int, 3> shared_f{}, shared_g{};
+  int num_shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (F(f, i) == F(g, j)) {
+        shared_f[num_shared] = i;
+        shared_g[num_shared] = j;
+        ++num_shared;
+      }
+  const auto P = [&](int face, int k) -> Vector3d { return V.row(F(face, k)).transpose(); };
+  if (num_shared == 0)
+    return triangles_intersect(P(f, 0), P(f, 1), P(f, 2), P(g, 0), P(g, 1), P(g, 2));
+  if (num_shared >= 3) return true;  // duplicated face
+  if (num_shared == 2) {
+    // Non-coplanar faces sharing an edge meet only along it; coplanar ones overlap iff
+    // their opposite vertices lie on the same side of the edge (a fold-over).
+    const int u = shared_f[0], v = shared_f[1];
+    const int a = 3 - u - v, b = 3 - shared_g[0] - shared_g[1];
+    // Coplanar within the same relative 1e-9 as segment_triangle_intersect's.
+    const Vector3d n = (P(f, v) - P(f, u)).cross(P(f, a) - P(f, u));
+    const double scale = std::max(
+        {(P(f, v) - P(f, u)).norm(), (P(f, a) - P(f, u)).norm(), (P(g, b) - P(f, u)).norm()});
+    if (std::abs(n.dot(P(g, b) - P(f, u))) > 1e-9 * n.norm() * scale) return false;
+    const int k = dominant_axis((P(f, 1) - P(f, 0)).cross(P(f, 2) - P(f, 0)));
+    const Vector2d u2 = project(P(f, u), k), v2 = project(P(f, v), k);
+    return orient2d(u2, v2, project(P(f, a), k)) * orient2d(u2, v2, project(P(g, b), k)) > 0;
+  }
+  // One shared vertex s: the (convex) intersection contains s, and it contains more iff the
+  // edge opposite s of one face meets the other face.
+  const int fa = (shared_f[0] + 1) % 3, fb = (shared_f[0] + 2) % 3;
+  const int ga = (shared_g[0] + 1) % 3, gb = (shared_g[0] + 2) % 3;
+  return segment_triangle_intersect(P(f, fa), P(f, fb), P(g, 0), P(g, 1), P(g, 2)) ||
+         segment_triangle_intersect(P(g, ga), P(g, gb), P(f, 0), P(f, 1), P(f, 2));
+}
+
+// Shared implementation: when label is given, only pairs with different labels are tested, or
+// with same_label only pairs with the same label.
+// active (optional, #F): only pairs with at least one active face are tested.
+std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i& F,
+                                            const std::vector<int>* label, bool stop_at_first,
+                                            bool same_label = false,
+                                            const std::vector<char>* active = nullptr) {
+  const int nf = static_cast<int>(F.rows());
+  std::vector<std::pair<int, int>> result;
+  if (nf == 0) return result;
+  MQ_CHECK(V.allFinite(), InvalidInput, "intersection test: vertex positions are not finite");
+  MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+
+  // Face bounding boxes (double, for the grid).
+  MatrixX3d lo(nf, 3), hi(nf, 3);
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
+    for (int f = r.begin(); f != r.end(); ++f) {
+      lo.row(f) = V.row(F(f, 0)).cwiseMin(V.row(F(f, 1))).cwiseMin(V.row(F(f, 2)));
+      hi.row(f) = V.row(F(f, 0)).cwiseMax(V.row(F(f, 1))).cwiseMax(V.row(F(f, 2)));
+    }
+  });
+  const Vector3d gmin = lo.colwise().minCoeff().transpose();
+  const Vector3d gext = (hi.colwise().maxCoeff().transpose() - gmin);
+
+  // Cell size: the mean face box size, enlarged if the grid would have too many cells.
+  double h = (hi - lo).rowwise().maxCoeff().mean();
+  if (!(h > 0)) h = std::max(gext.maxCoeff(), 1.0);
+  const double max_cells = 4.0 * nf + 64.0;
+  std::array<int, 3> n{};
+  for (;;) {
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      n[k] = std::max(1, static_cast<int>(std::ceil(gext[k] / h)));
+      cells *= n[k];
+    }
+    if (cells <= max_cells) break;
+    h *= 1.25;
+  }
+  const auto cell_coord = [&](double x, int k) {
+    return std::clamp(static_cast<int>(std::floor((x - gmin[k]) / h)), 0, n[k] - 1);
+  };
+  const auto cell_index = [&](int i, int j, int k) { return (k * n[1] + j) * n[0] + i; };
+
+  // What the narrow phase reads of a candidate, in one cache line: its box rounded outward to
+  // float (a quick, conservative rejection; the exact test decides), its first cell, its label.
+  struct Candidate {
+    float lo[3], hi[3];
+    int c0[3], c1[3];
+    int label;
+  };
+  std::vector<Candidate> box(static_cast<size_t>(nf));
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
+    for (int f = r.begin(); f != r.end(); ++f) {
+      Candidate& c = box[static_cast<size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        float l = static_cast<float>(lo(f, k)), u = static_cast<float>(hi(f, k));
+        if (static_cast<double>(l) > lo(f, k))
+          l = std::nextafter(l, -std::numeric_limits<float>::infinity());
+        if (static_cast<double>(u) < hi(f, k))
+          u = std::nextafter(u, std::numeric_limits<float>::infinity());
+        c.lo[k] = l;
+        c.hi[k] = u;
+        c.c0[k] = cell_coord(lo(f, k), k);
+        c.c1[k] = cell_coord(hi(f, k), k);
+      }
+      c.label = label ? (*label)[static_cast<size_t>(f)] : 0;
+    }
+  });
+
+  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order).
+  const int num_cells = n[0] * n[1] * n[2];
+  std::vector<int> offsets(num_cells + 1, 0);
+  for (int f = 0; f < nf; ++f) {
+    const Candidate& c = box[static_cast<size_t>(f)];
+    for (int k = c.c0[2]; k <= c.c1[2]; ++k)
+      for (int j = c.c0[1]; j <= c.c1[1]; ++j)
+        for (int i = c.c0[0]; i <= c.c1[0]; ++i) ++offsets[cell_index(i, j, k) + 1];
+  }
+  for (int c = 0; c < num_cells; ++c) offsets[c + 1] += offsets[c];
+  std::vector<int> members(offsets.back());
+  {
+    std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
+    for (int f = 0; f < nf; ++f) {
+      const Candidate& c = box[static_cast<size_t>(f)];
+      for (int k = c.c0[2]; k <= c.c1[2]; ++k)
+        for (int j = c.c0[1]; j <= c.c1[1]; ++j)
+          for (int i = c.c0[0]; i <= c.c1[0]; ++i) members[cursor[cell_index(i, j, k)]++] = f;
+    }
+  }
+
+  // Narrow phase per face f against later faces g; a pair is tested only in the cell holding
+  // the min corner of the intersection of the two boxes (per axis the larger of their first
+  // cells), so it is tested once. With an active set, a pair is tested by its active face (the
+  // first, if both are).
+  // Found per block of faces (a vector per face would zero 24 bytes per face for nothing),
+  // joined in block order: the same pairs in the same order whatever the threads.
+  constexpr int kBlock = 4096;
+  const int blocks = (nf + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::pair<int, int>>> found(static_cast<size_t>(blocks));
+  tbb::parallel_for(0, blocks, [&](int block) {
+    std::vector<std::pair<int, int>>& out = found[static_cast<size_t>(block)];
+    std::vector<int> hits;
+    for (int f = block * kBlock, end = std::min(nf, f + kBlock); f < end; ++f) {
+      if (active && !(*active)[f]) continue;
+      hits.clear();
+      const Candidate a = box[static_cast<size_t>(f)];
+      for (int k = a.c0[2]; k <= a.c1[2]; ++k)
+        for (int j = a.c0[1]; j <= a.c1[1]; ++j)
+          for (int i = a.c0[0]; i <= a.c1[0]; ++i) {
+            const int c = cell_index(i, j, k);
+            for (int m = offsets[c]; m < offsets[c + 1]; ++m) {
+              const int g = members[m];
+              if (g == f || (g < f && (!active || (*active)[g]))) continue;
+              const Candidate& b = box[static_cast<size_t>(g)];
+              if (label && (a.label == b.label) != same_label) continue;
+              if (a.lo[0] > b.hi[0] || b.lo[0] > a.hi[0] || a.lo[1] > b.hi[1] ||
+                  b.lo[1] > a.hi[1] || a.lo[2] > b.hi[2] || b.lo[2] > a.hi[2])
+                continue;
+              if (std::max(a.c0[0], b.c0[0]) != i || std::max(a.c0[1], b.c0[1]) != j ||
+                  std::max(a.c0[2], b.c0[2]) != k)
+                continue;
+              if (faces_intersect(V, F, f, g)) hits.push_back(g);
+            }
+          }
+      std::sort(hits.begin(), hits.end());
+      for (const int g : hits) out.emplace_back(std::min(f, g), std::max(f, g));
+    }
+  });
+  for (const auto& block : found) {
+    result.insert(result.end(), block.begin(), block.end());
+    if (stop_at_first && !result.empty()) {
+      result.resize(1);
+      break;
+    }
+  }
+  if (active) std::sort(result.begin(), result.end());
+  return result;
+}
+
+}  // namespace
+
+bool triangles_intersect(const Vector3d& a0, const Vector3d& a1, const Vector3d& a2,
+                         const Vector3d& b0, const Vector3d& b1, const Vector3d& b2) {
+  // Separating planes: all of one triangle strictly on one side of the other's plane.
+  const int da0 = orient3d(b0, b1, b2, a0), da1 = orient3d(b0, b1, b2, a1),
+            da2 = orient3d(b0, b1, b2, a2);
+  if ((da0 > 0 && da1 > 0 && da2 > 0) || (da0 < 0 && da1 < 0 && da2 < 0)) return false;
+  const int db0 = orient3d(a0, a1, a2, b0), db1 = orient3d(a0, a1, a2, b1),
+            db2 = orient3d(a0, a1, a2, b2);
+  if ((db0 > 0 && db1 > 0 && db2 > 0) || (db0 < 0 && db1 < 0 && db2 < 0)) return false;
+  if ((da0 == 0 && da1 == 0 && da2 == 0) || (db0 == 0 && db1 == 0 && db2 == 0)) {
+    const int k = coplanar_axis(a0, a1, a2, b0, b1, b2);
+    return coplanar_triangles_intersect({project(a0, k), project(a1, k), project(a2, k)},
+                                        {project(b0, k), project(b1, k), project(b2, k)});
+  }
+  // Non-coplanar: both meet the line of the two planes in an interval; the intervals overlap
+  // iff an endpoint of one, which lies on an edge of its triangle, is inside the other.
+  return segment_triangle_intersect(a0, a1, b0, b1, b2) ||
+         segment_triangle_intersect(a1, a2, b0, b1, b2) ||
+         segment_triangle_intersect(a2, a0, b0, b1, b2) ||
+         segment_triangle_intersect(b0, b1, a0, a1, a2) ||
+         segment_triangle_intersect(b1, b2, a0, a1, a2) ||
+         segment_triangle_intersect(b2, b0, a0, a1, a2);
+}
+
+std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
+                                                         const IntersectionOptions& options) {
+  if (!options.between_components_only) return find_pairs(V, F, nullptr, false);
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+  std::vector<int> component;
+  connected_components(F, static_cast<int>(V.rows()), component);
+  return find_pairs(V, F, &component, false);
+}
+
+std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
+                                                                  const MatrixX3i& F,
+                                                                  const std::vector<char>& active) {
+  MQ_CHECK(static_cast<Eigen::Index>(active.size()) == F.rows(), InvalidInput,
+           "intersection test: ", active.size(), " active flags for ", F.rows(), " faces");
+  return find_pairs(V, F, nullptr, false, false, &active);
+}
+
+std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+  std::vector<int> component;
+  connected_components(F, static_cast<int>(V.rows()), component);
+  std::vector<int> result;
+  for (const auto& [f, g] : find_pairs(V, F, &component, false, true))
+    result.push_back(component[f]);
+  std::sort(result.begin(), result.end());
+  result.erase(std::unique(result.begin(), result.end()), result.end());
+  return result;
+}
+
+bool meshes_intersect(const TriMesh& A, const TriMesh& B) {
+  MQ_CHECK(A.F.rows() == 0 || (A.F.minCoeff() >= 0 && A.F.maxCoeff() < A.V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", A.V.rows(), ")");
+  MQ_CHECK(B.F.rows() == 0 || (B.F.minCoeff() >= 0 && B.F.maxCoeff() < B.V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", B.V.rows(), ")");
+  MQ_CHECK(A.V.allFinite() && B.V.allFinite(), InvalidInput,
+           "intersection test: vertex positions are not finite");
+  if (A.F.rows() == 0 || B.F.rows() == 0) return false;
+  // Only faces whose boxes meet the other mesh's box can take part in an intersection; for two
+  // long elements crossing once that is a small part of each.
+  const auto face_box = [](const TriMesh& M, int f, Vector3d& lo, Vector3d& hi) {
+    lo = M.V.row(M.F(f, 0)).cwiseMin(M.V.row(M.F(f, 1))).cwiseMin(M.V.row(M.F(f, 2))).transpose();
+    hi = M.V.row(M.F(f, 0)).cwiseMax(M.V.row(M.F(f, 1))).cwiseMax(M.V.row(M.F(f, 2))).transpose();
+  };
+  const auto faces_meeting = [&](const TriMesh& M, const Vector3d& lo, const Vector3d& hi) {
+    std::vector<int> faces;
+    for (int f = 0; f < M.F.rows(); ++f) {
+      Vector3d flo, fhi;
+      face_box(M, f, flo, fhi);
+      if ((flo.array() <= hi.array()).all() && (lo.array() <= fhi.array()).all())
+        faces.push_back(f);
+    }
+    return faces;
+  };
+  const BoundingBox box_a = bounding_box(A.V, A.F), box_b = bounding_box(B.V, B.F);
+  const std::vector<int> fa = faces_meeting(A, box_b.min, box_b.max);
+  if (fa.empty()) return false;
+  const std::vector<int> fb = faces_meeting(B, box_a.min, box_a.max);
+  if (fb.empty()) return false;
+  TriMesh both = extract_faces(A, fa);
+  const int num_a = static_cast<int>(both.F.rows());
+  append_mesh(both, extract_faces(B, fb));
+  std::vector<int> label(both.F.rows(), 1);
+  std::fill(label.begin(), label.begin() + num_a, 0);
+  return !find_pairs(both.V, both.F, &label, true).empty();
+}
+
+}  // namespace mq

@@ -1,0 +1,302 @@
+#include "core/planar/planar_quilting.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+
+#include "core/common/errors.h"
+#include "core/mesh/embree_device.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/patch_quilting.h"
+#include "core/planar/swatch_symmetry.h"
+#include "core/planar/synthesis_grid.h"
+
+namespace mq {
+
+namespace {
+
+// The growing output: elements with a per-cell index of their footprints for local queries.
+class OutputStore final : public PatchOutput {
+ public:
+  explicit OutputStore(const SynthesisGrid& grid) : grid_(grid), cells_(grid.num_cells()) {}
+
+  const Element& element(int id) const override { return elements_[id]; }
+  std::vector<int> elements_near(const Vector2d& lo, const Vector2d& hi) const override {
+    return query(lo, hi);
+  }
+  int add(Element e) override {
+    const int id = static_cast<int>(elements_.size());
+    elements_.push_back(std::move(e));
+    alive_.push_back(1);
+    index(id);
+    return id;
+  }
+  void replace(int id, Element e) override {
+    elements_[id] = std::move(e);
+    index(id);
+  }
+  void remove(int id) override { alive_[id] = 0; }
+  bool alive(int id) const override { return alive_[id] != 0; }
+  const Element& operator[](int id) const { return elements_[id]; }
+  const std::vector<Element>& elements() const { return elements_; }
+  int size() const { return static_cast<int>(elements_.size()); }
+
+  // Alive elements whose footprint box meets [lo, hi], ascending ids.
+  std::vector<int> query(const Vector2d& lo, const Vector2d& hi) const {
+    std::vector<int> ids;
+    const Cell a = clamp(grid_.cell_of(lo.x(), lo.y())), b = clamp(grid_.cell_of(hi.x(), hi.y()));
+    for (int y = a.y; y <= b.y; ++y)
+      for (int x = a.x; x <= b.x; ++x)
+        for (const int id : cells_[grid_.index({x, y})]) ids.push_back(id);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    std::vector<int> result;
+    for (const int id : ids) {
+      const Element& e = elements_[id];
+      if (alive_[id] && e.lo.x() <= hi.x() && e.hi.x() >= lo.x() && e.lo.y() <= hi.y() &&
+          e.hi.y() >= lo.y())
+        result.push_back(id);
+    }
+    return result;
+  }
+
+ private:
+  Cell clamp(Cell c) const {
+    return {std::clamp(c.x, 0, grid_.nx() - 1), std::clamp(c.y, 0, grid_.ny() - 1)};
+  }
+  void index(int id) {
+    const Element& e = elements_[id];
+    const Cell a = clamp(grid_.cell_of(e.lo.x(), e.lo.y()));
+    const Cell b = clamp(grid_.cell_of(e.hi.x(), e.hi.y()));
+    for (int y = a.y; y <= b.y; ++y)
+      for (int x = a.x; x <= b.x; ++x) {
+        auto& list = cells_[grid_.index({x, y})];
+        if (list.empty() || list.back() != id) list.push_back(id);
+      }
+  }
+
+  const SynthesisGrid& grid_;
+  std::vector<Element> elements_;
+  std::vector<unsigned char> alive_;
+  std::vector<std::vector<int>> cells_;
+};
+
+void validate(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
+  MQ_CHECK(std::isfinite(o.length) && std::isfinite(o.width) && o.length > 0 && o.width > 0,
+           InvalidInput, "the output size must be positive and finite, got ", o.length, " x ",
+           o.width);
+  MQ_CHECK(o.cell_size == 0 || (std::isfinite(o.cell_size) && o.cell_size > 0), InvalidInput,
+           "the cell size must be positive, got ", o.cell_size);
+  MQ_CHECK(o.subpatch_fraction > 0 && o.subpatch_fraction <= 1, InvalidInput,
+           "the sub-patch fraction must lie in (0, 1], got ", o.subpatch_fraction);
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const Element& e : s.elements)
+    smallest = std::min(smallest, std::max(e.hi.x() - e.lo.x(), e.hi.y() - e.lo.y()));
+  MQ_CHECK(smallest <= std::max(o.length, o.width), InvalidInput,
+           "every element of the swatch is larger than the requested ", o.length, " x ", o.width,
+           " domain (smallest element spans ", smallest, ")");
+  // Output size estimate, to refuse jobs that cannot fit before any work.
+  const double faces = estimated_plane_faces(s, o.length, o.width);
+  MQ_CHECK(faces <= o.max_faces, InvalidInput, "a ", o.length, " x ", o.width,
+           " layer of this swatch would have about ", faces, " faces, more than the limit of ",
+           o.max_faces, " (--max-faces); choose a smaller size");
+}
+
+}  // namespace
+
+double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width) {
+  const double sx = swatch.size.x(), sy = swatch.size.y();
+  return static_cast<double>(swatch.mesh.F.rows()) * std::max(length, sx) * std::max(width, sy) /
+         (sx * sy);
+}
+
+double matching_cell_size(const PreparedSwatch& s) {
+  // Half an element across, but at least 8 cells along the swatch's shorter side so the
+  // sub-patch and the offsets have room.
+  const double shorter = std::min(s.size.x(), s.size.y());
+  return std::min(0.5 * s.mean_element_diameter, shorter / 8.0);
+}
+
+TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& options,
+                    TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats_out,
+                    ProgressSink* progress) {
+  PlanarQuiltingStats stats;
+  StageTimes& times = stats.times;
+  PreparedSwatch swatch;
+  {
+    ScopedStageTimer timer(times, "prepare");
+    swatch = prepare_swatch(swatch_mesh);
+    validate(swatch, options);
+  }
+  const double cell = options.cell_size > 0 ? options.cell_size : matching_cell_size(swatch);
+  MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ", cell,
+           " is larger than the swatch's footprint");
+  // The grid and the swatch in cells bound the memory of the grid and the offsets each match
+  // searches (every swatch cell is a candidate offset): the default cell gives at most a few
+  // hundred thousand and a few hundred.
+  const double cells_estimate = std::ceil(options.length / cell) * std::ceil(options.width / cell);
+  MQ_CHECK(cells_estimate <= double(1 << 24), InvalidInput, "the grid would have ", cells_estimate,
+           " cells of size ", cell, " (at most ", 1 << 24, "); use a larger --cell");
+  const double swatch_cells =
+      std::floor(swatch.size.x() / cell) * std::floor(swatch.size.y() / cell);
+  MQ_CHECK(swatch_cells <= double(1 << 16), InvalidInput, "a cell of ", cell,
+           " divides the swatch into ", swatch_cells, " cells (at most ", 1 << 16,
+           "), too many offsets to match; use a larger --cell");
+  SynthesisGrid grid(Vector2d::Zero(), cell, static_cast<int>(std::ceil(options.length / cell)),
+                     static_cast<int>(std::ceil(options.width / cell)));
+  stats.cell_size = cell;
+  stats.grid_nx = grid.nx();
+  stats.grid_ny = grid.ny();
+  const int swatch_cells_x = static_cast<int>(std::floor(swatch.size.x() / cell + 1e-9));
+  const int swatch_cells_y = static_cast<int>(std::floor(swatch.size.y() / cell + 1e-9));
+  // The swatch must be able to shift by a period of its texture and still cover the
+  // sub-patch, or no placement continues a lattice: the range of offsets (swatch cells minus
+  // window) is kept at least a period along each axis. Half the 3 x 3 chain mail sheet left
+  // 2.37 of its 2.5 period along x: a 20 x 20 plane had 93% of interior rings with their 4
+  // links, 100% with this bound.
+  int window = std::max(1, std::min({static_cast<int>(options.subpatch_fraction *
+                                                      std::min(swatch_cells_x, swatch_cells_y)),
+                                     swatch_cells_x, swatch_cells_y}));
+  const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
+
+  std::unique_ptr<SwatchFaceTree> swatch_tree;
+  const EmbreeDevice embree;  // for the merging's temporary BVHs
+  LaplacianTopologyCache laplacians;
+  {
+    ScopedStageTimer timer(times, "prepare");
+    swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
+    laplacians = swatch_topologies(swatch);
+    const Vector2d period = axis_periods(swatch, *swatch_tree, cell);
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!(period(axis) > 0)) continue;
+      const int cells = axis == 0 ? swatch_cells_x : swatch_cells_y;
+      window = std::max(
+          1, std::min(window, cells - static_cast<int>(std::ceil(period(axis) / cell - 1e-9))));
+    }
+    stats.window_cells = window;
+  }
+  const SwatchQueries queries{*swatch_tree, embree, laplacians};
+  OutputStore output(grid);
+  std::mt19937_64 rng(options.seed);
+
+  const std::function<bool(const Element&)> in_domain = [&](const Element& e) {
+    return e.hi.x() > domain_lo.x() && e.lo.x() < domain_hi.x() && e.hi.y() > domain_lo.y() &&
+           e.lo.y() < domain_hi.y();
+  };
+  PatchQuiltingOptions patch_options;
+  patch_options.correspondence = options.correspondence;
+  patch_options.merging = options.merging;
+  patch_options.deform = options.deform;
+  // Marks the cells lying entirely inside the patch footprint [lo, hi].
+  auto mark_patch = [&](const Vector2d& lo, const Vector2d& hi) {
+    const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x() / cell - 1e-9)));
+    const int y0 = std::max(0, static_cast<int>(std::ceil(lo.y() / cell - 1e-9)));
+    const int x1 = std::min(grid.nx(), static_cast<int>(std::floor(hi.x() / cell + 1e-9)));
+    const int y1 = std::min(grid.ny(), static_cast<int>(std::floor(hi.y() / cell + 1e-9)));
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) grid.set_processed({x, y});
+  };
+
+  // First patch: the swatch as it is, at the origin.
+  {
+    ScopedStageTimer timer(times, "merging");
+    for (const Element& e : swatch.elements)
+      if (in_domain(e)) {
+        output.add(e);
+        ++stats.counts.added;
+      }
+    mark_patch(Vector2d::Zero(), swatch.size.head<2>());
+    stats.iterations = 1;
+  }
+  report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
+
+  Cell seed;
+  while (grid.next_seed(seed)) {
+    ++stats.iterations;
+    // Step 2 (section 2.4): the sub-patch around the seed and the admissible offsets.
+    const int half = window / 2;
+    const int px0 = std::max(0, std::min(seed.x - half, grid.nx() - window));
+    const int py0 = std::max(0, std::min(seed.y - half, grid.ny() - window));
+    const int px1 = std::min(grid.nx(), px0 + window) - 1,
+              py1 = std::min(grid.ny(), py0 + window) - 1;
+    const Vector2d sub_lo(px0 * cell, py0 * cell), sub_hi((px1 + 1) * cell, (py1 + 1) * cell);
+    const Vector2d t_min = sub_hi - swatch.size.head<2>(), t_max = sub_lo;
+    OffsetChoice choice;
+    {
+      ScopedStageTimer timer(times, "matching");
+      std::vector<const Element*> near;
+      for (const int id : output.query(sub_lo, sub_hi)) near.push_back(&output[id]);
+      MatrixX3d P, NP;
+      gather_subpatch(near, sub_lo, sub_hi, options.match_points, P, NP);
+      const MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
+      MatchingOptions matching = options.matching;
+      matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
+      choice = choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
+      stats.matched_point_offsets += choice.point_offsets;
+    }
+    const Vector3d t = choice.offset;
+    const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
+    const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
+
+    // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
+    quilt_patch(output, swatch, queries, t, region, in_domain, patch_options, stats.counts, times);
+    mark_patch(patch_lo, patch_hi);
+    grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
+    report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
+  }
+
+  // Post-processing: elements outside the domain go; border elements stay whole unless trimmed.
+  std::vector<const Element*> kept;
+  std::vector<Element> trimmed;
+  {
+    ScopedStageTimer timer(times, "post-processing");
+    trimmed.reserve(output.size());
+    for (int id = 0; id < output.size(); ++id) {
+      if (!output.alive(id)) continue;
+      const Element& e = output[id];
+      if (!in_domain(e)) {
+        ++stats.removed_post;
+        continue;
+      }
+      const bool crosses = e.lo.x() < domain_lo.x() || e.lo.y() < domain_lo.y() ||
+                           e.hi.x() > domain_hi.x() || e.hi.y() > domain_hi.y();
+      if (options.trim_border && crosses) {
+        std::vector<int> faces;
+        for (int f = 0; f < e.F.rows(); ++f) {
+          const Vector3d c =
+              (e.V.row(e.F(f, 0)) + e.V.row(e.F(f, 1)) + e.V.row(e.F(f, 2))).transpose() / 3.0;
+          if (c.x() >= domain_lo.x() && c.y() >= domain_lo.y() && c.x() <= domain_hi.x() &&
+              c.y() <= domain_hi.y())
+            faces.push_back(f);
+        }
+        const TriMesh part = extract_faces(e.mesh(), faces);
+        Element t;
+        t.V = part.V;
+        t.F = part.F;
+        t.kind = e.kind;
+        t.update();
+        trimmed.push_back(std::move(t));
+        ++stats.trimmed;
+        continue;
+      }
+      kept.push_back(&e);
+    }
+    for (const Element& e : trimmed) kept.push_back(&e);
+  }
+  TriMesh result = merge_elements(kept);
+  result.kinds = swatch.kinds;
+  // Back to the swatch's own axes (the thickness axis returns to where it was).
+  const Eigen::Matrix3d back = swatch.rotation.transpose();
+  result.V = (result.V * back.transpose()).eval();
+  result.N = (result.N * back.transpose()).eval();
+  report_progress(progress, "quilting", 1, 1);
+  stats.faces = result.num_faces();
+  stats.vertices = result.num_vertices();
+  stats.elements = static_cast<int>(kept.size());
+  if (stats_out) *stats_out = std::move(stats);
+  return result;
+}
+
+}  // namespace mq

@@ -1,0 +1,178 @@
+#include "core/shell/surface_coverage.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/common/errors.h"
+#include "core/mesh/embree_device.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/point_triangle.h"
+#include "core/planar/quilt_elements.h"
+
+namespace mq {
+
+namespace {
+
+// Distance from c to the part of triangle abc in the half-space (x - c) . n >= -below: the
+// closest point of the whole triangle when it lies there; otherwise the constrained closest
+// point lies on the half-space's plane (the distance is convex), so on the segment the plane
+// cuts from the triangle. Infinity when the triangle lies wholly outside the half-space.
+double clipped_distance(const Vector3d& c, const Vector3d& n, double below, const Vector3d& a,
+                        const Vector3d& b, const Vector3d& d) {
+  const Vector3d w = closest_point_barycentric<double>(c, a, b, d);
+  const Vector3d q = w(0) * a + w(1) * b + w(2) * d;
+  if ((q - c).dot(n) >= -below) return (q - c).norm();
+  const Vector3d p[3] = {a, b, d};
+  double s[3];
+  for (int k = 0; k < 3; ++k) s[k] = (p[k] - c).dot(n) + below;  // >= 0 inside
+  Vector3d ends[2];
+  int m = 0;
+  for (int k = 0; k < 3 && m < 2; ++k) {
+    const int j = (k + 1) % 3;
+    if (s[k] >= 0 && s[j] >= 0) continue;
+    if (s[k] >= 0 || s[j] >= 0) {
+      const double t = s[k] / (s[k] - s[j]);
+      ends[m++] = p[k] + t * (p[j] - p[k]);
+    }
+  }
+  if (m == 0) {
+    // Only a vertex touches the plane, or none does.
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k)
+      if (s[k] >= 0) best = std::min(best, (p[k] - c).norm());
+    return best;
+  }
+  if (m == 1) return (ends[0] - c).norm();
+  const Vector3d e = ends[1] - ends[0];
+  const double len2 = e.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((c - ends[0]).dot(e) / len2, 0.0, 1.0) : 0.0;
+  return (ends[0] + t * e - c).norm();
+}
+
+struct Query {
+  const TriMesh* output;
+  Vector3d c, n;
+  double below, radius;
+  bool found = false;
+};
+
+bool visit(RTCPointQueryFunctionArguments* args) {
+  Query& q = *static_cast<Query*>(args->userPtr);
+  if (q.found) return false;
+  const int f = static_cast<int>(args->primID);
+  const MatrixX3d& V = q.output->V;
+  const MatrixX3i& F = q.output->F;
+  const double d = clipped_distance(q.c, q.n, q.below, V.row(F(f, 0)).transpose(),
+                                    V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+  if (!(d <= q.radius)) return false;
+  q.found = true;
+  args->query->radius = 0.0f;  // one is enough: Embree stops descending
+  return true;
+}
+
+}  // namespace
+
+double surface_coverage(const TriMesh& base, const TriMesh& output, double radius, double below) {
+  MQ_CHECK(base.F.rows() > 0, InvalidInput, "coverage: the base has no faces");
+  MQ_CHECK(base.V.allFinite(), InvalidInput, "coverage: the base has non-finite vertices");
+  MQ_CHECK(radius >= 0 && std::isfinite(radius), InvalidInput,
+           "coverage: radius must be finite and >= 0, got ", radius);
+  MQ_CHECK(below >= 0 && std::isfinite(below), InvalidInput,
+           "coverage: below must be finite and >= 0, got ", below);
+  if (output.F.rows() == 0) return 0.0;
+  MQ_CHECK(output.V.allFinite(), InvalidInput, "coverage: the output has non-finite vertices");
+  MQ_CHECK(output.F.minCoeff() >= 0 && output.F.maxCoeff() < output.V.rows(), InvalidInput,
+           "coverage: an output face index is out of range");
+  const EmbreeDevice device;
+  RTCScene scene = rtcNewScene(device.get());
+  device.check("coverage: rtcNewScene");
+  MQ_CHECK(scene, Error, "coverage: Embree returned no scene");
+  std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
+  try {
+    // A scene built once for few queries per output face: the fast build.
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+    RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), output.V.rows()));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), output.F.rows()));
+    if (!vb || !ib) {
+      rtcReleaseGeometry(geom);
+      device.check("coverage: rtcSetNewGeometryBuffer");
+      MQ_THROW(Error, "coverage: Embree returned no geometry buffer");
+    }
+    for (Eigen::Index i = 0; i < output.V.rows(); ++i)
+      for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(output.V(i, k));
+    for (Eigen::Index f = 0; f < output.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(output.F(f, k));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+    device.check("coverage: building the Embree BVH");
+    const BoundingBox box = bounding_box(output.V);
+    // Float bounds and a float query point: the radius handed to Embree is enlarged far above
+    // their rounding; every triangle is then measured exactly in double.
+    const double slack = 1e-6 * (box.extent().norm() + std::max(box.min.cwiseAbs().maxCoeff(),
+                                                                box.max.cwiseAbs().maxCoeff())) +
+                         1e-30;
+    const MatrixX3d N = face_normals(base.V, base.F);
+    tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
+      Query q;
+      q.output = &output;
+      q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
+                .transpose() /
+            3.0;
+      q.n = N.row(f).transpose();
+      q.below = below;
+      q.radius = radius;
+      RTCPointQuery pq;
+      pq.x = static_cast<float>(q.c.x());
+      pq.y = static_cast<float>(q.c.y());
+      pq.z = static_cast<float>(q.c.z());
+      pq.time = 0.0f;
+      pq.radius = static_cast<float>(radius + slack + 1e-6 * q.c.cwiseAbs().maxCoeff());
+      RTCPointQueryContext context;
+      rtcInitPointQueryContext(&context);
+      rtcPointQuery(scene, &pq, &context, visit, &q);
+      covered[static_cast<size_t>(f)] = q.found;
+    });
+  } catch (...) {
+    rtcReleaseScene(scene);
+    throw;
+  }
+  rtcReleaseScene(scene);
+  const Eigen::VectorXd A = face_areas(base.V, base.F);
+  // Summed in face order so the result does not depend on the thread count.
+  double sum = 0, total = 0;
+  for (Eigen::Index f = 0; f < base.F.rows(); ++f) {
+    total += A(f);
+    if (covered[static_cast<size_t>(f)]) sum += A(f);
+  }
+  return total > 0 ? sum / total : 0.0;
+}
+
+double swatch_coverage(const TriMesh& swatch) {
+  const PreparedSwatch prepared = prepare_swatch(swatch);
+  const int n = 48;
+  TriMesh grid;
+  grid.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      grid.V.row(j * (n + 1) + i) << prepared.size.x() * i / n, prepared.size.y() * j / n, 0.0;
+  grid.F.resize(2 * n * n, 3);
+  for (int j = 0, f = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      grid.F.row(f++) << a, b, d;  // counter-clockwise seen from +z, the swatch's side
+      grid.F.row(f++) << a, d, c;
+    }
+  const double h = prepared.size.z();
+  return surface_coverage(grid, prepared.mesh, 1.5 * h, 0.01 * h);
+}
+
+}  // namespace mq

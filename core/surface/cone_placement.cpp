@@ -1,0 +1,131 @@
+#include "core/surface/cone_placement.h"
+
+#include <cstdlib>
+#include <queue>
+
+#include "core/common/errors.h"
+
+namespace mq {
+
+namespace {
+
+int sign_of(int x) { return (x > 0) - (x < 0); }
+
+// Interior vertices within `reach` edges of v (through interior vertices), v first, then in
+// breadth-first order with ascending indices per ring: deterministic.
+std::vector<int> neighbourhood(const Adjacency& adj, const std::vector<char>& interior, int v,
+                               int reach, std::vector<int>& stamp, int mark) {
+  std::vector<int> out{v};
+  stamp[v] = mark;
+  size_t begin = 0;
+  for (int ring = 0; ring < reach; ++ring) {
+    const size_t end = out.size();
+    for (size_t i = begin; i < end; ++i)
+      for (const int* w = adj.begin(out[i]); w != adj.end(out[i]); ++w)
+        if (interior[*w] && stamp[*w] != mark) {
+          stamp[*w] = mark;
+          out.push_back(*w);
+        }
+    begin = end;
+  }
+  return out;
+}
+
+// Moves the cones of `index` towards lower E (see place_cones); u and energy are kept current.
+void move_cones(const TrivialConnection& solver, const Adjacency& adj,
+                const ConePlacementOptions& options, std::vector<int>& index, Eigen::VectorXd& u,
+                double& energy, std::vector<int>& stamp, int& mark, ConePlacementReport& rep) {
+  const int nv = static_cast<int>(index.size());
+  const std::vector<char>& interior = solver.interior();
+  const double unit = kTwoPi / solver.N();
+  int reach = options.reach;
+  for (int round = 0; round < options.max_rounds && reach >= 1; ++round) {
+    // dE/dk_v = 2 (P (A u))_v, P the inverse of the factorised -Delta, k_v the curvature at v:
+    // moving a cone of curvature c from v to w changes E by about 2 c (s_w - s_v).
+    const Eigen::VectorXd s = solver.solve_poisson(solver.vertex_area().cwiseProduct(u));
+    std::vector<int> next = index;
+    int moved = 0, cancelled = 0;
+    for (int v = 0; v < nv; ++v) {
+      if (index[v] == 0 || !interior[v]) continue;
+      const int k = index[v];
+      const double c = k * unit;
+      int best = v;
+      double best_value = c * s(v);
+      for (const int w : neighbourhood(adj, interior, v, reach, stamp, mark++)) {
+        // Never onto a cone of the same sign (that would make a pole again).
+        if (w == v || sign_of(next[w]) == sign_of(k)) continue;
+        if (c * s(w) < best_value - 1e-12 * std::abs(best_value)) {
+          best_value = c * s(w);
+          best = w;
+        }
+      }
+      if (best == v) continue;
+      if (next[best] != 0 && sign_of(next[best]) != sign_of(k)) ++cancelled;
+      next[v] -= k;
+      next[best] += k;
+      ++moved;
+    }
+    if (moved == 0) break;
+    const Eigen::VectorXd u_next = solver.log_scale(next);
+    const double e_next = scale_energy(solver, u_next);
+    ++rep.rounds;
+    if (e_next < energy) {
+      index = std::move(next);
+      u = u_next;
+      energy = e_next;
+      rep.moves += moved;
+      rep.cancelled += cancelled;
+    } else {
+      reach /= 2;
+    }
+  }
+}
+
+}  // namespace
+
+double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u) {
+  const Eigen::VectorXd& a = solver.vertex_area();
+  const double total = a.sum();
+  return total > 0 ? a.dot(u.cwiseProduct(u)) / total : 0.0;
+}
+
+std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> index,
+                             const Adjacency& adj, const ConePlacementOptions& options,
+                             ConePlacementReport* report) {
+  const int nv = static_cast<int>(index.size());
+  MQ_CHECK(nv == static_cast<int>(solver.interior().size()) && adj.size() == nv, InvalidInput,
+           "cone placement: ", nv, " indices for ", solver.interior().size(), " vertices");
+  MQ_CHECK(options.max_rounds >= 0 && options.reach >= 1, InvalidInput,
+           "cone placement: max_rounds must be >= 0 and reach >= 1");
+  ConePlacementReport rep;
+  const std::vector<char>& interior = solver.interior();
+  std::vector<int> stamp(static_cast<size_t>(nv), -1);
+  int mark = 0;
+  // Unit cones: a pole (a whole turn of a line field) is two half-turn cones at one place.
+  for (int v = 0; v < nv; ++v) {
+    if (!interior[v]) continue;
+    while (std::abs(index[v]) > 1) {
+      const int s = sign_of(index[v]);
+      int target = -1;
+      for (int reach = 1; target < 0 && reach <= 64; ++reach)
+        for (const int w : neighbourhood(adj, interior, v, reach, stamp, mark++))
+          if (w != v && index[w] == 0) {
+            target = w;
+            break;
+          }
+      if (target < 0) break;
+      index[v] -= s;
+      index[target] += s;
+      ++rep.split_poles;
+    }
+  }
+  Eigen::VectorXd u = solver.log_scale(index);
+  double energy = scale_energy(solver, u);
+  rep.energy_before = energy;
+  move_cones(solver, adj, options, index, u, energy, stamp, mark, rep);
+  rep.energy_after = energy;
+  if (report) *report = rep;
+  return index;
+}
+
+}  // namespace mq

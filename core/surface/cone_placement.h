@@ -1,0 +1,51 @@
+// Where the cones of a seamless layout go: moved over the surface so that the flat cone metric
+// they define (core/surface/trivial_connection) scales the surface as little as possible, in the
+// spirit of Ben-Chen, Gotsman and Bunin (2008) and Myles and Zorin (2013), who place cones where
+// the conformal factor is extreme.
+//
+// Why (issue 23, "even elements"): in a conformal layout an element's size on the surface is
+// its size in the plane over e^u. The smooth line field puts its cones where the field is
+// smoothest, not where they flatten the surface best; a pole it leaves (index 1: the two poles
+// of Blender's UV sphere) cannot be closed by the half-turn lattice at all. Moved to lower the
+// area-weighted sum of u^2, the cones spread the curvature so that most of the surface keeps
+// the texture's size. Cones are moved, not added: a half-turn cone's own logarithmic peak costs
+// more than it saves (measured: no + and - pair among the 36 best candidates lowered the
+// distortion away from the cones on Spot or Suzanne), and each is a lattice defect.
+#pragma once
+
+#include <vector>
+
+#include "core/surface/trivial_connection.h"
+
+namespace mq {
+
+struct ConePlacementOptions {
+  int max_rounds = 40;  // rounds of moves (each: two Poisson solves)
+  int reach = 3;        // a cone moves at most this many edges per round
+};
+
+struct ConePlacementReport {
+  int split_poles = 0;  // cones of more than one unit split into unit cones first
+  int rounds = 0;
+  int moves = 0;
+  int cancelled = 0;  // + and - cones that met and cancelled
+  double energy_before = 0, energy_after = 0;  // sum A u^2 / sum A
+};
+
+// Splits every cone of |index| > 1 into unit cones (on the vertex and its nearest interior
+// neighbours), then moves cones one interior vertex ring at a time towards lower
+// E = sum_v A_v u_v^2 (first order in the sensitivity G (A u), checked by a solve after each
+// round: a round that does not lower E is undone and the reach halved). A + and a - cone that
+// meet cancel. The indices keep their sums per component. Deterministic.
+//   solver  the factorised trivial connection of the mesh
+//   index   #V indices (units of 1/N turn), admissible for solver
+// Returns the moved indices. Throws InvalidInput for a size mismatch or bad options.
+std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> index,
+                             const Adjacency& vertex_neighbours,
+                             const ConePlacementOptions& options = {},
+                             ConePlacementReport* report = nullptr);
+
+// E = sum_v A_v u_v^2 / sum_v A_v: the mean squared log scale of a cone metric.
+double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u);
+
+}  // namespace mq

@@ -1,0 +1,212 @@
+// Mesh quilting over curved surfaces, paper section 3.1: the base mesh's triangles replace the
+// planar grid; each iteration grows a local patch from the most constrained unsynthesised
+// triangle, flattens it conformally, runs the planar steps of section 2 in that plane (oriented
+// by a guidance field) and stores the new geometry in local coordinates on the base mesh.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/common/progress.h"
+#include "core/common/stage_timer.h"
+#include "core/mesh/longest_edge_bisection.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/geometry_matching.h"
+#include "core/planar/patch_quilting.h"
+
+namespace mq {
+
+// Output geometry in local coordinates over the base mesh: vertex i of an element lies above
+// base face `face[i]`, at the point with barycentric coordinates `barycentric.row(i)` of that
+// face, at height `height[i]` in [0, shell height] along the surface normal.
+struct SurfaceElement {
+  MatrixX3i F;             // #F by 3, indices into the element's vertices
+  std::vector<int> face;   // #V base faces
+  MatrixX3d barycentric;   // #V by 3
+  Eigen::VectorXd height;  // #V
+  // Optional (#V by 3, or empty): the element as it was placed, in the flat frame of its
+  // placement (a rigid copy of its swatch element). The embedding falls back to it, moved
+  // rigidly, where the map folds the element through itself.
+  MatrixX3d flat;
+  int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds)
+  // Optional (empty face: none): the element as the layout alone places it, where the
+  // coordinates above are an even copy of it (core/surface/global_quilting, adaptive placement).
+  // The embedding tries it before removing the copy for touching a neighbour: distorted, but in its
+  // place among its neighbours.
+  struct Alternative {
+    std::vector<int> face;   // #V
+    MatrixX3d barycentric;   // #V by 3
+    Eigen::VectorXd height;  // #V
+  } through_layout;
+};
+
+struct SurfaceQuilt {
+  std::vector<SurfaceElement> elements;
+  double shell_height = 0;
+  TriMesh base;           // the (refined) base mesh the local coordinates refer to
+  TriMesh input_base;     // the base as given, coincident vertices welded (or its proxy)
+  Refinement refinement;  // base faces in input_base faces (empty: base is input_base)
+  std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
+};
+
+// Local coordinates on the refined base expressed on the input base: refined faces are affine
+// pieces of their parents, so this is exact.
+void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& barycentric);
+
+struct SurfaceQuiltingOptions {
+  // The swatch is scaled uniformly so that its longer footprint side is `scale` times the base
+  // mesh's bounding-box diagonal; its thickness, scaled alike, is the shell height.
+  double scale = 0.1;
+  // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
+  MatrixX3d field;
+  // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
+  // threshold"); 0: a disk reaching the farthest swatch corner of any admissible placement. A
+  // patch whose area distortion exceeds max_distortion is shrunk (paper: 4), judged by the 95th
+  // percentile of its faces' distortion.
+  double patch_area_factor = 0;
+  double max_distortion = 4.0;
+  double subpatch_fraction = 0.5;  // as for planar quilting
+  // The base is refined until no edge is longer than this fraction of the swatch's longer side.
+  double base_edge_fraction = 0.3;
+  // Fewer sub-patch points and a coarser sub-cell refinement than on the plane: a conformal
+  // patch is only accurate to a fraction of a cell anyway, and surfaces need many patches.
+  int match_points = 512;
+  MatchingOptions matching = [] {
+    MatchingOptions m;
+    m.refine_to = 1.0 / 16.0;
+    return m;
+  }();
+  PatchQuiltingOptions patch;
+  uint64_t seed = 1;
+  // Refuse a job whose output is estimated above this many faces (the swatch's faces per unit
+  // of footprint area times the base's area): issue 14.
+  double max_faces = 2e7;
+  // Turn base components whose faces point inward to face outward (orient_outward) first.
+  bool orient_outward = true;
+  // A base of more faces than this is simplified first (simplify_by_quadrics, issue 14): to
+  // edges no longer than the refinement's (base_edge_fraction of the swatch's side), within
+  // proxy_error shell heights of the surface given. The texture is then laid over that proxy.
+  // 0: never.
+  int proxy_min_faces = 200'000;
+  double proxy_error = 0.05;
+  // The global-parameterisation method (core/surface/global_quilting).
+  struct Global {
+    // Weight of the guidance field against the line field's smoothness: small lets the
+    // field's poles split into the mild half-turn cones a lattice can close around.
+    double guidance_weight = 1e-3;
+    // Weight of the one implicit Laplacian step that smooths the copy of the base the field and
+    // the parameterisation are computed on (0: the base itself).
+    double smoothing = 1.0;
+    // Pin the cones and fix the transitions at the texture's symmetries (periodic swatches).
+    bool seamless = true;
+    // Cancel + and - cones at the two ends of one edge (cancel_singular_pairs).
+    bool cancel_cone_pairs = true;
+    // Move the cones for the least change of scale (core/surface/cone_placement) and lay the
+    // texture out conformally, by the field parallel in their flat metric scaled by e^u
+    // (core/surface/trivial_connection); false: unit frames of the smooth line field.
+    bool conformal = true;
+    // The metric's scale is followed as e^(a u) with a <= 1 such that the lattice, normalised
+    // to the typical element's size, fills the surface at most this many times over
+    // (e^(2 a^2 E), E the mean squared log scale after the cones are placed).
+    double max_overfill = 1.2;
+    // How a lattice element is carried onto the base: through the layout vertex by vertex
+    // (kLayout: it keeps its place among its neighbours exactly, and takes the layout's
+    // distortion across it); as a copy of the layout's first-order image at its centre whose
+    // offsets are walked along the surface, a similarity (kRigid: bent by the surface only);
+    // or through the layout where that keeps its shape and as a first-order copy elsewhere
+    // (kAdaptive). The shape is kept when the layout there is nearly a similarity (aspect at
+    // most max_element_aspect), the same one across the element (its halves' scales within
+    // max_element_variation) and the element at most max_element_scale times the swatch's. A
+    // copy's size is clamped to [1 / max_element_scale, max_element_scale] times the swatch's.
+    enum class Placement { kLayout, kRigid, kAdaptive };
+    Placement placement = Placement::kAdaptive;
+    double max_element_scale = 1.3;
+    double max_element_aspect = 1.3;
+    double max_element_variation = 1.3;
+    // A periodic swatch of compact elements is tiled over the parameter plane (the planar
+    // quilt it would give), one of threads by one-period pieces welded into threads
+    // (core/surface/thread_tiling); else the plane is quilted.
+    bool tile = true;
+    // The quilt will be embedded by plain normal displacement: thread pieces that it folds
+    // through themselves are left out (a folded thread would be removed whole). The shell map
+    // unfolds them, so they are kept for it.
+    bool drop_folded_pieces = false;
+  } global;
+};
+
+struct SurfaceQuiltingStats {
+  int iterations = 0;
+  int base_faces = 0;       // after refinement
+  int welded_vertices = 0;  // base vertices merged with another at the same position
+  int duplicate_faces = 0;  // base faces that repeated another, removed
+  int flipped_components = 0;  // base components turned to face outward (orient_outward)
+  int proxy_faces = 0;         // faces of the simplified base (0: the base was not simplified)
+  double proxy_error = 0;      // the simplification's largest quadric error (mesh units)
+  int patches_shrunk = 0;
+  long long patch_faces = 0;  // faces of every local patch used (after shrinking), summed
+  double swatch_scale = 0;  // factor applied to the swatch
+  double shell_height = 0;
+  double cell_size = 0;
+  long long matched_point_offsets = 0;
+  PatchCounts counts;
+  int rejected_outside_patch = 0;             // swatch elements reaching beyond the flattened patch
+  int faces = 0, vertices = 0, elements = 0;  // before the embedding's post-processing
+  // Output faces estimated before any work (the swatch's faces per footprint area over the
+  // base's area), and, for the global layout, counted once the layout is known.
+  double estimated_faces = 0;
+  StageTimes times;
+};
+
+// The base and the swatch as both surface methods work on them: the base with coincident
+// vertices welded and refined, the guidance field on the refined faces (the smooth default when
+// none is given), the swatch scaled to its size on the surface.
+struct SurfaceJob {
+  TriMesh cleaned;        // the base as given, coincident vertices welded (or its proxy)
+  TriMesh base;           // cleaned, refined by longest-edge bisection
+  Refinement refinement;  // base faces in cleaned faces
+  MatrixX3d field;        // #F(base) by 3 unit tangents
+  EdgeTopology topo;
+  MatrixX3i TT;
+  double swatch_scale = 0;  // factor applied to the swatch
+  TriMesh swatch;           // the swatch scaled by it
+};
+
+// The factor taking swatch units to base units for SurfaceQuiltingOptions::scale = `scale`: the
+// swatch's longer side (of its prepared footprint) becomes `scale` times the base's bounding-box
+// diagonal (section 3.1's relative size s). Throws InvalidInput for scale <= 0 or not finite, an
+// empty base or swatch.
+double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale);
+
+// Validates the inputs (the same throws as quilt_surface) and prepares a SurfaceJob; times go
+// to the stage "prepare", welded vertices and base faces to stats.
+SurfaceJob prepare_surface_job(const TriMesh& base, const TriMesh& swatch,
+                               const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats);
+
+// Runs mesh quilting over `base`. Local coordinates in the result refer to the base (coincident
+// vertices welded) refined by bisect_longest_edges(base, scale * diagonal * base_edge_fraction,
+// 2'000'000); SurfaceQuilt::refinement maps them back. Throws
+// InvalidInput for an empty or non-finite base or swatch, scale <= 0 or not finite, a field of the
+// wrong size.
+SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
+                           const SurfaceQuiltingOptions& options,
+                           TranslationCostEvaluator& evaluator,
+                           SurfaceQuiltingStats* stats = nullptr, ProgressSink* progress = nullptr);
+
+// quilt_surface on a job prepare_surface_job made with the same options (`stats`: the figures
+// and times so far), for a caller that has prepared it already. Throws like quilt_surface.
+SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
+                                    const SurfaceQuiltingOptions& options,
+                                    TranslationCostEvaluator& evaluator,
+                                    SurfaceQuiltingStats* stats_out = nullptr,
+                                    ProgressSink* progress = nullptr);
+
+// 3D positions of local coordinates by plain normal displacement: the base point plus height
+// times the interpolated unit vertex normal.
+//   N  #V(base) by 3 unit vertex normals of the base
+Vector3d displace_along_normal(const TriMesh& base, const MatrixX3d& N, int face,
+                               const Vector3d& barycentric, double height);
+
+// The whole quilt embedded by normal displacement over quilt.base, elements in order.
+TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt);
+
+}  // namespace mq

@@ -1,0 +1,1294 @@
+#include "core/surface/vine_growth.h"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <queue>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "core/common/errors.h"
+#include "core/mesh/closest_point_query.h"
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/quilt_elements.h"
+#include "core/shell/offset_surface.h"
+
+namespace mq {
+
+namespace {
+
+// --- the swatch ------------------------------------------------------------------------------
+
+// Shortest-path distances along the edges of (V, adj) from `source`.
+std::vector<double> graph_distances(const MatrixX3d& V, const Adjacency& adj, int source) {
+  std::vector<double> dist(static_cast<size_t>(V.rows()), kInf);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[static_cast<size_t>(source)] = 0;
+  queue.emplace(0.0, source);
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[static_cast<size_t>(v)]) continue;
+    for (const int* w = adj.begin(v); w != adj.end(v); ++w) {
+      const double nd = d + (V.row(v) - V.row(*w)).norm();
+      if (nd < dist[static_cast<size_t>(*w)]) {
+        dist[static_cast<size_t>(*w)] = nd;
+        queue.emplace(nd, *w);
+      }
+    }
+  }
+  return dist;
+}
+
+int farthest(const std::vector<double>& d) {
+  int best = 0;
+  for (size_t i = 0; i < d.size(); ++i)
+    if (std::isfinite(d[i]) && d[i] > d[static_cast<size_t>(best)]) best = static_cast<int>(i);
+  return best;
+}
+
+// An element's length as the structure measure takes it (core/structure/texture_structure): the
+// double-sweep graph diameter, exact on a tube; its width the diameter of a tube of that length
+// and the element's area.
+struct ElementLength {
+  double length = 0, width = 0;
+  bool is_long = false;
+};
+
+ElementLength element_length(const Element& e) {
+  ElementLength out;
+  if (e.V.rows() < 2 || e.F.rows() == 0) return out;
+  const Adjacency adj = vertex_adjacency(e.F, static_cast<int>(e.V.rows()));
+  const int a = farthest(graph_distances(e.V, adj, 0));
+  const std::vector<double> from_a = graph_distances(e.V, adj, a);
+  out.length = from_a[static_cast<size_t>(farthest(from_a))];
+  if (!(out.length > 0)) return out;
+  out.width = surface_area(e.V, e.F) / (M_PI * out.length);
+  out.is_long = out.length >= 4 * out.width;
+  return out;
+}
+
+// The vine and what it carries, in the vine's straight frame: u along its principal axis, v to
+// the left of it (v = z x u: the frame is right-handed like the stem's (tangent, normal x
+// tangent, normal) on the surface), z the height.
+struct SwatchLeaf {
+  // #V by 3: (along, across, z) in the frame of the vine's centreline where it is attached (its
+  // point and tangent there), z the height.
+  MatrixX3d P;
+  MatrixX3i F;
+  int kind = 0;
+  double attach = 0;  // where it sits along one swatch vine length, in [0, period]
+};
+
+struct VineModel {
+  int kind = 0;
+  double period = 0;        // the swatch vine's length along its axis
+  double radius = 0;        // of its tube
+  int segments = 8;         // around the tube
+  double ring_spacing = 0;  // between its cross-sections
+  // The centreline's lateral offset and height at u = i * step, i = 0..n-1, periodic with
+  // period n * step: the swatch's own, with a cubic blend added so that its value and slope
+  // at the end meet those at the start.
+  double step = 0;
+  std::vector<double> wave, lift;
+  double extent = 0;               // max |wave| + radius: the tube's lateral reach from the axis
+  double reach = 0;                // the farthest any element's vertex lies from the axis
+  std::vector<SwatchLeaf> leaves;  // ascending attach
+
+  // A leaf's vertices in the stem's straight frame (arc length, lateral, height) when attached
+  // at arc length x: moved with the stem's centreline there (its point and tangent), so that it
+  // sits on the vine as in the swatch although the blend changed the wave.
+  MatrixX3d pose(const SwatchLeaf& leaf, double x, double phase = 0) const {
+    const double w = at(wave, x + phase), t = std::atan(slope(wave, x + phase));
+    const double c = std::cos(t), s = std::sin(t);
+    MatrixX3d out(leaf.P.rows(), 3);
+    for (Eigen::Index i = 0; i < leaf.P.rows(); ++i)
+      out.row(i) << x + c * leaf.P(i, 0) - s * leaf.P(i, 1),
+          w + s * leaf.P(i, 0) + c * leaf.P(i, 1), leaf.P(i, 2);
+    return out;
+  }
+
+  // Linear interpolation of the periodic samples and its central-difference slope.
+  double at(const std::vector<double>& f, double s) const {
+    const int n = static_cast<int>(f.size());
+    double x = std::fmod(s / step, static_cast<double>(n));
+    if (x < 0) x += n;
+    const int i = std::min(n - 1, static_cast<int>(x));
+    const double t = x - i;
+    return (1 - t) * f[static_cast<size_t>(i)] + t * f[static_cast<size_t>((i + 1) % n)];
+  }
+  double slope(const std::vector<double>& f, double s) const {
+    return (at(f, s + step) - at(f, s - step)) / (2 * step);
+  }
+};
+
+// The vine's principal axis in the swatch plane: (origin, unit direction).
+std::pair<Vector2d, Vector2d> principal_axis(const MatrixX3d& V) {
+  const Vector2d c = V.leftCols<2>().colwise().mean().transpose();
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Vector2d q = V.row(i).head<2>().transpose() - c;
+    cov += q * q.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  Vector2d a = eig.eigenvectors().col(1);
+  if (a.x() < 0 || (a.x() == 0 && a.y() < 0)) a = -a;  // deterministic sign
+  return {c, a};
+}
+
+int find_vine(const PreparedSwatch& swatch, std::vector<ElementLength>* lengths) {
+  const int n = static_cast<int>(swatch.elements.size());
+  std::vector<ElementLength> len(static_cast<size_t>(n));
+  int vine = -1, long_count = 0;
+  for (int i = 0; i < n; ++i) {
+    len[static_cast<size_t>(i)] = element_length(swatch.elements[static_cast<size_t>(i)]);
+    if (len[static_cast<size_t>(i)].is_long) {
+      ++long_count;
+      vine = i;
+    }
+  }
+  if (lengths) *lengths = std::move(len);
+  return long_count == 1 ? vine : -1;
+}
+
+VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index) {
+  const Element& vine = swatch.elements[static_cast<size_t>(vine_index)];
+  VineModel m;
+  m.kind = vine.kind;
+  const auto [origin, axis] = principal_axis(vine.V);
+  const Vector2d left(-axis.y(), axis.x());
+  const auto frame = [&](const Vector3d& q) {
+    const Vector2d d = q.head<2>() - origin;
+    return Vector3d(d.dot(axis), d.dot(left), q.z());
+  };
+  const Eigen::Index nv = vine.V.rows();
+  MatrixX3d U(nv, 3);
+  for (Eigen::Index i = 0; i < nv; ++i) U.row(i) = frame(vine.V.row(i).transpose()).transpose();
+  const double u0 = U.col(0).minCoeff(), u1 = U.col(0).maxCoeff();
+  m.period = u1 - u0;
+  MQ_CHECK(m.period > 0, InvalidInput, "the swatch's vine has no length");
+  // Resolution as the swatch's: segments from the largest valence (a fan cap's centre has one
+  // per segment), cross-sections from the vertex count.
+  const Adjacency adj = vertex_adjacency(vine.F, static_cast<int>(nv));
+  int valence = 0;
+  for (int v = 0; v < adj.size(); ++v) valence = std::max(valence, adj.degree(v));
+  m.segments = std::clamp(valence, 6, 32);
+  const int rings =
+      std::max(2, static_cast<int>(std::lround(static_cast<double>(nv - 2) / m.segments)));
+  m.ring_spacing = std::clamp(m.period / (rings - 1), m.period / 2000, m.period / 4);
+  // The centreline: mean lateral offset and height of the vertices in slabs across the axis.
+  const int bins = std::max(4, static_cast<int>(std::lround(m.period / m.ring_spacing)));
+  const double width = m.period / bins;
+  std::vector<double> sv(static_cast<size_t>(bins), 0), sz(sv), count(sv);
+  for (Eigen::Index i = 0; i < nv; ++i) {
+    const int b = std::clamp(static_cast<int>((U(i, 0) - u0) / width), 0, bins - 1);
+    sv[static_cast<size_t>(b)] += U(i, 1);
+    sz[static_cast<size_t>(b)] += U(i, 2);
+    count[static_cast<size_t>(b)] += 1;
+  }
+  std::vector<double> bv(static_cast<size_t>(bins)), bz(bv);
+  std::vector<int> filled;
+  for (int b = 0; b < bins; ++b)
+    if (count[static_cast<size_t>(b)] > 0) {
+      bv[static_cast<size_t>(b)] = sv[static_cast<size_t>(b)] / count[static_cast<size_t>(b)];
+      bz[static_cast<size_t>(b)] = sz[static_cast<size_t>(b)] / count[static_cast<size_t>(b)];
+      filled.push_back(b);
+    }
+  MQ_CHECK(!filled.empty(), InvalidInput, "the swatch's vine has no vertices");
+  for (int b = 0; b < bins; ++b) {
+    if (count[static_cast<size_t>(b)] > 0) continue;
+    // Empty slab: interpolated between the nearest filled ones.
+    const auto hi = std::lower_bound(filled.begin(), filled.end(), b);
+    const int r = hi == filled.end() ? filled.back() : *hi;
+    const int l = hi == filled.begin() ? filled.front() : *(hi - 1);
+    const double t = r == l ? 0 : static_cast<double>(b - l) / (r - l);
+    bv[static_cast<size_t>(b)] =
+        (1 - t) * bv[static_cast<size_t>(l)] + t * bv[static_cast<size_t>(r)];
+    bz[static_cast<size_t>(b)] =
+        (1 - t) * bz[static_cast<size_t>(l)] + t * bz[static_cast<size_t>(r)];
+  }
+  // Nodes at the slab borders u0 + i * width, i = 0..bins.
+  std::vector<double> nvv(static_cast<size_t>(bins) + 1), nvz(nvv);
+  for (int i = 0; i <= bins; ++i) {
+    const int a = std::max(0, i - 1), b = std::min(bins - 1, i);
+    nvv[static_cast<size_t>(i)] = 0.5 * (bv[static_cast<size_t>(a)] + bv[static_cast<size_t>(b)]);
+    nvz[static_cast<size_t>(i)] = 0.5 * (bz[static_cast<size_t>(a)] + bz[static_cast<size_t>(b)]);
+  }
+  // Tube radius: the median distance of the vertices from the centreline polyline.
+  {
+    std::vector<double> d(static_cast<size_t>(nv));
+    for (Eigen::Index i = 0; i < nv; ++i) {
+      const Vector3d q = U.row(i).transpose();
+      const int b = std::clamp(static_cast<int>((q.x() - u0) / width), 0, bins - 1);
+      double best = kInf;
+      for (int k = std::max(0, b - 2); k <= std::min(bins - 1, b + 2); ++k) {
+        const Vector3d a(u0 + k * width, nvv[static_cast<size_t>(k)], nvz[static_cast<size_t>(k)]);
+        const Vector3d c(u0 + (k + 1) * width, nvv[static_cast<size_t>(k) + 1],
+                         nvz[static_cast<size_t>(k) + 1]);
+        const Vector3d e = c - a;
+        const double t = std::clamp((q - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+        best = std::min(best, (a + t * e - q).norm());
+      }
+      d[static_cast<size_t>(i)] = best;
+    }
+    std::nth_element(d.begin(), d.begin() + nv / 2, d.end());
+    m.radius = d[static_cast<size_t>(nv / 2)];
+  }
+  MQ_CHECK(m.radius > 0, InvalidInput, "the swatch's vine has no thickness");
+  // The periodic blend h (cubic Hermite in t = u / period): h(0) = h'(0) = 0, and at the end
+  // h = f(0) - f(P), h' = f'(0) - f'(P), so that f + h joins itself with value and slope.
+  const auto blend = [&](const std::vector<double>& f) {
+    const double f0 = f.front(), f1 = f.back();
+    const double s0 = (f[1] - f[0]) / width,
+                 s1 = (f[static_cast<size_t>(bins)] - f[static_cast<size_t>(bins) - 1]) / width;
+    return [=](double u) {
+      const double t = std::clamp(u / (bins * width), 0.0, 1.0);
+      return (f0 - f1) * (3 * t * t - 2 * t * t * t) +
+             (s0 - s1) * bins * width * (t * t * t - t * t);
+    };
+  };
+  const auto hv = blend(nvv), hz = blend(nvz);
+  m.step = width;
+  m.wave.resize(static_cast<size_t>(bins));
+  m.lift.resize(static_cast<size_t>(bins));
+  for (int i = 0; i < bins; ++i) {
+    m.wave[static_cast<size_t>(i)] = nvv[static_cast<size_t>(i)] + hv(i * width);
+    m.lift[static_cast<size_t>(i)] = nvz[static_cast<size_t>(i)] + hz(i * width);
+  }
+  for (const double w : m.wave) m.extent = std::max(m.extent, std::abs(w) + m.radius);
+  m.reach = m.extent;
+  // The other elements, relative to where they meet the vine: the swatch's centreline (before
+  // the blend) and its slope there.
+  const auto centre_v = [&](double u) {
+    const double x = std::clamp((u - u0) / width, 0.0, static_cast<double>(bins));
+    const int i = std::min(bins - 1, static_cast<int>(x));
+    const double t = x - i;
+    return (1 - t) * nvv[static_cast<size_t>(i)] + t * nvv[static_cast<size_t>(i) + 1];
+  };
+  const auto centre_slope = [&](double u) {
+    return (centre_v(u + width) - centre_v(u - width)) /
+           (std::min(u + width, u1) - std::max(u - width, u0));
+  };
+  for (size_t e = 0; e < swatch.elements.size(); ++e) {
+    if (static_cast<int>(e) == vine_index) continue;
+    const Element& el = swatch.elements[e];
+    SwatchLeaf leaf;
+    leaf.kind = el.kind;
+    leaf.F = el.F;
+    leaf.P.resize(el.V.rows(), 3);
+    double nearest = kInf;
+    for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
+      const Vector3d q = frame(el.V.row(i).transpose());
+      leaf.P.row(i) = q.transpose();
+      const double d = std::abs(q.y() - centre_v(q.x()));
+      if (d < nearest) {
+        nearest = d;
+        leaf.attach = std::clamp(q.x(), u0, u1) - u0;
+      }
+    }
+    const double ua = u0 + leaf.attach, va = centre_v(ua), t = std::atan(centre_slope(ua));
+    const double c = std::cos(t), s = std::sin(t);
+    for (Eigen::Index i = 0; i < leaf.P.rows(); ++i) {
+      const double du = leaf.P(i, 0) - ua, dv = leaf.P(i, 1) - va;
+      leaf.P(i, 0) = c * du + s * dv;
+      leaf.P(i, 1) = -s * du + c * dv;
+    }
+    // Heights follow the blended centreline's (the vine's lift changes little along it).
+    leaf.P.col(2).array() += hz(leaf.attach);
+    leaf.P.col(2) = leaf.P.col(2).cwiseMax(0.0);
+    m.leaves.push_back(std::move(leaf));
+  }
+  for (const SwatchLeaf& leaf : m.leaves)
+    m.reach = std::max(m.reach, m.pose(leaf, leaf.attach).col(1).cwiseAbs().maxCoeff());
+  return m;
+}
+
+// --- walking on the base -----------------------------------------------------------------------
+
+struct SurfacePoint {
+  int face = -1;
+  Vector3d bary = Vector3d::Constant(1.0 / 3);
+};
+
+// Straight lines on the surface: within a face a line, across an edge the direction carried over
+// by unfolding the two faces into one plane (so it keeps its angle to the edge: a geodesic).
+class SurfaceWalker {
+ public:
+  SurfaceWalker(const TriMesh& base, const MatrixX3i& TT)
+      : V_(base.V), F_(base.F), TT_(TT), FN_(face_normals(base.V, base.F)) {}
+
+  Vector3d position(const SurfacePoint& p) const {
+    return p.bary(0) * V_.row(F_(p.face, 0)).transpose() +
+           p.bary(1) * V_.row(F_(p.face, 1)).transpose() +
+           p.bary(2) * V_.row(F_(p.face, 2)).transpose();
+  }
+  Vector3d normal(int f) const { return FN_.row(f).transpose(); }
+  Vector3d centroid(int f) const {
+    return (V_.row(F_(f, 0)) + V_.row(F_(f, 1)) + V_.row(F_(f, 2))).transpose() / 3.0;
+  }
+  const MatrixX3d& normals() const { return FN_; }
+
+  // Moves p by `distance` along d (a unit vector in p's face plane), carrying d along. Returns
+  // false when a boundary edge (or a non-manifold one) stops it first: p then lies on it.
+  bool walk(SurfacePoint& p, Vector3d& d, double distance) const {
+    double left = distance;
+    int crossings = 0, stalled = 0;
+    while (left > 0) {
+      const Vector3d r = rate(p.face, d);
+      double t = kInf;
+      int exit = -1;
+      for (int k = 0; k < 3; ++k)
+        if (r(k) < 0) {
+          const double tk = std::max(0.0, p.bary(k)) / -r(k);
+          if (tk < t) t = tk, exit = k;
+        }
+      if (exit < 0 || t >= left) {
+        p.bary = normalized(p.bary + left * r);
+        return true;
+      }
+      p.bary += t * r;
+      p.bary(exit) = 0;
+      p.bary = normalized(p.bary);
+      left -= t;
+      // A point on a vertex can bounce between the faces around it without advancing: it is
+      // nudged into its face.
+      stalled = t > 0 ? 0 : stalled + 1;
+      if (stalled > 8) {
+        p.bary = normalized(0.999 * p.bary + Vector3d::Constant(0.001 / 3));
+        stalled = 0;
+        continue;
+      }
+      const int e = (exit + 1) % 3;  // the edge F(f,e)-F(f,e+1), opposite vertex `exit`
+      const int g = TT_(p.face, e);
+      if (g < 0 || ++crossings > 100000) return false;
+      const int va = F_(p.face, e), vb = F_(p.face, (e + 1) % 3);
+      const double wa = p.bary(e), wb = p.bary((e + 1) % 3);
+      d = unfold(p.face, g, va, vb, d);
+      Vector3d b = Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        if (F_(g, k) == va) b(k) = wa;
+        if (F_(g, k) == vb) b(k) = wb;
+      }
+      p.face = g;
+      p.bary = normalized(b);
+    }
+    return true;
+  }
+
+ private:
+  static Vector3d normalized(Vector3d b) {
+    b = b.cwiseMax(0.0);
+    const double s = b.sum();
+    return s > 0 ? Vector3d(b / s) : Vector3d::Constant(1.0 / 3);
+  }
+  // Change of the barycentric coordinates per unit move along d in face f.
+  Vector3d rate(int f, const Vector3d& d) const {
+    const Vector3d a = V_.row(F_(f, 0)), e0 = V_.row(F_(f, 1)).transpose() - a,
+                   e1 = V_.row(F_(f, 2)).transpose() - a;
+    const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+    const double den = d00 * d11 - d01 * d01;
+    if (!(den > 0)) return Vector3d::Zero();
+    const double x0 = d.dot(e0), x1 = d.dot(e1);
+    const double v = (d11 * x0 - d01 * x1) / den, w = (d00 * x1 - d01 * x0) / den;
+    return Vector3d(-v - w, v, w);
+  }
+  // d (in face f's plane) carried across the edge (va, vb) into face g's plane.
+  Vector3d unfold(int f, int g, int va, int vb, const Vector3d& d) const {
+    const Vector3d A = V_.row(va), B = V_.row(vb);
+    const Vector3d e = (B - A).normalized();
+    Vector3d mf = normal(f).cross(e), mg = normal(g).cross(e);
+    if (mf.dot(centroid(f) - A) > 0) mf = -mf;  // out of f
+    if (mg.dot(centroid(g) - A) < 0) mg = -mg;  // into g
+    const Vector3d out = d.dot(e) * e + d.dot(mf) * mg;
+    const double n = out.norm();
+    return n > 0 ? Vector3d(out / n) : d;
+  }
+
+  const MatrixX3d& V_;
+  const MatrixX3i& F_;
+  const MatrixX3i& TT_;
+  MatrixX3d FN_;
+};
+
+// Points in a uniform hash grid of cell `cell`; near() visits those in the cells a ball of
+// radius <= cell around q meets.
+class PointGrid {
+ public:
+  explicit PointGrid(double cell) : cell_(cell) {}
+  void insert(int id, const Vector3d& p) { cells_[key(cell_of(p))].push_back(id); }
+  template <class Visit>
+  bool any(const Vector3d& q, Visit&& visit) const {
+    const Eigen::Array3i c = cell_of(q);
+    for (int x = -1; x <= 1; ++x)
+      for (int y = -1; y <= 1; ++y)
+        for (int z = -1; z <= 1; ++z) {
+          const auto it = cells_.find(key(c + Eigen::Array3i(x, y, z)));
+          if (it == cells_.end()) continue;
+          for (const int id : it->second)
+            if (visit(id)) return true;
+        }
+    return false;
+  }
+
+ private:
+  Eigen::Array3i cell_of(const Vector3d& p) const {
+    return (p / cell_).array().floor().cast<int>();
+  }
+  static long long key(const Eigen::Array3i& c) {
+    return (static_cast<long long>(c(0)) * 73856093LL) ^
+           (static_cast<long long>(c(1)) * 19349663LL) ^
+           (static_cast<long long>(c(2)) * 83492791LL);
+  }
+  double cell_;
+  std::unordered_map<long long, std::vector<int>> cells_;
+};
+
+// Triangles placed so far, binned by their boxes, for the test whether a new element would
+// intersect any.
+class TriangleGrid {
+ public:
+  explicit TriangleGrid(double cell) : cell_(cell) {}
+  // The owner of a placed triangle that one of (V, F) intersects, or -1.
+  int intersects(const MatrixX3d& V, const MatrixX3i& F) const {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      const Vector3d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+      const Eigen::Array3i l = cell_of(lo), h = cell_of(hi);
+      for (int x = l(0); x <= h(0); ++x)
+        for (int y = l(1); y <= h(1); ++y)
+          for (int z = l(2); z <= h(2); ++z) {
+            const auto it = cells_.find(key(x, y, z));
+            if (it == cells_.end()) continue;
+            for (const int t : it->second) {
+              const Tri& o = tris_[static_cast<size_t>(t)];
+              if ((o.lo.array() > hi.array()).any() || (o.hi.array() < lo.array()).any()) continue;
+              if (triangles_intersect(a, b, c, o.p[0], o.p[1], o.p[2])) return o.owner;
+            }
+          }
+    }
+    return -1;
+  }
+  // Marks the faces of (V, F) that intersect a placed triangle (bad: #F flags).
+  void mark_intersecting(const MatrixX3d& V, const MatrixX3i& F, std::vector<char>& bad) const {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      if (bad[static_cast<size_t>(f)]) continue;
+      MatrixX3i one(1, 3);
+      one.row(0) = F.row(f);
+      bad[static_cast<size_t>(f)] = intersects(V, one) >= 0;
+    }
+  }
+  void insert(const MatrixX3d& V, const MatrixX3i& F, int owner) {
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      Tri t;
+      t.owner = owner;
+      for (int k = 0; k < 3; ++k) t.p[static_cast<size_t>(k)] = V.row(F(f, k)).transpose();
+      t.lo = t.p[0].cwiseMin(t.p[1]).cwiseMin(t.p[2]);
+      t.hi = t.p[0].cwiseMax(t.p[1]).cwiseMax(t.p[2]);
+      const int id = static_cast<int>(tris_.size());
+      const Eigen::Array3i l = cell_of(t.lo), h = cell_of(t.hi);
+      tris_.push_back(t);
+      for (int x = l(0); x <= h(0); ++x)
+        for (int y = l(1); y <= h(1); ++y)
+          for (int z = l(2); z <= h(2); ++z) cells_[key(x, y, z)].push_back(id);
+    }
+  }
+
+ private:
+  struct Tri {
+    std::array<Vector3d, 3> p;
+    Vector3d lo, hi;
+    int owner = -1;
+  };
+  Eigen::Array3i cell_of(const Vector3d& p) const {
+    return (p / cell_).array().floor().cast<int>();
+  }
+  static long long key(int x, int y, int z) {
+    return (static_cast<long long>(x) * 73856093LL) ^ (static_cast<long long>(y) * 19349663LL) ^
+           (static_cast<long long>(z) * 83492791LL);
+  }
+  double cell_;
+  std::vector<Tri> tris_;
+  std::unordered_map<long long, std::vector<int>> cells_;
+};
+
+// --- evenly spaced streamlines -----------------------------------------------------------------
+
+struct Sample {
+  SurfacePoint point;
+  Vector3d position, direction, normal;  // direction: the stem's, forwards
+  double s = 0;                          // arc length along its line
+  int line = -1;
+};
+
+struct StreamlineOptions {
+  double step = 0;            // between samples
+  double separation = 0;      // d_sep: seeds this far from their line
+  double seed_clearance = 0;  // a seed needs no sample (of any line) closer than this
+  double stop = 0;            // d_test: a line ends this close to another
+  double self_gap = 0;        // samples of its own line nearer along it than this do not stop it
+  double obstacle = 0;        // a line ends this close to the base's boundary
+  double turn_radius = 0;
+  double min_length = 0;
+  Vector3d up = Vector3d::UnitY();  // unit: seeds lowest along it first, patterns anchored on it
+};
+
+struct Seed {
+  SurfacePoint point;
+  int parent_sample = -1;  // the sample of the line beside which it lies, or -1
+};
+
+// Jobard and Lefer's placement on the base: lines are traced both ways from a seed until they
+// come near another line (or their own, further along it), a boundary, or a place where the
+// field turns against them; seeds are taken beside each finished line at the separation, then,
+// when none is left, at the lowest face centre (along `up`) that no line is near, so that the
+// stems grow from the bottom as ivy does.
+class Streamlines {
+ public:
+  Streamlines(const SurfaceWalker& walker, const MatrixX3d& guide, const MatrixX3d& fallback,
+              const std::vector<Vector3d>& obstacles, const StreamlineOptions& o)
+      : walker_(walker),
+        guide_(guide),
+        fallback_(fallback),
+        o_(o),
+        grid_(std::max(o.stop, o.seed_clearance)),
+        obstacle_grid_(std::max(o.obstacle, 1e-12)),
+        obstacles_(obstacles) {
+    for (size_t i = 0; i < obstacles_.size(); ++i)
+      obstacle_grid_.insert(static_cast<int>(i), obstacles_[i]);
+  }
+
+  void grow(const std::vector<int>& seed_faces, ProgressSink* progress) {
+    std::deque<Seed> queue;
+    for (size_t k = 0; k < seed_faces.size(); ++k) {
+      Seed seed;
+      seed.point.face = seed_faces[k];
+      if ((k & 1023) == 0)
+        report_progress(progress, "streamlines", static_cast<double>(k),
+                        static_cast<double>(seed_faces.size()));
+      if (!free_at(seed.point)) continue;
+      nearest_line(seed);
+      if (!trace_from(seed)) continue;
+      beside(static_cast<int>(lines_.size()) - 1, queue);
+      while (!queue.empty()) {
+        const Seed q = queue.front();
+        queue.pop_front();
+        if (free_at(q.point) && trace_from(q)) beside(static_cast<int>(lines_.size()) - 1, queue);
+      }
+    }
+  }
+
+  // The kept lines, each its samples in order along it (s from 0), and its phase: the arc
+  // length its swatch pattern starts at. A line seeded beside a parallel one continues that
+  // one's phase at the seed, so that neighbours grown side by side carry their leaves at
+  // matching places along them and the leaves of one interleave with the next's (as parallel
+  // lines from one seed row do on a plane); another starts its pattern at the seed's height
+  // along `up`, which is the same thing for lines that climb straight up.
+  std::vector<std::pair<std::vector<Sample>, double>> lines() const {
+    std::vector<double> start(lines_.size()), phase(lines_.size(), 0.0);
+    for (size_t l = 0; l < lines_.size(); ++l) {
+      start[l] = samples_[static_cast<size_t>(lines_[l].front())].s;
+      const Origin& o = origin_[l];
+      phase[l] = o.parent >= 0 ? (o.parent_s - start[static_cast<size_t>(o.parent)]) +
+                                     phase[static_cast<size_t>(o.parent)] + start[l]
+                               : o.anchor + start[l];
+    }
+    std::vector<std::pair<std::vector<Sample>, double>> out;
+    for (size_t l = 0; l < lines_.size(); ++l) {
+      if (!alive_[l]) continue;
+      std::vector<Sample> line;
+      for (const int id : lines_[l]) line.push_back(samples_[static_cast<size_t>(id)]);
+      for (Sample& q : line) q.s -= start[l];
+      out.emplace_back(std::move(line), phase[l]);
+    }
+    return out;
+  }
+  int short_lines() const { return short_; }
+
+ private:
+  bool near_line(const Vector3d& q, const Vector3d& n, double radius, int line, double s) const {
+    return grid_.any(q, [&](int id) {
+      const Sample& o = samples_[static_cast<size_t>(id)];
+      if (!alive_[static_cast<size_t>(o.line)]) return false;
+      // The other side of a thin wall is no neighbour: its texture grows away from this.
+      if (o.normal.dot(n) < -0.5) return false;
+      if (o.line == line && std::abs(o.s - s) <= o_.self_gap) return false;
+      return (o.position - q).squaredNorm() < radius * radius;
+    });
+  }
+  bool near_obstacle(const Vector3d& q) const {
+    return obstacle_grid_.any(q, [&](int id) {
+      return (obstacles_[static_cast<size_t>(id)] - q).squaredNorm() < o_.obstacle * o_.obstacle;
+    });
+  }
+  bool free_at(const SurfacePoint& p) const {
+    const Vector3d q = walker_.position(p);
+    return !near_line(q, walker_.normal(p.face), o_.seed_clearance, -1, 0) && !near_obstacle(q);
+  }
+
+  Vector3d start_direction(int f) const {
+    const Vector3d n = walker_.normal(f);
+    Vector3d g = guide_.row(f).transpose();
+    if (g.norm() < 0.3) g = fallback_.row(f).transpose();  // the field is weak here
+    g -= g.dot(n) * n;
+    if (!(g.norm() > 0)) g = n.unitOrthogonal();
+    return g.normalized();
+  }
+
+  int add(const SurfacePoint& p, const Vector3d& direction, double s, int line) {
+    Sample q;
+    q.point = p;
+    q.position = walker_.position(p);
+    q.normal = walker_.normal(p.face);
+    q.direction = direction;
+    q.s = s;
+    q.line = line;
+    samples_.push_back(q);
+    const int id = static_cast<int>(samples_.size()) - 1;
+    grid_.insert(id, q.position);
+    return id;
+  }
+
+  // One half of a line: from p along sign * field. Returns the sample ids in order of tracing.
+  std::vector<int> trace(SurfacePoint p, Vector3d d, double sign, int line) {
+    std::vector<int> ids;
+    double s = 0;
+    const double max_length = 1e6 * o_.step;  // a guard only: lines end near others first
+    while (s < max_length) {
+      const int f = p.face;
+      const Vector3d n = walker_.normal(f);
+      const Vector3d g = sign * guide_.row(f).transpose();
+      const double strength = g.norm();
+      if (strength > 1e-12) {
+        const Vector3d gh = g / strength;
+        const double angle = std::atan2(n.dot(d.cross(gh)), d.dot(gh));
+        // The field turns against the line (over the top of a wall, down its back): it ends.
+        if (std::abs(angle) > 0.75 * M_PI && strength > 0.5) break;
+        const double limit = strength * o_.step / o_.turn_radius;
+        const double turn = std::clamp(angle, -limit, limit);
+        d = std::cos(turn) * d + std::sin(turn) * n.cross(d);
+        d -= d.dot(n) * n;
+        d.normalize();
+      }
+      if (!walker_.walk(p, d, o_.step)) break;
+      s += o_.step;
+      const Vector3d q = walker_.position(p);
+      if (near_line(q, walker_.normal(p.face), o_.stop, line, sign * s) || near_obstacle(q)) break;
+      ids.push_back(add(p, sign > 0 ? d : Vector3d(-d), sign * s, line));
+    }
+    return ids;
+  }
+
+  // The line nearest to a seed that no line placed (within the grid's reach) and running
+  // along the field there, as its parent.
+  void nearest_line(Seed& seed) const {
+    const Vector3d q = walker_.position(seed.point), n = walker_.normal(seed.point.face);
+    const Vector3d d = start_direction(seed.point.face);
+    double best = kInf;
+    grid_.any(q, [&](int id) {
+      const Sample& o = samples_[static_cast<size_t>(id)];
+      const double dist = (o.position - q).squaredNorm();
+      if (alive_[static_cast<size_t>(o.line)] && o.normal.dot(n) >= -0.5 &&
+          o.direction.dot(d) > kParallel &&
+          (dist < best || (dist == best && id < seed.parent_sample))) {
+        best = dist;
+        seed.parent_sample = id;
+      }
+      return false;
+    });
+  }
+
+  bool trace_from(const Seed& seed_in) {
+    const SurfacePoint& seed = seed_in.point;
+    const int line = static_cast<int>(lines_.size());
+    lines_.emplace_back();
+    alive_.push_back(1);
+    const Vector3d d = start_direction(seed.face);
+    Origin origin;
+    origin.anchor = walker_.position(seed).dot(o_.up);
+    if (seed_in.parent_sample >= 0) {
+      const Sample& p = samples_[static_cast<size_t>(seed_in.parent_sample)];
+      if (p.direction.dot(d) > kParallel) origin.parent = p.line, origin.parent_s = p.s;
+    }
+    origin_.push_back(origin);
+    const int first = add(seed, d, 0, line);
+    std::vector<int> back = trace(seed, -d, -1, line);
+    const std::vector<int> ahead = trace(seed, d, 1, line);
+    std::vector<int>& ids = lines_.back();
+    ids.assign(back.rbegin(), back.rend());
+    ids.push_back(first);
+    ids.insert(ids.end(), ahead.begin(), ahead.end());
+    const double length = o_.step * static_cast<double>(ids.size() - 1);
+    if (length < o_.min_length) {
+      alive_.back() = 0;  // its samples stay in the grid, ignored
+      ++short_;
+      return false;
+    }
+    return true;
+  }
+
+  // Seeds at the separation on both sides of a line, about every half separation along it.
+  void beside(int line, std::deque<Seed>& queue) const {
+    const std::vector<int>& ids = lines_[static_cast<size_t>(line)];
+    const int every = std::max(1, static_cast<int>(0.5 * o_.separation / o_.step));
+    for (size_t i = 0; i < ids.size(); i += static_cast<size_t>(every))
+      for (const double side : {1.0, -1.0}) {
+        const Sample& q = samples_[static_cast<size_t>(ids[i])];
+        SurfacePoint p = q.point;
+        Vector3d d = side * q.normal.cross(q.direction);
+        if (walker_.walk(p, d, o_.separation)) {
+          Seed seed;
+          seed.point = p;
+          seed.parent_sample = ids[i];
+          queue.push_back(seed);
+        }
+      }
+  }
+
+  const SurfaceWalker& walker_;
+  const MatrixX3d& guide_;
+  const MatrixX3d& fallback_;
+  StreamlineOptions o_;
+  std::vector<Sample> samples_;
+  std::vector<std::vector<int>> lines_;
+  std::vector<char> alive_;
+  struct Origin {
+    int parent = -1;      // the parallel line it was seeded beside, or -1
+    double parent_s = 0;  // where, along the parent, as traced
+    double anchor = 0;    // the seed's height along `up`
+  };
+  static constexpr double kParallel = 0.866;  // within 30 degrees
+  std::vector<Origin> origin_;
+  PointGrid grid_, obstacle_grid_;
+  const std::vector<Vector3d>& obstacles_;
+  int short_ = 0;
+};
+
+// --- elements along a stem ---------------------------------------------------------------------
+
+// A stem's frame: arc length X along its streamline, lateral Y to its left.
+class StemFrame {
+ public:
+  StemFrame(const SurfaceWalker& walker, const std::vector<Sample>& line)
+      : walker_(walker), line_(line) {}
+  double length() const { return line_.back().s; }
+
+  // The point at arc length x (clamped to the line) and the line's direction there.
+  SurfacePoint at(double x, Vector3d& direction) const {
+    x = std::clamp(x, 0.0, length());
+    size_t i =
+        static_cast<size_t>(std::upper_bound(line_.begin(), line_.end(), x,
+                                             [](double v, const Sample& q) { return v < q.s; }) -
+                            line_.begin());
+    i = i == 0 ? 0 : i - 1;
+    SurfacePoint p = line_[i].point;
+    direction = line_[i].direction;
+    walker_.walk(p, direction, x - line_[i].s);
+    return p;
+  }
+  // The point reached from `from` (direction `direction` there) by the offset (dx, dy) in the
+  // tangent plane (dx along the direction, dy to its left), along the surface. *whole (if
+  // given) is cleared when the base's boundary cut the way short.
+  SurfacePoint offset(SurfacePoint from, const Vector3d& direction, double dx, double dy,
+                      bool* whole = nullptr) const {
+    const Vector3d n = walker_.normal(from.face);
+    const Vector3d v = dx * direction + dy * n.cross(direction);
+    const double len = v.norm();
+    if (len > 0) {
+      Vector3d d = v / len;
+      if (!walker_.walk(from, d, len) && whole) *whole = false;
+    }
+    return from;
+  }
+
+ private:
+  const SurfaceWalker& walker_;
+  const std::vector<Sample>& line_;
+};
+
+// An element placed on the base: local coordinates and its 3D positions by normal displacement
+// (for the intersection tests).
+struct Placed {
+  SurfaceElement element;
+  MatrixX3d position;
+};
+
+// Where the embedding's normal displacement puts a point: over the refined base along the
+// shell's smoothed directions (core/shell/offset_surface's displacement_directions, as
+// core/shell/quilt_embedding). The shell map, where there is one, differs from it by a fraction of
+// the shell height.
+class Displacement {
+ public:
+  Displacement(const TriMesh& base, double shell_height)
+      : base_(base), N_(displacement_directions(base.V, base.F, shell_height)) {}
+  Vector3d operator()(int face, const Vector3d& b, double height) const {
+    return displace_along_normal(base_, N_, face, b, height);
+  }
+
+ private:
+  const TriMesh& base_;
+  MatrixX3d N_;
+};
+
+void set_vertex(Placed& out, int v, const SurfacePoint& p, double height,
+                const Displacement& shell) {
+  out.element.face[static_cast<size_t>(v)] = p.face;
+  out.element.barycentric.row(v) = p.bary.transpose();
+  out.element.height(v) = height;
+  out.position.row(v) = shell(p.face, p.bary, height).transpose();
+}
+
+// A stem of length S in its straight frame (arc length, lateral, height): the swatch vine's
+// cross-section swept along its periodic centreline from pattern coordinate `phase`, capped
+// at both ends. ring[v]: the arc length of vertex v's cross-section centre.
+TriMesh stem_in_frame(const VineModel& m, double S, double phase, std::vector<double>* ring) {
+  const int rings = std::max(2, static_cast<int>(std::ceil(S / m.ring_spacing)) + 1);
+  const int seg = m.segments;
+  TriMesh t;
+  t.V.resize(rings * seg + 2, 3);
+  if (ring) ring->assign(static_cast<size_t>(t.V.rows()), 0.0);
+  for (int j = 0; j < rings; ++j) {
+    const double s = S * j / (rings - 1);
+    const double u = s + phase;  // along the swatch's pattern
+    const Vector3d centre(s, m.at(m.wave, u), m.at(m.lift, u));
+    const Vector3d T = Vector3d(1, m.slope(m.wave, u), m.slope(m.lift, u)).normalized();
+    // The cross-section frame of the swatch generator's tubes: side = z x T, up = T x side.
+    const Vector3d side = Vector3d::UnitZ().cross(T).normalized(), up = T.cross(side);
+    for (int k = 0; k < seg; ++k) {
+      const double phi = kTwoPi * k / seg;
+      t.V.row(j * seg + k) =
+          (centre + m.radius * (std::cos(phi) * side + std::sin(phi) * up)).transpose();
+      if (ring) (*ring)[static_cast<size_t>(j * seg + k)] = s;
+    }
+    if (j == 0 || j == rings - 1) {
+      const int c = rings * seg + (j == 0 ? 0 : 1);
+      t.V.row(c) = centre.transpose();
+      if (ring) (*ring)[static_cast<size_t>(c)] = s;
+    }
+  }
+  t.F.resize(2 * (rings - 1) * seg + 2 * seg, 3);
+  int f = 0;
+  for (int j = 0; j + 1 < rings; ++j)
+    for (int k = 0; k < seg; ++k) {
+      const int k1 = (k + 1) % seg;
+      const int a = j * seg + k, b = j * seg + k1, c = (j + 1) * seg + k1, d = (j + 1) * seg + k;
+      t.F.row(f++) << a, b, c;
+      t.F.row(f++) << a, c, d;
+    }
+  const int c0 = rings * seg, c1 = rings * seg + 1;
+  for (int k = 0; k < seg; ++k) {
+    const int k1 = (k + 1) % seg;
+    t.F.row(f++) << c0, k1, k;
+    t.F.row(f++) << c1, (rings - 1) * seg + k, (rings - 1) * seg + k1;
+  }
+  return t;
+}
+
+// The places along a stem of length S with pattern phase `phase` where the swatch's ratio puts
+// a leaf: (arc length, leaf index), in order along the stem.
+std::vector<std::pair<double, int>> leaf_slots(const VineModel& m, double S, double phase) {
+  std::vector<std::pair<double, int>> out;
+  double first = std::fmod(phase, m.period);
+  if (first < 0) first += m.period;
+  for (int j = 0; j * m.period - first <= S; ++j)
+    for (size_t i = 0; i < m.leaves.size(); ++i) {
+      const double x = m.leaves[i].attach + j * m.period - first;
+      if (x >= 0 && x <= S) out.emplace_back(x, static_cast<int>(i));
+    }
+  return out;
+}
+
+// The closest two straight stems side by side, in phase (as stems climbing a wall together
+// are), can lie without touching: found by bisection on the swatch's own geometry laid out
+// over a few periods in the stems' frame. Neighbours' leaves then interleave, each between two
+// of the other's.
+double parallel_spacing(const VineModel& m) {
+  const double S = 4 * m.period;
+  TriMesh one = stem_in_frame(m, S, 0, nullptr);
+  for (const auto& [x, i] : leaf_slots(m, S, 0)) {
+    TriMesh leaf;
+    leaf.V = m.pose(m.leaves[static_cast<size_t>(i)], x);
+    leaf.F = m.leaves[static_cast<size_t>(i)].F;
+    append_mesh(one, leaf);
+  }
+  double lo = 2 * m.extent, hi = 2 * m.reach + m.extent;
+  for (int it = 0; it < 24; ++it) {
+    const double d = 0.5 * (lo + hi);
+    TriMesh other = one;
+    other.V.col(1).array() += d;
+    (meshes_intersect(one, other) ? lo : hi) = d;
+  }
+  return hi;
+}
+
+// A stem laid along its line: each vertex reached from its cross-section's centre on the line
+// by its offset in the frame, along the surface.
+Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
+                 const Displacement& shell, std::vector<double>* rings) {
+  std::vector<double> ring;
+  const TriMesh t = stem_in_frame(m, frame.length(), phase, &ring);
+  Placed out;
+  SurfaceElement& e = out.element;
+  e.kind = m.kind;
+  e.F = t.F;
+  const int nv = static_cast<int>(t.V.rows());
+  e.face.resize(static_cast<size_t>(nv));
+  e.barycentric.resize(nv, 3);
+  e.height.resize(nv);
+  out.position.resize(nv, 3);
+  double at = -1;
+  SurfacePoint c;
+  Vector3d direction;
+  for (int v = 0; v < nv; ++v) {
+    const double s = ring[static_cast<size_t>(v)];
+    if (s != at) c = frame.at(s, direction), at = s;
+    set_vertex(out, v, frame.offset(c, direction, t.V(v, 0) - s, t.V(v, 1)), t.V(v, 2), shell);
+  }
+  if (rings) *rings = std::move(ring);
+  return out;
+}
+
+// A swatch leaf laid rigidly from its attachment at arc length x: each vertex reached by its
+// offset from there, along the surface. *whole is cleared when part of it would lie beyond the
+// base's boundary.
+Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& frame, double x,
+                 double phase, double push, const Displacement& shell, bool* whole) {
+  Placed out;
+  SurfaceElement& e = out.element;
+  e.kind = leaf.kind;
+  e.F = leaf.F;
+  e.flat = m.pose(leaf, x, phase);  // a rigid copy of the swatch's leaf
+  e.flat.col(0).array() -= x;
+  // Moved away from the vine by `push`, on its side of it.
+  e.flat.col(1).array() += leaf.P.col(1).mean() < 0 ? -push : push;
+  const int nv = static_cast<int>(leaf.P.rows());
+  e.face.resize(static_cast<size_t>(nv));
+  e.barycentric.resize(nv, 3);
+  e.height.resize(nv);
+  out.position.resize(nv, 3);
+  Vector3d direction;
+  const SurfacePoint a = frame.at(x, direction);
+  for (int v = 0; v < nv; ++v)
+    set_vertex(out, v, frame.offset(a, direction, e.flat(v, 0), e.flat(v, 1), whole), e.flat(v, 2),
+               shell);
+  return out;
+}
+
+// Whether every vertex of an element lies over one face of the base as given: displaced along
+// the normals interpolated over one triangle, a copy of an unfolded element stays unfolded
+// (across faces it can fold: where they meet at an angle, or belong to separate pieces).
+bool on_one_face(const Refinement& refinement, const SurfaceElement& e) {
+  const auto parent = [&](int f) {
+    return refinement.parent.empty() ? f : refinement.parent[static_cast<size_t>(f)];
+  };
+  const int first = parent(e.face.front());
+  for (const int f : e.face)
+    if (parent(f) != first) return false;
+  return true;
+}
+
+// Where a leaf is tried, in order: (along the stem, in leaf pitches; away from the vine, in
+// tube radii).
+constexpr std::array<std::pair<double, double>, 8> kLeafMoves = {
+    {{0, 0}, {0.15, 0}, {-0.15, 0}, {0.3, 0}, {-0.3, 0}, {0, 1}, {0.15, 1}, {-0.15, 1}}};
+
+void check_options(const VineGrowthOptions& o) {
+  MQ_CHECK(o.up.allFinite() && o.up.norm() > 0, InvalidInput,
+           "vines: the up direction must be finite and non-zero");
+  for (const double v : {o.spacing, o.stop_fraction, o.turn_radius})
+    MQ_CHECK(std::isfinite(v) && v > 0, InvalidInput,
+             "vines: spacing, stop fraction and turn radius must be positive and finite");
+  MQ_CHECK(std::isfinite(o.min_length) && o.min_length >= 0, InvalidInput,
+           "vines: the shortest stem must be >= 0 and finite");
+}
+
+}  // namespace
+
+bool is_vine_swatch(const PreparedSwatch& swatch) {
+  if (swatch.elements.size() < 2) return false;
+  std::vector<ElementLength> lengths;
+  const int vine = find_vine(swatch, &lengths);
+  if (vine < 0) return false;
+  if (lengths[static_cast<size_t>(vine)].length < 0.5 * swatch.size.head<2>().maxCoeff())
+    return false;
+  const Element& v = swatch.elements[static_cast<size_t>(vine)];
+  const ClosestPointQuery query(v.V, v.F);
+  for (size_t i = 0; i < swatch.elements.size(); ++i) {
+    if (static_cast<int>(i) == vine) continue;
+    const Element& e = swatch.elements[i];
+    const double within = 0.25 * e.footprint_diameter();
+    bool attached = false;
+    for (Eigen::Index k = 0; k < e.V.rows() && !attached; ++k)
+      attached = query.closest(Vector3d(e.V.row(k).transpose()), within).face >= 0;
+    if (!attached) return false;
+  }
+  return true;
+}
+
+SurfaceQuilt quilt_surface_vines(const TriMesh& base, const TriMesh& swatch,
+                                 const SurfaceQuiltingOptions& options,
+                                 const VineGrowthOptions& vine_options,
+                                 SurfaceQuiltingStats* stats_out, VineGrowthStats* vine_stats,
+                                 ProgressSink* progress) {
+  check_options(vine_options);
+  SurfaceQuiltingStats stats;
+  SurfaceJob job = prepare_surface_job(base, swatch, options, stats);
+  return quilt_prepared_vines(std::move(job), std::move(stats), options, vine_options, stats_out,
+                              vine_stats, progress);
+}
+
+SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
+                                  const SurfaceQuiltingOptions& options,
+                                  const VineGrowthOptions& vo, SurfaceQuiltingStats* stats_out,
+                                  VineGrowthStats* vine_stats, ProgressSink* progress) {
+  check_options(vo);
+  StageTimes& times = stats.times;
+  VineGrowthStats vs;
+  PreparedSwatch swatch;
+  VineModel model;
+  {
+    ScopedStageTimer timer(times, "prepare");
+    swatch = prepare_swatch(job.swatch);
+    MQ_CHECK(is_vine_swatch(swatch), InvalidInput,
+             "the vine method needs a swatch of one long element (a vine) with compact elements "
+             "attached along it");
+    model = analyse_vine(swatch, find_vine(swatch, nullptr));
+  }
+  const TriMesh& base = job.base;
+  const int nf = base.num_faces();
+  const double H = swatch.size.z();
+  stats.shell_height = H;
+  const SurfaceWalker walker(base, job.TT);
+  const MatrixX3d& FN = walker.normals();
+
+  // The field the stems follow: the given one at full strength, else `up` projected onto each
+  // face at the length of its projection (0 where it is normal to the surface: lines run on
+  // straight there). The smooth default field gives seeds there a direction.
+  MatrixX3d guide(nf, 3);
+  Vector3d up = vo.up.normalized();
+  if (options.field.rows() > 0) {
+    guide = job.field;
+    Vector3d mean = Vector3d::Zero();
+    const Eigen::VectorXd area = face_areas(base.V, base.F);
+    for (int f = 0; f < nf; ++f) mean += area(f) * job.field.row(f).transpose();
+    if (mean.norm() > 0) up = mean.normalized();  // only orders the seeds
+  } else {
+    for (int f = 0; f < nf; ++f) {
+      const Vector3d n = FN.row(f).transpose();
+      guide.row(f) = (vo.up.normalized() - vo.up.normalized().dot(n) * n).transpose();
+    }
+  }
+
+  StreamlineOptions so;
+  so.separation = vo.spacing * parallel_spacing(model);
+  so.stop = std::max(vo.stop_fraction * so.separation, 2 * model.extent + model.radius);
+  // Lower than Jobard and Lefer's d_sep: distances are taken straight through space, which is
+  // shorter than along the surface around a box's edge, where seeds at the spacing beside a
+  // line were refused (ivy wall: 0.9 left the edges 54% covered, 0.75 67%).
+  so.seed_clearance = std::max(0.75 * so.separation, so.stop);
+  so.step = std::min(so.separation / 8, model.period / 8);
+  so.self_gap = std::max(2 * so.separation, M_PI * vo.turn_radius * model.period);
+  so.obstacle = model.extent + model.radius;
+  so.turn_radius = vo.turn_radius * model.period;
+  so.min_length = vo.min_length * model.period;
+  so.up = up;
+  vs.vine_length = model.period;
+  vs.spacing = so.separation;
+
+  // The size before any work: stems at the spacing over the base's area, as many leaves as the
+  // swatch's ratio gives.
+  {
+    const double area = surface_area(base.V, base.F);
+    const double length = area / so.separation;
+    double leaf_faces = 0;
+    for (const SwatchLeaf& l : model.leaves) leaf_faces += static_cast<double>(l.F.rows());
+    const double faces =
+        length * (2.0 * model.segments / model.ring_spacing + leaf_faces / model.period);
+    stats.estimated_faces = faces;  // the memory estimate's (--stats `memory`), not the patches'
+    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
+             " the vines would have about ", faces, " faces, more than the limit of ",
+             options.max_faces, " (--max-faces); use a larger --scale");
+  }
+
+  std::vector<std::vector<Sample>> lines;
+  std::vector<double> phases;  // where each line's swatch pattern starts (arc length)
+  {
+    ScopedStageTimer timer(times, "streamlines");
+    // The base's boundary, sampled, keeps the tubes off it.
+    std::vector<Vector3d> obstacles;
+    for (int e = 0; e < job.topo.num_edges(); ++e) {
+      if (job.topo.edge_faces.degree(e) == 2) continue;
+      const Vector3d a = base.V.row(job.topo.E(e, 0)), b = base.V.row(job.topo.E(e, 1));
+      const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * so.obstacle))));
+      for (int k = 0; k <= n; ++k) obstacles.push_back(a + (b - a) * (static_cast<double>(k) / n));
+    }
+    // Seeds lowest first (ties by face index: deterministic).
+    std::vector<std::pair<double, int>> order(static_cast<size_t>(nf));
+    for (int f = 0; f < nf; ++f) order[static_cast<size_t>(f)] = {walker.centroid(f).dot(up), f};
+    std::sort(order.begin(), order.end());
+    std::vector<int> seeds(static_cast<size_t>(nf));
+    for (int f = 0; f < nf; ++f)
+      seeds[static_cast<size_t>(f)] = order[static_cast<size_t>(f)].second;
+    Streamlines grower(walker, guide, job.field, obstacles, so);
+    grower.grow(seeds, progress);
+    for (auto& [line, phase] : grower.lines()) {
+      lines.push_back(std::move(line));
+      phases.push_back(phase);
+    }
+    vs.streamlines_short = grower.short_lines();
+  }
+
+  const Displacement shell(job.base, H);
+  // Stems first, in order, then their leaves: nothing placed may intersect what is there. A
+  // stem that would intersect itself (bent over a fold of the surface too tight for its
+  // tube) or an earlier stem is cut there, and what is left on either side grown in a later
+  // round; after the last round such a stem is left out.
+  TriangleGrid placed(std::max(0.25 * model.reach, 4 * model.radius));
+  SurfaceQuilt quilt;
+  struct Stem {
+    std::vector<Sample> line;
+    double phase = 0;
+  };
+  std::vector<Stem> todo, kept;
+  for (size_t l = 0; l < lines.size(); ++l) todo.push_back({std::move(lines[l]), phases[l]});
+  {
+    ScopedStageTimer timer(times, "stems");
+    const int kRounds = 3;
+    for (int round = 0; round < kRounds && !todo.empty(); ++round) {
+      const int n = static_cast<int>(todo.size());
+      std::vector<Placed> made(static_cast<size_t>(n));
+      std::vector<std::vector<double>> rings(static_cast<size_t>(n));
+      std::vector<std::vector<char>> bad(static_cast<size_t>(n));
+      tbb::parallel_for(0, n, [&](int l) {
+        const Stem& st = todo[static_cast<size_t>(l)];
+        const StemFrame frame(walker, st.line);
+        made[static_cast<size_t>(l)] =
+            make_stem(model, frame, st.phase, shell, &rings[static_cast<size_t>(l)]);
+        const Placed& p = made[static_cast<size_t>(l)];
+        std::vector<char>& b = bad[static_cast<size_t>(l)];
+        b.assign(static_cast<size_t>(p.element.F.rows()), 0);
+        IntersectionOptions all;
+        all.between_components_only = false;
+        for (const auto& [f, g] : intersecting_face_pairs(p.position, p.element.F, all))
+          b[static_cast<size_t>(f)] = b[static_cast<size_t>(g)] = 1;
+      });
+      std::vector<Stem> next;
+      for (int l = 0; l < n; ++l) {
+        Placed& p = made[static_cast<size_t>(l)];
+        std::vector<char>& b = bad[static_cast<size_t>(l)];
+        placed.mark_intersecting(p.position, p.element.F, b);
+        if (std::find(b.begin(), b.end(), 1) == b.end()) {
+          placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
+          quilt.elements.push_back(std::move(p.element));
+          kept.push_back(std::move(todo[static_cast<size_t>(l)]));
+          continue;
+        }
+        ++vs.stems_cut;
+        // The arc lengths its bad faces span, widened by the spacing, are cut out.
+        const std::vector<double>& ring = rings[static_cast<size_t>(l)];
+        std::vector<std::pair<double, double>> cut;
+        for (Eigen::Index f = 0; f < p.element.F.rows(); ++f) {
+          if (!b[static_cast<size_t>(f)]) continue;
+          double lo = kInf, hi = -kInf;
+          for (int k = 0; k < 3; ++k) {
+            lo = std::min(lo, ring[static_cast<size_t>(p.element.F(f, k))]);
+            hi = std::max(hi, ring[static_cast<size_t>(p.element.F(f, k))]);
+          }
+          cut.emplace_back(lo - 0.5 * so.separation, hi + 0.5 * so.separation);
+        }
+        std::sort(cut.begin(), cut.end());
+        const Stem& st = todo[static_cast<size_t>(l)];
+        double from = 0;
+        const auto piece = [&](double a, double b) {
+          if (b - a < so.min_length) return;
+          Stem part;
+          for (const Sample& q : st.line)
+            if (q.s >= a && q.s <= b) part.line.push_back(q);
+          if (part.line.size() < 2) return;
+          const double s0 = part.line.front().s;
+          for (Sample& q : part.line) q.s -= s0;
+          part.phase = st.phase + s0;
+          next.push_back(std::move(part));
+        };
+        for (const auto& [a, b2] : cut) {
+          piece(from, a);
+          from = std::max(from, b2);
+        }
+        piece(from, st.line.back().s);
+      }
+      todo = std::move(next);
+    }
+    vs.stems_dropped = static_cast<int>(todo.size());
+  }
+  {
+    ScopedStageTimer timer(times, "leaves");
+    const double pitch = model.period / std::max<size_t>(1, model.leaves.size());
+    for (size_t k = 0; k < kept.size(); ++k) {
+      const StemFrame frame(walker, kept[k].line);
+      const double S = frame.length();
+      const double phase = kept[k].phase;
+      for (const auto& [x, i] : leaf_slots(model, S, phase)) {
+        const SwatchLeaf& leaf = model.leaves[static_cast<size_t>(i)];
+        ++vs.leaf_slots;
+        // Tried at its place, then a little along the stem either way, then as far again from
+        // the vine's axis as the tube's radius (where the surface curves, a leaf laid rigidly
+        // from the stem can meet the stem itself).
+        for (const auto& [shift, push] : kLeafMoves) {
+          const double xs = x + shift * pitch;
+          if (xs < 0 || xs > S) continue;
+          bool whole = true;
+          Placed p = make_leaf(model, leaf, frame, xs, phase, push * model.radius, shell, &whole);
+          // Whole on the base, clear of everything placed, and not folded through itself
+          // (bent over a box's edge, the displacement can fold a leaf).
+          if (!whole || placed.intersects(p.position, p.element.F) >= 0 ||
+              (!on_one_face(job.refinement, p.element) &&
+               !self_intersecting_components(p.position, p.element.F).empty()))
+            continue;
+          placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
+          quilt.elements.push_back(std::move(p.element));
+          ++vs.leaves;
+          vs.leaves_shifted += shift != 0 || push != 0 ? 1 : 0;
+          break;
+        }
+      }
+      report_progress(progress, "leaves", static_cast<double>(k + 1),
+                      static_cast<double>(kept.size()));
+    }
+  }
+
+  vs.stems = static_cast<int>(kept.size());
+  std::vector<double> lengths;
+  for (const Stem& st : kept) lengths.push_back(st.line.back().s);
+  for (const double l : lengths) vs.total_length += l;
+  if (!lengths.empty()) {
+    std::vector<double> sorted = lengths;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    vs.median_length = sorted[sorted.size() / 2] / model.period;
+  }
+  quilt.kinds = swatch.kinds;
+  quilt.shell_height = H;
+  quilt.base = std::move(job.base);
+  quilt.input_base = std::move(job.cleaned);
+  quilt.refinement = std::move(job.refinement);
+  stats.iterations = vs.stems;
+  stats.counts.added = static_cast<int>(quilt.elements.size());
+  stats.elements = static_cast<int>(quilt.elements.size());
+  for (const SurfaceElement& e : quilt.elements) {
+    stats.faces += static_cast<int>(e.F.rows());
+    stats.vertices += static_cast<int>(e.face.size());
+  }
+  report_progress(progress, "leaves", 1, 1);
+  if (stats_out) *stats_out = std::move(stats);
+  if (vine_stats) *vine_stats = vs;
+  return quilt;
+}
+
+}  // namespace mq

@@ -1,0 +1,239 @@
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/common/errors.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/quilt_elements.h"
+#include "core/planar/swatch_generators.h"
+#include "core/planar/translation_cost.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/structure/texture_structure.h"
+#include "core/surface/global_quilting.h"
+#include "core/surface/tangent_field.h"
+#include "core/surface/vine_growth.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+// The sample ivy of the bench jobs (`swatch ivy --count 2 --length 2`): one vine, two leaves.
+TriMesh ivy_swatch() {
+  IvyOptions o;
+  o.leaves = 2;
+  o.length = 2;
+  return ivy_section(o);
+}
+
+// The kind index of a name in a quilt.
+int kind_of(const SurfaceQuilt& q, const std::string& name) {
+  const auto it = std::find(q.kinds.begin(), q.kinds.end(), name);
+  return it == q.kinds.end() ? -1 : static_cast<int>(it - q.kinds.begin());
+}
+
+struct Grown {
+  SurfaceQuilt quilt;
+  VineGrowthStats stats;
+  // Embedded as the tool does where the shell map is not used (normal displacement over the
+  // base as given), nothing removed; its elements in the quilt's order.
+  TriMesh mesh;
+  std::vector<TriMesh> elements;
+};
+
+Grown grow(const TriMesh& base, double scale, const MatrixX3d& field = {}) {
+  SurfaceQuiltingOptions o;
+  o.scale = scale;
+  o.field = field;
+  Grown g;
+  g.quilt = quilt_surface_vines(base, ivy_swatch(), o, {}, nullptr, &g.stats);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;
+  e.remove_intersecting = false;
+  TetStretchCpu stretch;
+  g.mesh = embed_quilt(g.quilt, e, stretch);
+  std::vector<int> fc;
+  const int n = connected_components(g.mesh.F, g.mesh.num_vertices(), fc);
+  for (const std::vector<int>& faces : component_faces(fc, n))
+    g.elements.push_back(extract_faces(g.mesh, faces));
+  EXPECT_EQ(g.elements.size(), g.quilt.elements.size());
+  return g;
+}
+
+// What every grown result must be: each stem one closed manifold tube, no two elements and no
+// element with itself intersecting, leaves at the swatch's ratio (two per swatch vine length).
+void expect_sound(const Grown& g, double leaf_share) {
+  const int vine = kind_of(g.quilt, "vine");
+  ASSERT_GE(vine, 0);
+  int stems = 0, leaves = 0;
+  for (size_t i = 0; i < g.quilt.elements.size(); ++i) {
+    const SurfaceElement& e = g.quilt.elements[i];
+    if (e.kind != vine) {
+      ++leaves;
+      continue;
+    }
+    ++stems;
+    const TopologyReport t = topology_report(g.elements[i]);
+    EXPECT_EQ(t.num_components, 1);
+    EXPECT_TRUE(t.closed() && t.manifold());
+  }
+  EXPECT_EQ(stems, g.stats.stems);
+  EXPECT_EQ(leaves, g.stats.leaves);
+  EXPECT_TRUE(intersecting_face_pairs(g.mesh.V, g.mesh.F).empty());
+  EXPECT_TRUE(self_intersecting_components(g.mesh.V, g.mesh.F).empty());
+  // The swatch carries 2 leaves per vine length; the slots along the stems are that ratio.
+  const double vines = g.stats.total_length / g.stats.vine_length;
+  EXPECT_NEAR(g.stats.leaf_slots / vines, 2.0, 0.15);
+  EXPECT_GE(g.stats.leaves, leaf_share * g.stats.leaf_slots);
+}
+
+TEST(VineGrowth, TheIvySectionIsAVineAndTheLatticesAreNot) {
+  EXPECT_TRUE(is_vine_swatch(prepare_swatch(ivy_swatch())));
+  IvyOptions longer;
+  longer.length = 6;
+  longer.leaves = 6;
+  EXPECT_TRUE(is_vine_swatch(prepare_swatch(ivy_section(longer))));
+  ChainMailOptions mail;
+  mail.rows = mail.cols = 3;
+  EXPECT_FALSE(is_vine_swatch(prepare_swatch(chainmail_4in1(mail))));
+  WeaveOptions weave;
+  weave.threads_x = weave.threads_y = 3;
+  EXPECT_FALSE(is_vine_swatch(prepare_swatch(plain_weave(weave))));
+  AppleOptions apples;
+  apples.count = 5;
+  EXPECT_FALSE(is_vine_swatch(prepare_swatch(apple_layer(apples))));
+  IvyOptions bare;  // a vine alone carries nothing
+  bare.leaves = 0;
+  EXPECT_FALSE(is_vine_swatch(prepare_swatch(ivy_section(bare))));
+}
+
+TEST(VineGrowth, BadInputThrows) {
+  const TriMesh plane = test::plane_grid(2, 1.5, 8, 6);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.06;
+  VineGrowthOptions v;
+  v.spacing = 0;
+  EXPECT_THROW(quilt_surface_vines(plane, ivy_swatch(), o, v), InvalidInput);
+  v = {};
+  v.up = Vector3d::Zero();
+  EXPECT_THROW(quilt_surface_vines(plane, ivy_swatch(), o, v), InvalidInput);
+  AppleOptions apples;
+  apples.count = 4;
+  EXPECT_THROW(quilt_surface_vines(plane, apple_layer(apples), o), InvalidInput);
+  o.max_faces = 1000;
+  EXPECT_THROW(quilt_surface_vines(plane, ivy_swatch(), o), InvalidInput);
+}
+
+// On an upright plane (y up) stems climb from the bottom to the top in evenly spaced columns,
+// with the swatch's leaves between them.
+TEST(VineGrowth, StemsClimbAPlaneEvenlySpaced) {
+  const Grown g = grow(test::plane_grid(2, 1.5, 20, 15), 0.06);
+  expect_sound(g, 0.95);
+  ASSERT_GE(g.stats.stems, 8);
+  EXPECT_GE(g.stats.median_length, 3.0);
+  const int vine = kind_of(g.quilt, "vine");
+  std::vector<double> columns;
+  for (size_t i = 0; i < g.quilt.elements.size(); ++i) {
+    const SurfaceElement& e = g.quilt.elements[i];
+    if (e.kind != vine) continue;
+    const TriMesh m = g.elements[i];
+    const Vector3d lo = m.V.colwise().minCoeff(), hi = m.V.colwise().maxCoeff();
+    // Upwards, the height of the plane less the margins its border leaves.
+    EXPECT_GT(hi.y() - lo.y(), 1.0);
+    EXPECT_LT(hi.x() - lo.x(), 0.5 * g.stats.spacing);
+    columns.push_back(m.V.col(0).mean());
+  }
+  // Side by side at the spacing; a gap left at the border may take one a little closer (a
+  // seed needs 0.75 of the spacing to every line).
+  std::sort(columns.begin(), columns.end());
+  std::vector<double> gaps;
+  for (size_t i = 1; i < columns.size(); ++i) {
+    gaps.push_back(columns[i] - columns[i - 1]);
+    EXPECT_GT(gaps.back(), 0.75 * g.stats.spacing);
+    EXPECT_LT(gaps.back(), 1.1 * g.stats.spacing);
+  }
+  std::sort(gaps.begin(), gaps.end());
+  EXPECT_NEAR(gaps[gaps.size() / 2], g.stats.spacing, 0.01 * g.stats.spacing);
+}
+
+// A given field is followed: along x, the stems run across the plane.
+TEST(VineGrowth, StemsFollowAGivenField) {
+  const TriMesh plane = test::plane_grid(2, 1.5, 20, 15);
+  const Grown g = grow(plane, 0.06, tangent_field_from_direction(plane.V, plane.F, {1, 0, 0}));
+  expect_sound(g, 0.95);
+  const int vine = kind_of(g.quilt, "vine");
+  for (size_t i = 0; i < g.quilt.elements.size(); ++i) {
+    const SurfaceElement& e = g.quilt.elements[i];
+    if (e.kind != vine) continue;
+    const TriMesh m = g.elements[i];
+    const Vector3d ext = m.V.colwise().maxCoeff() - m.V.colwise().minCoeff();
+    EXPECT_GT(ext.x(), 3 * ext.y());
+  }
+}
+
+// On a box, stems climb its sides and bend over the top edge onto the top (the field vanishes
+// there, and they run on straight); nothing intersects across the edges.
+TEST(VineGrowth, StemsBendOverABoxsEdges) {
+  TriMesh box = test::unit_cube();
+  box.V.col(1) *= 2;  // 1 x 2 x 1, y up
+  const Grown g = grow(box, 0.06);
+  expect_sound(g, 0.85);
+  EXPECT_GE(g.stats.median_length, 3.0);
+  const int vine = kind_of(g.quilt, "vine");
+  int over = 0;
+  for (size_t i = 0; i < g.quilt.elements.size(); ++i) {
+    const SurfaceElement& e = g.quilt.elements[i];
+    if (e.kind != vine) continue;
+    const TriMesh m = g.elements[i];
+    bool low = false, on_top = false;
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+      const Vector3d p = m.V.row(v);
+      low = low || p.y() < 1.5;
+      on_top = on_top || (p.y() > 2 && std::min({p.x(), 1 - p.x(), p.z(), 1 - p.z()}) > 0.1);
+    }
+    over += low && on_top;
+  }
+  EXPECT_GE(over, 4);  // at least one from each side
+}
+
+TEST(VineGrowth, SameResultWhateverTheThreadCount) {
+  TriMesh box = test::unit_cube();
+  box.V.col(1) *= 2;
+  std::vector<Grown> runs;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    runs.push_back(grow(box, 0.08));
+  }
+  ASSERT_EQ(runs[0].quilt.elements.size(), runs[1].quilt.elements.size());
+  EXPECT_EQ(runs[0].mesh.V, runs[1].mesh.V);
+  EXPECT_EQ(runs[0].mesh.F, runs[1].mesh.F);
+  EXPECT_EQ(runs[0].mesh.face_kind, runs[1].mesh.face_kind);
+}
+
+// --method auto grows the ivy section as vines, and the structure measure sees stems many
+// swatch vines long with the swatch's leaves per length.
+TEST(VineGrowth, AutoChoosesVinesForIvyAndTheMeasureSeesThem) {
+  const TriMesh plane = test::plane_grid(2, 1.5, 20, 15);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.06;
+  TranslationCostCpu cost;
+  bool global = true, vines = false;
+  VineGrowthStats vs;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt q = quilt_surface_auto(plane, ivy_swatch(), o, cost, &stats, nullptr, nullptr,
+                                            &global, &vines, &vs);
+  EXPECT_FALSE(global);
+  EXPECT_TRUE(vines);
+  EXPECT_GT(vs.stems, 0);
+  const TriMesh out = embed_by_normal_displacement(q);
+  const StructureSummary s = summarize_structure(out, ivy_swatch(), &plane, stats.swatch_scale);
+  EXPECT_EQ(s.output.long_elements, vs.stems);
+  EXPECT_GE(s.comparison.long_length_ratio, 3.0);
+  EXPECT_NEAR(s.comparison.compact_per_length_ratio, 1.0, 0.15);
+}
+
+}  // namespace
+}  // namespace mq
