@@ -202,8 +202,9 @@ bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
                   const Vector2d& centre, int f, double shell_height, bool similarity,
                   const SurfaceQuiltingOptions::Global& options, SurfaceElement& s) {
   const MatrixX3i& F = job.base.F;
-  const Eigen::JacobiSVD<Eigen::Matrix<double, 2, 3>> svd(M, Eigen::ComputeFullU |
-                                                                Eigen::ComputeThinV);
+  // Thin V needs a dynamic column count (Eigen asserts it; a fixed 2 x 3 is refused).
+  const Eigen::JacobiSVD<Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, 3>> svd(
+      M, Eigen::ComputeFullU | Eigen::ComputeThinV);
   Vector2d sv = svd.singularValues();
   if (!(sv(1) > 0)) return false;
   const double sigma = std::sqrt(sv(0) * sv(1));
