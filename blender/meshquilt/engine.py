@@ -43,6 +43,23 @@ def _die_with_parent():
         pass
 
 
+def killed_message(signal_number):
+    """The artist's words for an engine ended by a signal (a negative return code), not "-9"."""
+    try:
+        name = signal.Signals(signal_number).name
+    except ValueError:
+        name = "signal %d" % signal_number
+    if signal_number == signal.SIGKILL:
+        return ("the meshquilt engine was killed (%s), most often by the system when the "
+                "machine's memory ran out: raise the Scale (fewer, larger elements) or use a "
+                "swatch of fewer faces" % name)
+    if signal_number in (signal.SIGSEGV, signal.SIGABRT, signal.SIGBUS, signal.SIGFPE,
+                         signal.SIGILL):
+        return ("the meshquilt engine crashed (%s): a bug in meshquilt; please report it with "
+                "the base and the settings" % name)
+    return "the meshquilt engine was stopped from outside (%s)" % name
+
+
 class Job:
     """One engine run in the background.
 
@@ -111,9 +128,12 @@ class Job:
             self.state = "done"
         else:
             self.state = "failed"
-            # The engine's error is its last line: "meshquilt surface: error: ..." or similar.
-            self.error = self._stderr_tail[-1] if self._stderr_tail else (
-                "meshquilt exited with code %d" % code)
+            if code < 0:
+                self.error = killed_message(-code)
+            else:
+                # The engine's error is its last line: "meshquilt surface: error: ..." or similar.
+                self.error = self._stderr_tail[-1] if self._stderr_tail else (
+                    "meshquilt exited with code %d" % code)
         return self.state
 
     def wait(self, timeout=None):

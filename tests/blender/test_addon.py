@@ -252,6 +252,22 @@ def test_engine_error_is_reported():
         enable_addon()
 
 
+@test
+def test_a_killed_or_crashed_engine_is_reported_in_words():
+    """An engine ended by a signal (the kernel's out-of-memory killer sends SIGKILL) is reported
+    as killed, with what to change, not as "exited with code -9" (issue 26)."""
+    from meshquilt import engine
+    for sig, words in ((9, "was killed (SIGKILL)"), (11, "crashed (SIGSEGV)")):
+        fake = os.path.join(WORK, "engine_killed_%d" % sig)
+        with open(fake, "w") as f:
+            f.write("#!/bin/sh\nkill -%d $$\n" % sig)
+        os.chmod(fake, 0o755)
+        job = engine.surface_job(fake, "base.ply", "swatch.ply", os.path.join(WORK, "k.obj"), 0.1)
+        check(job.wait(30) == "failed", "state %s" % job.state)
+        check(words in job.error, "message: %r" % job.error)
+    check("memory" in engine.killed_message(9), engine.killed_message(9))
+
+
 def engine_output(name):
     """A small job written by the engine itself (OBJ with groups, .glb), for the importers."""
     from meshquilt import engine
