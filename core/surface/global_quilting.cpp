@@ -522,6 +522,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
     for (const LatticeCopy& c : copies)
       faces += static_cast<double>(swatch.elements[reps[c.rep]].F.rows());
     gstats.layout_faces = faces;
+    if (options.global.count_only) return {};
     MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", copies.size(),
              " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
              " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
@@ -975,17 +976,19 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     gstats.threads = true;
     stats.iterations = 1;
     stats.cell_size = matching_cell_size(swatch);
-    placed = place_threads(gp, job, threads, symmetry, lo, swatch.size.z(), options, gstats, times,
-                           progress);
+    if (!options.global.count_only)
+      placed = place_threads(gp, job, threads, symmetry, lo, swatch.size.z(), options, gstats,
+                             times, progress);
     // A layout that bends or breaks most pieces carries no threads that run on, even when its
     // area is even (the wicker chair's 77 rough parts, 471 cones: 28% of the pieces on the surface
     // kept, coverage 48%; bunny 88%, cup 93%).
     const int on_surface = gstats.thread_pieces + gstats.pieces_distorted + gstats.pieces_near_cones;
-    if (unfit && gstats.thread_pieces < kMinThreadPiecesKept * on_surface) {
+    if (unfit && !options.global.count_only &&
+        gstats.thread_pieces < kMinThreadPiecesKept * on_surface) {
       *unfit = true;
       return {};
     }
-  } else {
+  } else if (!options.global.count_only) {
     PlanarQuiltingOptions po;
     po.length = std::max(hi.x() - lo.x(), swatch.size.x());
     po.width = std::max(hi.y() - lo.y(), swatch.size.y());
@@ -1109,6 +1112,10 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
     if (used_vines) *used_vines = true;
     return quilt_prepared_vines(std::move(job), std::move(stats), options, VineGrowthOptions{},
                                 stats_out, vine_stats, progress);
+  }
+  if (options.global.count_only) {  // the preparation's estimate is the patches'
+    if (stats_out) *stats_out = std::move(stats);
+    return {};
   }
   // The job prepared once (a large base is simplified in the preparation).
   return quilt_prepared_surface(std::move(job), std::move(stats), options, evaluator, stats_out,

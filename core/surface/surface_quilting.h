@@ -91,6 +91,9 @@ struct SurfaceQuiltingOptions {
   double proxy_error = 0.05;
   // The global-parameterisation method (core/surface/global_quilting).
   struct Global {
+    // Stop once the output's size is known (the lattice's copies counted, the vines' estimate,
+    // the preparation's for the patches), placing nothing: `meshquilt surface --estimate`.
+    bool count_only = false;
     // Weight of the guidance field against the line field's smoothness: small lets the
     // field's poles split into the mild half-turn cones a lattice can close around.
     double guidance_weight = 1e-3;

@@ -1117,6 +1117,11 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
              " the vines would have about ", faces, " faces, more than the limit of ",
              options.max_faces, " (--max-faces); use a larger --scale");
   }
+  if (options.global.count_only) {
+    if (stats_out) *stats_out = std::move(stats);
+    if (vine_stats) *vine_stats = vs;
+    return {};
+  }
 
   std::vector<std::vector<Sample>> lines;
   std::vector<double> phases;  // where each line's swatch pattern starts (arc length)

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/mesh/mesh_io.h"
@@ -255,6 +257,46 @@ TEST_F(Reliability, NonManifoldEdgesAreSaid) {
             std::string::npos)
       << r.out;
   for (const char* f : {"f.obj", "f.mtl", "fin.off"}) fs::remove(dir_ + "/" + f);
+}
+
+// Issue 26: `surface --estimate` prints the job's size in one machine-readable line and writes
+// nothing. Through the global layout (the sample 3 x 3 sheet, a lattice) it counts the copies
+// the run places: within 10% of the faces written. Through the patches (the fixture's 2 x 2
+// sheet is not a lattice) it is the preparation's bound, whole swatch copies over the area:
+// never under the faces written, at most twice them (1.74x here). `fits` follows --max-faces.
+TEST_F(Reliability, EstimateIsOneLineAndHolds) {
+  write_mesh(dir_ + "/sphere.obj", test::uv_sphere(1.0, 32, 16));
+  ASSERT_EQ(meshquilt(dir_, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw3.obj --quiet")
+                .status,
+            0);
+  for (const auto& [swatch, lo, hi] : {std::tuple<std::string, double, double>{"sw3.obj", 0.9, 1.1},
+                                       {"sw.obj", 1.0, 2.0}}) {
+    SCOPED_TRACE(swatch);
+    const std::string job =
+        "surface --base sphere.obj --swatch " + swatch + " --scale 0.15 -o s.obj";
+    const std::vector<std::string> before = listing(dir_);
+    const CliRun e = meshquilt(dir_, job + " --estimate");
+    ASSERT_EQ(e.status, 0) << e.err;
+    EXPECT_EQ(listing(dir_), before) << "--estimate wrote something";
+    double faces = 0, bytes = 0, seconds = 0;
+    int fits = -1;
+    ASSERT_EQ(std::sscanf(e.out.c_str(), "estimate faces %lf bytes %lf seconds %lf fits %d",
+                          &faces, &bytes, &seconds, &fits),
+              4)
+        << e.out;
+    EXPECT_EQ(fits, 1);
+    EXPECT_GT(bytes, faces);
+    EXPECT_GT(seconds, 0);
+    ASSERT_EQ(meshquilt(dir_, job + " --quiet").status, 0);
+    const double written = read_mesh(dir_ + "/s.obj").num_faces();
+    EXPECT_GE(faces / written, lo) << faces << " estimated, " << written << " written";
+    EXPECT_LE(faces / written, hi) << faces << " estimated, " << written << " written";
+    const CliRun small = meshquilt(dir_, job + " --estimate --max-faces 1000");
+    ASSERT_EQ(small.status, 0) << small.err;
+    EXPECT_NE(small.out.find(" fits 0"), std::string::npos) << small.out;
+    for (const char* f : {"s.obj", "s.mtl"}) fs::remove(dir_ + "/" + f);
+  }
+  for (const char* f : {"sphere.obj", "sphere.mtl", "sw3.obj", "sw3.mtl"}) fs::remove(dir_ + "/" + f);
 }
 
 // Issue 28: an output name with a line break would split the OBJ's `mtllib` line; one that is not
