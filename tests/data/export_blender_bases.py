@@ -36,7 +36,10 @@ def clear():
 
 
 def write_obj(obj, name):
-    """The evaluated mesh in world space, faces as stored (no triangulation)."""
+    """The evaluated mesh in world space, faces as stored (no triangulation), in a fixed order:
+    Blender 3.4's UV sphere lists its faces in a different order from one run to the next, and
+    the quilting (a chain of discrete choices) follows the order, so the faces are sorted by their
+    vertex indices, each face's own order (its winding) kept."""
     depsgraph = bpy.context.evaluated_depsgraph_get()
     mesh = obj.evaluated_get(depsgraph).to_mesh()
     mw = obj.matrix_world
@@ -46,8 +49,8 @@ def write_obj(obj, name):
         for v in mesh.vertices:
             p = mw @ v.co
             f.write("v %.9g %.9g %.9g\n" % (p.x, p.y, p.z))
-        for poly in mesh.polygons:
-            f.write("f " + " ".join(str(i + 1) for i in poly.vertices) + "\n")
+        for face in sorted(tuple(poly.vertices) for poly in mesh.polygons):
+            f.write("f " + " ".join(str(i + 1) for i in face) + "\n")
     print("[export] %s: %d vertices, %d faces" % (name, len(mesh.vertices), len(mesh.polygons)))
     obj.evaluated_get(depsgraph).to_mesh_clear()
 
