@@ -66,6 +66,55 @@ Vector2d refine(const SwatchFaceTree& faces, const Sample& s, double sign, Vecto
   return t;
 }
 
+// An evenly strided sample of up to `count` face centroids with their unit normals (faces of no
+// area skipped).
+Sample strided_sample(const MatrixX3d& V, const MatrixX3i& F, Eigen::Index count) {
+  Sample s;
+  const Eigen::Index want = std::min<Eigen::Index>(count, F.rows());
+  for (Eigen::Index k = 0; k < want; ++k) {
+    const Eigen::Index f = k * F.rows() / want;
+    const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Vector3d n = (b - a).cross(c - a);
+    if (!(n.norm() > 0)) continue;
+    s.p.push_back((a + b + c) / 3.0);
+    s.n.push_back(n.normalized());
+  }
+  return s;
+}
+
+// The elements' footprint box centres.
+std::vector<Vector2d> element_box_centres(const PreparedSwatch& swatch) {
+  std::vector<Vector2d> c;
+  for (const Element& e : swatch.elements) c.push_back(0.5 * (e.lo + e.hi));
+  return c;
+}
+
+// The index of the centre nearest p (the first on a tie).
+size_t nearest_centre(const std::vector<Vector2d>& c, const Vector2d& p) {
+  size_t k = 0;
+  for (size_t i = 1; i < c.size(); ++i)
+    if ((c[i] - p).squaredNorm() < (c[k] - p).squaredNorm()) k = i;
+  return k;
+}
+
+// The `count` centres nearest centre k, nearest first (ties by index), k itself among them only
+// when `with_k`.
+std::vector<size_t> nearest_centres(const std::vector<Vector2d>& c, size_t k, size_t count,
+                                    bool with_k) {
+  std::vector<size_t> order;
+  for (size_t j = 0; j < c.size(); ++j)
+    if (j != k || with_k) order.push_back(j);
+  const size_t n = std::min(count, order.size());
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n), order.end(),
+                    [&](size_t a, size_t b) {
+                      const double da = (c[a] - c[k]).squaredNorm();
+                      const double db = (c[b] - c[k]).squaredNorm();
+                      return da < db || (da == db && a < b);
+                    });
+  order.resize(n);
+  return order;
+}
+
 }  // namespace
 
 // Shifts a grid search may evaluate (each 128 nearest-face queries): beyond it the search tries
@@ -86,30 +135,15 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
   }
   const double margin = 0.1 * max_element;
   if (!(cell > 0) || size.x() <= 2 * margin || size.y() <= 2 * margin) return out;
-  // An evenly strided sample of face centroids with their normals.
-  Sample s;
-  const Eigen::Index want = std::min<Eigen::Index>(128, F.rows());
-  for (Eigen::Index k = 0; k < want; ++k) {
-    const Eigen::Index f = k * F.rows() / want;
-    const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    const Vector3d n = (b - a).cross(c - a);
-    if (!(n.norm() > 0)) continue;
-    s.p.push_back((a + b + c) / 3.0);
-    s.n.push_back(n.normalized());
-  }
+  const Sample s = strided_sample(V, F, 128);
   const size_t min_points = std::max<size_t>(16, s.p.size() / 5);
   const double lambda = 1.0 / cell;
   const double step = 0.5 * cell;
+  const std::vector<Vector2d> centre = element_box_centres(swatch);
+  const size_t middle = centre.empty() ? 0 : nearest_centre(centre, 0.5 * size);
 
   // Whole-step shifts in both directions for the periods, shifts over [0, 2 size] for the half
   // turn (which maps [0, size] to [-size, 0] before the shift).
-  // Element centres (footprint box centres), and the one nearest the footprint's middle.
-  std::vector<Vector2d> centre;
-  for (const Element& e : swatch.elements) centre.push_back(0.5 * (e.lo + e.hi));
-  size_t middle = 0;
-  for (size_t i = 1; i < centre.size(); ++i)
-    if ((centre[i] - 0.5 * size).squaredNorm() < (centre[middle] - 0.5 * size).squaredNorm())
-      middle = i;
   auto search = [&](double sign, const Vector2d& from, const Vector2d& to,
                     std::vector<std::pair<double, Vector2d>>& found) {
     const double grid_shifts = std::floor((to.x() - from.x()) / step + 1) *
@@ -120,19 +154,8 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
       // below, instead of a grid over the footprint (issue 28).
       // The shortest periods, and half turns about the nearest centres, map it onto one of its
       // nearest elements: the 64 nearest are tried.
-      std::vector<size_t> near;
-      for (size_t j = 0; j < centre.size(); ++j)
-        if (j != middle || sign < 0) near.push_back(j);
-      const size_t count = std::min<size_t>(64, near.size());
-      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(count), near.end(),
-                        [&](size_t a, size_t b) {
-                          const double da = (centre[a] - centre[middle]).squaredNorm();
-                          const double db = (centre[b] - centre[middle]).squaredNorm();
-                          return da < db || (da == db && a < b);
-                        });
-      near.resize(count);
       std::vector<Vector2d> tries;
-      for (const size_t j : near) {
+      for (const size_t j : nearest_centres(centre, middle, 64, sign < 0)) {
         const Vector2d t = sign > 0 ? Vector2d(centre[j] - centre[middle])
                                     : Vector2d(centre[j] + centre[middle]);
         if ((t.array() < from.array()).any() || (t.array() > to.array()).any()) continue;
@@ -247,16 +270,7 @@ Vector2d axis_periods(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
     max_element = std::max(max_element, e.footprint_diameter());
   const double margin = 0.1 * max_element;
   if (!(cell > 0)) return out;
-  Sample s;
-  const Eigen::Index want = std::min<Eigen::Index>(64, F.rows());
-  for (Eigen::Index k = 0; k < want; ++k) {
-    const Eigen::Index f = k * F.rows() / want;
-    const Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    const Vector3d n = (b - a).cross(c - a);
-    if (!(n.norm() > 0)) continue;
-    s.p.push_back((a + b + c) / 3.0);
-    s.n.push_back(n.normalized());
-  }
+  const Sample s = strided_sample(V, F, 64);
   const size_t min_points = std::max<size_t>(8, s.p.size() / 5);
   const double lambda = 1.0 / cell, step = 0.5 * cell;
   for (int axis = 0; axis < 2; ++axis) {
@@ -296,12 +310,9 @@ Vector2d axis_periods(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
 bool repeating_elements(const PreparedSwatch& swatch) {
   const int n = static_cast<int>(swatch.elements.size());
   if (n < 4) return false;
-  std::vector<Vector2d> c(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const Element& e = swatch.elements[i];
+  for (const Element& e : swatch.elements)
     if (((e.hi - e.lo).array() > 0.6 * swatch.size.head<2>().array()).any()) return false;
-    c[i] = 0.5 * (e.lo + e.hi);
-  }
+  const std::vector<Vector2d> c = element_box_centres(swatch);
   // The median nearest-centre distance (all pairs: swatches hold tens to hundreds of elements).
   std::vector<double> nearest(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
   for (int i = 0; i < n; ++i)
@@ -327,24 +338,12 @@ bool repeating_elements(const PreparedSwatch& swatch) {
             if ((c[j] - p).norm() <= tol) return true;
     return false;
   };
-  // Shifts from the element nearest the footprint's centre to every other element.
-  const Vector2d middle = 0.5 * swatch.size.head<2>();
-  int k = 0;
-  for (int i = 1; i < n; ++i)
-    if ((c[i] - middle).squaredNorm() < (c[k] - middle).squaredNorm()) k = i;
-  // The shortest periods are shifts to near elements: the 24 nearest are tried.
-  std::vector<int> order;
-  for (int j = 0; j < n; ++j)
-    if (j != k) order.push_back(j);
-  const auto closer = [&](int a, int b) {
-    const double da = (c[a] - c[k]).squaredNorm(), db = (c[b] - c[k]).squaredNorm();
-    return da < db || (da == db && a < b);
-  };
-  const size_t tries = std::min<size_t>(24, order.size());
-  std::partial_sort(order.begin(), order.begin() + tries, order.end(), closer);
-  order.resize(tries);
+  // Shifts from the element nearest the footprint's centre to every other element; the shortest
+  // periods are shifts to near elements: the 24 nearest are tried.
+  const size_t k = nearest_centre(c, 0.5 * swatch.size.head<2>());
+  const std::vector<size_t> order = nearest_centres(c, k, 24, false);
   const Vector2d lo = Vector2d::Constant(tol), hi = swatch.size.head<2>() - lo;
-  for (const int j : order) {
+  for (const size_t j : order) {
     const Vector2d t = c[j] - c[k];
     int inside = 0, matched = 0;
     for (int i = 0; i < n; ++i) {

@@ -1162,18 +1162,18 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     std::vector<Sample> line;
     double phase = 0;
   };
-  std::vector<Stem> todo, kept;
-  for (size_t l = 0; l < lines.size(); ++l) todo.push_back({std::move(lines[l]), phases[l]});
+  std::vector<Stem> pending, kept;
+  for (size_t l = 0; l < lines.size(); ++l) pending.push_back({std::move(lines[l]), phases[l]});
   {
     ScopedStageTimer timer(times, "stems");
     const int kRounds = 3;
-    for (int round = 0; round < kRounds && !todo.empty(); ++round) {
-      const int n = static_cast<int>(todo.size());
+    for (int round = 0; round < kRounds && !pending.empty(); ++round) {
+      const int n = static_cast<int>(pending.size());
       std::vector<Placed> made(static_cast<size_t>(n));
       std::vector<std::vector<double>> rings(static_cast<size_t>(n));
       std::vector<std::vector<char>> bad(static_cast<size_t>(n));
       tbb::parallel_for(0, n, [&](int l) {
-        const Stem& st = todo[static_cast<size_t>(l)];
+        const Stem& st = pending[static_cast<size_t>(l)];
         const StemFrame frame(walker, st.line);
         made[static_cast<size_t>(l)] =
             make_stem(model, frame, st.phase, shell, &rings[static_cast<size_t>(l)]);
@@ -1193,7 +1193,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
         if (std::find(b.begin(), b.end(), 1) == b.end()) {
           placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
           quilt.elements.push_back(std::move(p.element));
-          kept.push_back(std::move(todo[static_cast<size_t>(l)]));
+          kept.push_back(std::move(pending[static_cast<size_t>(l)]));
           continue;
         }
         ++vs.stems_cut;
@@ -1210,7 +1210,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
           cut.emplace_back(lo - 0.5 * so.separation, hi + 0.5 * so.separation);
         }
         std::sort(cut.begin(), cut.end());
-        const Stem& st = todo[static_cast<size_t>(l)];
+        const Stem& st = pending[static_cast<size_t>(l)];
         double from = 0;
         const auto piece = [&](double a, double b) {
           if (b - a < so.min_length) return;
@@ -1229,9 +1229,9 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
         }
         piece(from, st.line.back().s);
       }
-      todo = std::move(next);
+      pending = std::move(next);
     }
-    vs.stems_dropped = static_cast<int>(todo.size());
+    vs.stems_dropped = static_cast<int>(pending.size());
   }
   {
     ScopedStageTimer timer(times, "leaves");
