@@ -61,14 +61,20 @@ BENCHMARK(BM_LscmOf500FacePatch)->Unit(benchmark::kMicrosecond);
 void BM_LscmOfPatch(benchmark::State& state) {
   const TriMesh base = bunny70k();
   LocalPatchBuilder builder(base);
-  const LocalPatch p = builder.grow(12345, patch_options(base, static_cast<double>(state.range(0))));
+  const LocalPatch p =
+      builder.grow(12345, patch_options(base, static_cast<double>(state.range(0))));
   for (auto _ : state) benchmark::DoNotOptimize(lscm(p.mesh.V, p.mesh.F).data());
   state.counters["faces"] = static_cast<double>(p.faces.size());
   state.counters["us_per_face"] = benchmark::Counter(
       static_cast<double>(p.faces.size()),
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_LscmOfPatch)->Arg(500)->Arg(2000)->Arg(8000)->Arg(24000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LscmOfPatch)
+    ->Arg(500)
+    ->Arg(2000)
+    ->Arg(8000)
+    ->Arg(24000)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_BuilderSetup(benchmark::State& state) {
   const TriMesh base = bunny70k();

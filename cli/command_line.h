@@ -16,7 +16,6 @@ inline constexpr const char* kExitStatus =
     "  2 bad usage (an unknown option or a value out of range); 3 internal error (a bug in\n"
     "  meshquilt, or the OpenCL device failed).\n";
 
-
 // Wrong usage: the CLI prints the message and a hint to --help, and exits with status 2.
 class UsageError : public std::runtime_error {
  public:

@@ -270,11 +270,11 @@ int run_surface(int argc, char** argv, int first) {
   const TriMesh base = read_mesh(cl.get("base"));
   const TriMesh swatch = read_mesh(cl.get("swatch"));
   // Finite coordinates whose extent overflows (1e300) would make every size estimate NaN.
-  for (const auto& [mesh, name] : {std::pair<const TriMesh*, std::string>{&base, cl.get("base")},
-                                   {&swatch, cl.get("swatch")}})
+  for (const auto& [mesh, name] :
+       {std::pair<const TriMesh*, std::string>{&base, cl.get("base")}, {&swatch, cl.get("swatch")}})
     MQ_CHECK(mesh->num_vertices() == 0 ||
-                 std::isfinite((mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff())
-                                   .squaredNorm()),
+                 std::isfinite(
+                     (mesh->V.colwise().maxCoeff() - mesh->V.colwise().minCoeff()).squaredNorm()),
              InvalidInput, name,
              ": coordinates too large (the bounding box's diagonal overflows); scale the mesh "
              "down");
@@ -310,8 +310,7 @@ int run_surface(int argc, char** argv, int first) {
     GlobalQuiltingStats layout;
     bool global = method == "global", vines = method == "vines";
     if (method == "auto")
-      quilt_surface_auto(base, swatch, counting, cpu, &estimate, &layout, nullptr, &global,
-                         &vines);
+      quilt_surface_auto(base, swatch, counting, cpu, &estimate, &layout, nullptr, &global, &vines);
     else if (global)
       quilt_surface_global(base, swatch, counting, cpu, &estimate, &layout);
     else if (vines)
@@ -416,13 +415,15 @@ int run_surface(int argc, char** argv, int first) {
     // Faces meeting three or more at an edge (fins, flaps): the layout ends there as at a
     // border, which the user should know of rather than find (issue 28, item 7).
     if (const int fins = topology_report(base).num_non_manifold_edges; fins > 0)
-      std::printf("base: %d non-manifold edges (three or more faces meeting) are borders: the "
-                  "texture ends at them on every side\n",
-                  fins);
+      std::printf(
+          "base: %d non-manifold edges (three or more faces meeting) are borders: the "
+          "texture ends at them on every side\n",
+          fins);
     if (stats.flipped_components > 0)
-      std::printf("base: %d components faced inward and were turned outward "
-                  "(--keep-orientation keeps them)\n",
-                  stats.flipped_components);
+      std::printf(
+          "base: %d components faced inward and were turned outward "
+          "(--keep-orientation keeps them)\n",
+          stats.flipped_components);
     if (stats.proxy_faces > 0)
       std::printf(
           "base: simplified to %d faces, within %.3g of the surface given "

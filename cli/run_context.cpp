@@ -1,7 +1,7 @@
 #include "cli/run_context.h"
 
-#include <tbb/info.h>
 #include <sys/resource.h>
+#include <tbb/info.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -72,9 +72,8 @@ double memory_limit(const CommandLine& cl) {
       pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
   if (cl.has("max-memory")) {
     const double asked = cl.get_double("max-memory", 0, 0.01, 1e6) * (1 << 30);
-    MQ_CHECK(machine == 0 || asked <= machine, InvalidInput, "--max-memory ",
-             asked / (1 << 30), " GiB is more than this machine's ", machine / (1 << 30),
-             " GiB");
+    MQ_CHECK(machine == 0 || asked <= machine, InvalidInput, "--max-memory ", asked / (1 << 30),
+             " GiB is more than this machine's ", machine / (1 << 30), " GiB");
     return asked;
   }
   return machine > 0 ? 0.8 * machine : 0.0;
@@ -86,8 +85,8 @@ double face_limit(const CommandLine& cl) {
   if (!(memory > 0)) return asked;
   const double fits = memory / kBytesPerOutputFace;
   MQ_CHECK(asked <= fits || !cl.has("max-faces"), InvalidInput, "--max-faces ", asked,
-           " needs about ", asked * kBytesPerOutputFace / (1 << 30), " GiB of memory; the limit is ",
-           memory / (1 << 30), " GiB (--max-memory)");
+           " needs about ", asked * kBytesPerOutputFace / (1 << 30),
+           " GiB of memory; the limit is ", memory / (1 << 30), " GiB (--max-memory)");
   return std::min(asked, fits);
 }
 

@@ -1,6 +1,7 @@
 #include "tests/test_support.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -8,8 +9,6 @@
 #include <fstream>
 #include <sstream>
 #include <vector>
-
-#include <unistd.h>
 
 namespace mq::test {
 

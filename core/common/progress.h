@@ -28,7 +28,8 @@ inline void report_progress(ProgressSink* sink, const std::string& stage, double
 // optimisation, ...), not only those with many units of work.
 class ScopedStageProgress {
  public:
-  ScopedStageProgress(ProgressSink* sink, std::string stage) : sink_(sink), stage_(std::move(stage)) {
+  ScopedStageProgress(ProgressSink* sink, std::string stage)
+      : sink_(sink), stage_(std::move(stage)) {
     report_progress(sink_, stage_, 0, 1);
   }
   ~ScopedStageProgress() { report_progress(sink_, stage_, 1, 1); }

@@ -36,8 +36,8 @@ class ScopedStageTimer {
   ScopedStageTimer(StageTimes& times, std::string stage)
       : times_(times), stage_(std::move(stage)), start_(std::chrono::steady_clock::now()) {}
   ~ScopedStageTimer() {
-    times_.add(stage_, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_)
-                           .count());
+    times_.add(stage_,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
   }
   ScopedStageTimer(const ScopedStageTimer&) = delete;
   ScopedStageTimer& operator=(const ScopedStageTimer&) = delete;

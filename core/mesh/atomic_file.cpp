@@ -103,10 +103,9 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path) : path_(path) {
   MQ_CHECK(!fs::is_directory(target, ec), InvalidInput, path, ": is a directory");
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   remove_stale_temporaries(dir, target.filename().string());
-  std::string pattern =
-      (dir / ("." + temporary_stem(target.filename().string()) + ".tmp-" +
-              std::to_string(::getpid()) + "-XXXXXX"))
-          .string();
+  std::string pattern = (dir / ("." + temporary_stem(target.filename().string()) + ".tmp-" +
+                                std::to_string(::getpid()) + "-XXXXXX"))
+                            .string();
   const int fd = ::mkstemp(pattern.data());
   if (fd < 0)
     MQ_THROW(Error, path, ": cannot write: cannot create a file in '", dir.string(),
@@ -191,8 +190,8 @@ void commit_together(AtomicOutputFile& first, AtomicOutputFile& second) {
       std::rename(kept.c_str(), first.path_.c_str());
     else
       ::unlink(first.path_.c_str());
-    MQ_THROW(Error, second.path_, ": cannot write: rename failed: ", std::strerror(err),
-             " (", first.path_, " left as it was)");
+    MQ_THROW(Error, second.path_, ": cannot write: rename failed: ", std::strerror(err), " (",
+             first.path_, " left as it was)");
   }
   if (had_old) ::unlink(kept.c_str());
   second.committed_ = true;

@@ -41,8 +41,7 @@ CornerNormals corner_normals(const MatrixX3d& V, const MatrixX3i& F, double crea
       for (int k = 0; k < 3; ++k) faces[static_cast<size_t>(fill[F(f, k)]++)] = static_cast<int>(f);
   }
   // 180 degrees must take every face, even exactly opposite ones.
-  const double min_cos =
-      crease_degrees >= 180 ? -2.0 : std::cos(crease_degrees * M_PI / 180.0);
+  const double min_cos = crease_degrees >= 180 ? -2.0 : std::cos(crease_degrees * M_PI / 180.0);
   // Per vertex: its distinct corner normals, numbered locally; FN holds local numbers first.
   std::vector<std::vector<Vector3d>> local(static_cast<size_t>(nv));
   MatrixX3i FN(nf, 3);

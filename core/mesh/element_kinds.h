@@ -53,10 +53,10 @@ std::vector<std::string> unique_kind_names(const std::vector<std::string>& kinds
 // first face, as split_elements numbers them), of kind element_kind[e] in kinds.
 struct ElementLabels {
   int count = 0;
-  std::vector<int> face_element;  // #F
+  std::vector<int> face_element;    // #F
   std::vector<int> vertex_element;  // #V: the element of each vertex (0 for unused ones)
-  std::vector<int> element_kind;  // #elements, indices into kinds
-  std::vector<std::string> kinds; // the mesh's kinds, or {kDefaultKind} when it has none
+  std::vector<int> element_kind;    // #elements, indices into kinds
+  std::vector<std::string> kinds;   // the mesh's kinds, or {kDefaultKind} when it has none
 };
 ElementLabels element_labels(const TriMesh& mesh);
 

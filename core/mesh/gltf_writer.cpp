@@ -99,7 +99,8 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
   // Indices grouped by kind, faces in order within a kind.
   std::vector<std::vector<unsigned>> by_kind(labels.kinds.size());
   for (Eigen::Index f = 0; f < nf; ++f) {
-    const int kind = labels.element_kind[static_cast<size_t>(labels.face_element[static_cast<size_t>(f)])];
+    const int kind =
+        labels.element_kind[static_cast<size_t>(labels.face_element[static_cast<size_t>(f)])];
     for (int k = 0; k < 3; ++k)
       by_kind[static_cast<size_t>(kind)].push_back(corner_index[static_cast<size_t>(3 * f + k)]);
   }
@@ -117,14 +118,14 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
   const int id_view = add_view(model, id_at, element.size() * sizeof(float), kArrayBuffer);
   const int idx_view =
       add_view(model, idx_at, indices.size() * sizeof(unsigned), kElementArrayBuffer);
-  const int pos = add_accessor(model, pos_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                               TINYGLTF_TYPE_VEC3, nv);
+  const int pos =
+      add_accessor(model, pos_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
   model.accessors[static_cast<size_t>(pos)].minValues = lo;
   model.accessors[static_cast<size_t>(pos)].maxValues = hi;
-  const int nrm = add_accessor(model, nrm_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                               TINYGLTF_TYPE_VEC3, nv);
-  const int ids = add_accessor(model, id_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                               TINYGLTF_TYPE_SCALAR, nv);
+  const int nrm =
+      add_accessor(model, nrm_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
+  const int ids =
+      add_accessor(model, id_view, 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, nv);
 
   tinygltf::Mesh gm;
   gm.name = std::filesystem::path(path).stem().string();

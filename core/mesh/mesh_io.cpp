@@ -257,8 +257,7 @@ TriMesh read_obj(const std::string& path, const std::string& data) {
       c.advance(1);
       group = c.rest_of_line();
       update_kind();
-    } else if (c.remaining() > 7 && std::memcmp(c.pos(), "usemtl", 6) == 0 &&
-               is_blank(c.peek(6))) {
+    } else if (c.remaining() > 7 && std::memcmp(c.pos(), "usemtl", 6) == 0 && is_blank(c.peek(6))) {
       c.advance(6);
       material = c.rest_of_line();
       if (material == "(null)") material.clear();  // what some exporters write for "none"
@@ -904,8 +903,8 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
     };
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
   }
-  const int width = labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size())
-                           : 0;
+  const int width =
+      labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size()) : 0;
   // A face line may follow an "o" and a "usemtl" line naming its kind.
   size_t longest_kind = 0;
   if (labels)
@@ -1001,8 +1000,8 @@ void write_ply(AtomicOutputFile& out, const TriMesh& m, const MatrixX3d* N, bool
       // The look other tools give the kind (kind_material): r g b metallic roughness.
       const KindMaterial m = kind_material(labels->kinds[k]);
       char buf[160];
-      std::snprintf(buf, sizeof buf, "comment kind_material %zu %.4f %.4f %.4f %.3f %.3f\n", k,
-                    m.r, m.g, m.b, m.metallic, m.roughness);
+      std::snprintf(buf, sizeof buf, "comment kind_material %zu %.4f %.4f %.4f %.3f %.3f\n", k, m.r,
+                    m.g, m.b, m.metallic, m.roughness);
       header += buf;
     }
   }

@@ -22,10 +22,11 @@ MeshFormat mesh_format_from_path(const std::string& path);
 // "v", "v/vt", "v//vn" and "v/vt/vn" forms and negative (relative) indices; other OBJ
 // statements (vt, l, ...) are ignored. Element kinds (element_kinds.h) come from OBJ usemtl
 // names, else g/o names (sanitized_kind), and from a PLY integer vertex property `kind` named by
-// "comment kind K NAME" header lines (a face takes its first vertex's); otherwise kinds is empty. OFF accepts the OFF/COFF/NOFF/CNOFF/STOFF
-// headers and '#' comments. PLY accepts ascii, binary_little_endian and binary_big_endian, any
-// order of vertex properties (x y z as any scalar type), face lists with any integer count and
-// index types, and skips unknown properties and elements.
+// "comment kind K NAME" header lines (a face takes its first vertex's); otherwise kinds is empty.
+// OFF accepts the OFF/COFF/NOFF/CNOFF/STOFF headers and '#' comments. PLY accepts ascii,
+// binary_little_endian and binary_big_endian, any order of vertex properties (x y z as any scalar
+// type), face lists with any integer count and index types, and skips unknown properties and
+// elements.
 //
 // Returns V (#V by 3), F (#F by 3, 0-based) and N (#V by 3) when the file carries complete
 // per-vertex normals (PLY nx ny nz, NOFF normals, or OBJ vn referenced consistently by every
@@ -67,8 +68,8 @@ struct WriteOptions {
   int precision = 9;
 };
 
-// Writes mesh to path in the format given by its extension (.glb: write_glb). Output bytes depend only on the mesh
-// and options. PLY coordinates are stored as double.
+// Writes mesh to path in the format given by its extension (.glb: write_glb). Output bytes depend
+// only on the mesh and options. PLY coordinates are stored as double.
 //
 // The data go to a temporary file in the same directory which is then renamed over path, so a
 // failed or interrupted write never leaves a partial file at path (an existing file is kept).

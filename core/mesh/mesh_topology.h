@@ -21,7 +21,7 @@ struct Adjacency {
 // Undirected edges of a face set and how faces use them.
 struct EdgeTopology {
   Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor> E;  // #E by 2, E(e,0) < E(e,1)
-  MatrixX3i FE;        // #F by 3: FE(f,k) is the edge from F(f,k) to F(f,(k+1)%3)
+  MatrixX3i FE;          // #F by 3: FE(f,k) is the edge from F(f,k) to F(f,(k+1)%3)
   Adjacency edge_faces;  // for each edge, the faces using it (ascending)
 
   int num_edges() const { return static_cast<int>(E.rows()); }

@@ -146,8 +146,8 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
   // turn (which maps [0, size] to [-size, 0] before the shift).
   auto search = [&](double sign, const Vector2d& from, const Vector2d& to,
                     std::vector<std::pair<double, Vector2d>>& found) {
-    const double grid_shifts = std::floor((to.x() - from.x()) / step + 1) *
-                               std::floor((to.y() - from.y()) / step + 1);
+    const double grid_shifts =
+        std::floor((to.x() - from.x()) / step + 1) * std::floor((to.y() - from.y()) / step + 1);
     if (grid_shifts > kMaxGridShifts && centre.size() >= 2) {
       // Many small elements (a 20 x 20 swatch of boxes: 260,000 shifts, minutes): a symmetry
       // maps the middle element onto another one, so only such shifts are tried, refined as
@@ -156,8 +156,8 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
       // nearest elements: the 64 nearest are tried.
       std::vector<Vector2d> tries;
       for (const size_t j : nearest_centres(centre, middle, 64, sign < 0)) {
-        const Vector2d t = sign > 0 ? Vector2d(centre[j] - centre[middle])
-                                    : Vector2d(centre[j] + centre[middle]);
+        const Vector2d t =
+            sign > 0 ? Vector2d(centre[j] - centre[middle]) : Vector2d(centre[j] + centre[middle]);
         if ((t.array() < from.array()).any() || (t.array() > to.array()).any()) continue;
         if (sign > 0 && t.norm() < 0.5 * cell) continue;
         tries.push_back(t);

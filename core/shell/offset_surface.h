@@ -20,8 +20,8 @@ struct OffsetOptions {
   // smoothing: with 10 steps alone the Stanford bunny split 1-to-4 twice (1.1M faces) had no
   // valid shell ("3 offending vertices at the minimum height"), as 70k and 278k faces had.
   double smoothing_radius = 1.25;
-  double min_fraction = 0.1;      // no vertex's height drops below min_fraction * height
-  int max_rounds = 64;            // bound on the shrink-and-check rounds (>= 1)
+  double min_fraction = 0.1;  // no vertex's height drops below min_fraction * height
+  int max_rounds = 64;        // bound on the shrink-and-check rounds (>= 1)
 };
 
 // The offset vertices W = V + h_i d_i with their directions and heights.

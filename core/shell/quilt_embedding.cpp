@@ -178,8 +178,8 @@ std::vector<std::pair<int, int>> updated_pairs(const SurfaceQuilt& quilt, const 
 // Returns the elements that came back (V's rows replaced, drop cleared).
 std::vector<char> try_alternatives(const SurfaceQuilt& quilt, const std::vector<char>& skip,
                                    const MatrixX3d& A,
-                                   const std::vector<Eigen::Index>& alternative_first,
-                                   MatrixX3d& V, std::vector<char>& drop) {
+                                   const std::vector<Eigen::Index>& alternative_first, MatrixX3d& V,
+                                   std::vector<char>& drop) {
   const size_t ne = quilt.elements.size();
   std::vector<char> restored(ne, 0);
   if (A.rows() == 0) return restored;
@@ -290,7 +290,8 @@ int keep_in_shell(const SurfaceQuilt& quilt, const std::vector<Eigen::Index>& fi
       back[k] = 1;
       return;
     }
-    const double limit = std::max(quilt.shell_height, farthest(before, k, std::numeric_limits<double>::infinity()));
+    const double limit =
+        std::max(quilt.shell_height, farthest(before, k, std::numeric_limits<double>::infinity()));
     back[k] = farthest(V, k, limit) > limit;
   });
   int count = 0;
@@ -479,8 +480,9 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   // normal displacement): tried before such a copy is removed.
   std::vector<Eigen::Index> alternative_first(ne + 1, 0);
   for (size_t k = 0; k < ne; ++k)
-    alternative_first[k + 1] = alternative_first[k] + static_cast<Eigen::Index>(
-                                                          quilt.elements[k].through_layout.face.size());
+    alternative_first[k + 1] =
+        alternative_first[k] +
+        static_cast<Eigen::Index>(quilt.elements[k].through_layout.face.size());
   MatrixX3d alternative_V;
   if (alternative_first.back() > 0 && options.remove_intersecting) {
     LocalCoordinates alt;
@@ -508,8 +510,10 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
       const MatrixX3d mapped_alt = ShellEmbedding(*map).embed(through);
       for (size_t k = 0; k < ne; ++k)
         if (!alt_normal[k])
-          alternative_V.middleRows(alternative_first[k], alternative_first[k + 1] - alternative_first[k]) =
-              mapped_alt.middleRows(alternative_first[k], alternative_first[k + 1] - alternative_first[k]);
+          alternative_V.middleRows(alternative_first[k],
+                                   alternative_first[k + 1] - alternative_first[k]) =
+              mapped_alt.middleRows(alternative_first[k],
+                                    alternative_first[k + 1] - alternative_first[k]);
     }
   }
 
@@ -676,8 +680,11 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     ScopedStageProgress shown(progress, "ring separation");
     std::vector<char> touching(ne, 0), folded_now(ne, 0);
     for (const auto& [f, g] : pairs) {
-      if (element_of[f] == element_of[g]) folded_now[static_cast<size_t>(element_of[f])] = 1;
-      else touching[static_cast<size_t>(element_of[f])] = touching[static_cast<size_t>(element_of[g])] = 1;
+      if (element_of[f] == element_of[g])
+        folded_now[static_cast<size_t>(element_of[f])] = 1;
+      else
+        touching[static_cast<size_t>(element_of[f])] =
+            touching[static_cast<size_t>(element_of[g])] = 1;
     }
     for (size_t k = 0; k < ne; ++k) touching[k] = touching[k] && !folded_now[k];
     if (std::find(touching.begin(), touching.end(), 1) != touching.end()) {

@@ -34,9 +34,9 @@ struct QuiltEmbeddingStats {
   int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
   int shrunk_to_fit = 0;              // elements kept at 85-95% of their size instead of removed
   int layout_versions = 0;  // even copies that touched a neighbour, kept as the layout placed them
-  int separated_rings = 0;            // rings moved apart from those they touched
-  int separation_reverted = 0;        // moved, then put back: a link would have changed
-  int separation_left_shell = 0;      // moved, then put back: it left the shell
+  int separated_rings = 0;  // rings moved apart from those they touched
+  int separation_reverted = 0;    // moved, then put back: a link would have changed
+  int separation_left_shell = 0;  // moved, then put back: it left the shell
   int separation_iterations = 0;
   // Elements mapped through the shell map as it was before stretch optimisation, because the
   // optimised map made them intersect another element.

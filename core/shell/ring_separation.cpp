@@ -177,13 +177,11 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
                                  const RingSeparationOptions& options,
                                  RingSeparationStats* stats_out) {
   const size_t ne = bins.size();
-  MQ_CHECK(first.size() == ne + 1 && movable.size() == ne && link_bins.size() == ne,
-           InvalidInput,
+  MQ_CHECK(first.size() == ne + 1 && movable.size() == ne && link_bins.size() == ne, InvalidInput,
            "separate_rings: ", first.size(), " offsets, ", bins.size(), " binnings and ",
            movable.size(), " flags do not describe the same elements");
-  MQ_CHECK(ne == 0 || first.back() == V.rows(), InvalidInput,
-           "separate_rings: the offsets end at ", ne ? first.back() : 0, ", V has ", V.rows(),
-           " rows");
+  MQ_CHECK(ne == 0 || first.back() == V.rows(), InvalidInput, "separate_rings: the offsets end at ",
+           ne ? first.back() : 0, ", V has ", V.rows(), " rows");
   RingSeparationStats stats;
   std::vector<char> moved(ne, 0);
   // The rings in play: the movable ones and every ring whose tube box meets theirs.

@@ -43,9 +43,9 @@ struct RingSeparationOptions {
 };
 
 struct RingSeparationStats {
-  int rings = 0;            // rings taken into account (movable ones and their neighbours)
-  int moved = 0;            // rings left at a new place
-  int reverted = 0;         // moved, then put back because a link would have changed
+  int rings = 0;     // rings taken into account (movable ones and their neighbours)
+  int moved = 0;     // rings left at a new place
+  int reverted = 0;  // moved, then put back because a link would have changed
   int iterations = 0;
   int overlaps_before = 0;  // pairs of rings whose tubes overlap, before and after
   int overlaps_after = 0;

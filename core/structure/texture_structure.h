@@ -125,7 +125,7 @@ struct ElementStructure {
   // Long elements: end-to-end length along the surface (closed: the length of the loop round);
   // width: the diameter of a tube of that length and the element's area.
   double length = 0, width = 0;
-  int interior_ends = 0;                   // of its two ends, those away from the border
+  int interior_ends = 0;  // of its two ends, those away from the border
   // Measured against options.swatch: the swatch kind it was matched to (-1: none) and, for a
   // compact element (its swatch kind's elements mostly not long), its shape against the swatch
   // element it came from at the output's scale (0: not measured). The element's linear map from

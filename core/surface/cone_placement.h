@@ -28,7 +28,7 @@ struct ConePlacementReport {
   int split_poles = 0;  // cones of more than one unit split into unit cones first
   int rounds = 0;
   int moves = 0;
-  int cancelled = 0;  // + and - cones that met and cancelled
+  int cancelled = 0;                           // + and - cones that met and cancelled
   double energy_before = 0, energy_after = 0;  // sum A u^2 / sum A
 };
 

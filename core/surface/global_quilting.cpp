@@ -92,9 +92,8 @@ bool share_wedge(const GlobalParameterization& gp, int f, int g) {
 // False when a vertex lies beyond a boundary or around a singular vertex. turn (optional)
 // receives per vertex the sign of the chart transition from f0's chart to its face's (+1, or -1
 // across a half turn).
-bool place_from(const GlobalParameterization& gp, const SurfaceJob& job, const MatrixX3d& P,
-                int f0, double shell_height, SurfaceElement& s,
-                std::vector<signed char>* turn = nullptr) {
+bool place_from(const GlobalParameterization& gp, const SurfaceJob& job, const MatrixX3d& P, int f0,
+                double shell_height, SurfaceElement& s, std::vector<signed char>* turn = nullptr) {
   s.face.resize(P.rows());
   s.barycentric.resize(P.rows(), 3);
   s.height.resize(P.rows());
@@ -185,8 +184,7 @@ bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P
     const double a = scale_of(sum[0] / count[0], nullptr), b = scale_of(sum[1] / count[1], nullptr);
     even = std::max(a, b) <= options.max_element_variation * std::min(a, b);
   }
-  return element_scale <= options.max_element_scale && aspect <= options.max_element_aspect &&
-         even;
+  return element_scale <= options.max_element_scale && aspect <= options.max_element_aspect && even;
 }
 
 // The element as the layout's first-order image at its centre, bent only by the surface: its
@@ -198,8 +196,8 @@ bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P
 // an element keeps its place among neighbours laid out through the layout to first order (its
 // links), and loses only the layout's variation across it (a teardrop's) and extreme sizes.
 bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
-                  const Eigen::Matrix<double, 2, 3>& M, const MatrixX3d& P,
-                  const Vector2d& centre, int f, double shell_height, bool similarity,
+                  const Eigen::Matrix<double, 2, 3>& M, const MatrixX3d& P, const Vector2d& centre,
+                  int f, double shell_height, bool similarity,
                   const SurfaceQuiltingOptions::Global& options, SurfaceElement& s) {
   const MatrixX3i& F = job.base.F;
   // Thin V needs a dynamic column count (Eigen asserts it; a fixed 2 x 3 is refused).
@@ -209,8 +207,8 @@ bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
   if (!(sv(1) > 0)) return false;
   const double sigma = std::sqrt(sv(0) * sv(1));
   if (similarity || sv(0) > options.max_element_aspect * sv(1)) sv.setConstant(sigma);
-  const double k = std::clamp(1.0 / sigma, 1.0 / options.max_element_scale,
-                              options.max_element_scale);
+  const double k =
+      std::clamp(1.0 / sigma, 1.0 / options.max_element_scale, options.max_element_scale);
   // Plane offset -> surface offset: V diag(1 / sv) U^T, rescaled to the clamped size.
   const Eigen::Matrix<double, 3, 2> inverse =
       (k * sigma) * svd.matrixV() * sv.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
@@ -246,9 +244,9 @@ bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
 
 // One lattice copy of an orbit representative whose centre lies in a chart triangle.
 struct LatticeCopy {
-  int rep = 0;                            // index into the representatives
+  int rep = 0;                                  // index into the representatives
   Eigen::Vector2i k = Eigen::Vector2i::Zero();  // lattice coordinates of its translation
-  int face = 0;                           // a base face whose chart triangle holds its centre
+  int face = 0;                                 // a base face whose chart triangle holds its centre
   bool operator<(const LatticeCopy& o) const {
     if (rep != o.rep) return rep < o.rep;
     if (k.y() != o.k.y()) return k.y() < o.k.y();
@@ -294,7 +292,8 @@ std::vector<LatticeCopy> lattice_copies(const GlobalParameterization& gp, int nu
           const double w = (e0.x() * d.y() - d.x() * e0.y()) / den;
           if (v >= 0 && w >= 0 && v + w <= 1)
             per[static_cast<size_t>(f)].push_back(
-                {static_cast<int>(r), Eigen::Vector2i(static_cast<int>(i), static_cast<int>(j)), f});
+                {static_cast<int>(r), Eigen::Vector2i(static_cast<int>(i), static_cast<int>(j)),
+                 f});
         }
     }
   });
@@ -309,7 +308,8 @@ std::vector<LatticeCopy> lattice_copies(const GlobalParameterization& gp, int nu
     const size_t first = out.size();
     for (size_t q = i; q < j; ++q) {
       bool same = false;
-      for (size_t o = first; o < out.size() && !same; ++o) same = share_wedge(gp, all[q].face, out[o].face);
+      for (size_t o = first; o < out.size() && !same; ++o)
+        same = share_wedge(gp, all[q].face, out[o].face);
       if (!same) out.push_back(all[q]);
     }
     i = j;
@@ -502,9 +502,8 @@ namespace {
 // parameterised surface, placed from the face holding its centre. The output is counted before
 // anything is built, and refused over max_faces.
 std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, const SurfaceJob& job,
-                                          const PreparedSwatch& swatch,
-                                          const SwatchSymmetry& sym, const Vector2d& lo,
-                                          const SurfaceQuiltingOptions& options,
+                                          const PreparedSwatch& swatch, const SwatchSymmetry& sym,
+                                          const Vector2d& lo, const SurfaceQuiltingOptions& options,
                                           GlobalQuiltingStats& gstats, StageTimes& times,
                                           ProgressSink* progress) {
   const double max_faces = options.max_faces;
@@ -528,7 +527,8 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
              " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
     for (int f = 0; f < job.base.num_faces(); ++f) {
       const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
-      gstats.parameter_area += 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+      gstats.parameter_area +=
+          0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
     }
   }
   ScopedStageTimer timer(times, "placement");
@@ -914,9 +914,8 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
       const TrivialConnection connection(base.V, base.F, job.topo, job.TT, df.N);
       if (connection.unbalanced_component(df.index) < 0) {
         ConePlacementReport report;
-        const std::vector<int> cones =
-            place_cones(connection, df.index, vertex_adjacency(base.F, base.num_vertices()),
-                        {}, &report);
+        const std::vector<int> cones = place_cones(
+            connection, df.index, vertex_adjacency(base.F, base.num_vertices()), {}, &report);
         gstats.split_poles = report.split_poles;
         gstats.cone_moves = report.moves;
         gstats.scale_energy_before = report.energy_before;
@@ -936,10 +935,9 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
             E > 0 ? std::min(1.0, std::sqrt(std::log(options.global.max_overfill) / (2 * E))) : 1.0;
         face_scale.resize(base.num_faces());
         for (int f = 0; f < base.num_faces(); ++f)
-          face_scale(f) = std::exp(gstats.scale_exponent *
-                                   (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) +
-                                    metric.u(base.F(f, 2))) /
-                                   3);
+          face_scale(f) = std::exp(
+              gstats.scale_exponent *
+              (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) + metric.u(base.F(f, 2))) / 3);
       }
     }
     gp = seamless_parameterization(*layout_V, base, job, df, face_scale, symmetry,
@@ -982,7 +980,8 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     // A layout that bends or breaks most pieces carries no threads that run on, even when its
     // area is even (the wicker chair's 77 rough parts, 471 cones: 28% of the pieces on the surface
     // kept, coverage 48%; bunny 88%, cup 93%).
-    const int on_surface = gstats.thread_pieces + gstats.pieces_distorted + gstats.pieces_near_cones;
+    const int on_surface =
+        gstats.thread_pieces + gstats.pieces_distorted + gstats.pieces_near_cones;
     if (unfit && !options.global.count_only &&
         gstats.thread_pieces < kMinThreadPiecesKept * on_surface) {
       *unfit = true;

@@ -303,9 +303,9 @@ int cancel_singular_pairs(const MatrixX3d& V, const MatrixX3i& F, const EdgeTopo
     // Rotation across e changed by -ia units at a (and +ia at b): both indices become 0.
     const long shift = -static_cast<long>(ia) * sign_at_first[e];
     const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
-    const double raw = angle_of(field.direction.row(g).transpose(), fr, g) -
-                       (angle_of(field.direction.row(f).transpose(), fr, f) +
-                        transport(V, topo, fr, e));
+    const double raw =
+        angle_of(field.direction.row(g).transpose(), fr, g) -
+        (angle_of(field.direction.row(f).transpose(), fr, f) + transport(V, topo, fr, e));
     const long k = std::lround(raw / unit) - shift;
     field.matching[e] = static_cast<int>(((k % N) + N) % N);
     field.index[a] = field.index[b] = 0;

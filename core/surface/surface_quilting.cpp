@@ -437,7 +437,8 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
     stats.estimated_faces = faces;
     MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
              " the texture would have about ", faces, " faces, more than the limit of ",
-             options.max_faces, " (--max-faces, or --max-memory at 400 bytes a face); use a "
+             options.max_faces,
+             " (--max-faces, or --max-memory at 400 bytes a face); use a "
              "larger --scale");
   }
   // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be

@@ -43,9 +43,9 @@ struct SurfaceElement {
 struct SurfaceQuilt {
   std::vector<SurfaceElement> elements;
   double shell_height = 0;
-  TriMesh base;           // the (refined) base mesh the local coordinates refer to
-  TriMesh input_base;     // the base as given, coincident vertices welded (or its proxy)
-  Refinement refinement;  // base faces in input_base faces (empty: base is input_base)
+  TriMesh base;                    // the (refined) base mesh the local coordinates refer to
+  TriMesh input_base;              // the base as given, coincident vertices welded (or its proxy)
+  Refinement refinement;           // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
 };
 
@@ -139,15 +139,15 @@ struct SurfaceQuiltingOptions {
 
 struct SurfaceQuiltingStats {
   int iterations = 0;
-  int base_faces = 0;       // after refinement
-  int welded_vertices = 0;  // base vertices merged with another at the same position
-  int duplicate_faces = 0;  // base faces that repeated another, removed
+  int base_faces = 0;          // after refinement
+  int welded_vertices = 0;     // base vertices merged with another at the same position
+  int duplicate_faces = 0;     // base faces that repeated another, removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
   int proxy_faces = 0;         // faces of the simplified base (0: the base was not simplified)
   double proxy_error = 0;      // the simplification's largest quadric error (mesh units)
   int patches_shrunk = 0;
   long long patch_faces = 0;  // faces of every local patch used (after shrinking), summed
-  double swatch_scale = 0;  // factor applied to the swatch
+  double swatch_scale = 0;    // factor applied to the swatch
   double shell_height = 0;
   double cell_size = 0;
   long long matched_point_offsets = 0;

@@ -278,8 +278,8 @@ Eigen::VectorXd TrivialConnection::solve_poisson(const Eigen::VectorXd& rhs) con
 
 Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index) const {
   const int nv = static_cast<int>(V_.rows());
-  MQ_CHECK(static_cast<int>(index.size()) == nv, InvalidInput, "trivial connection: ",
-           index.size(), " indices for ", nv, " vertices");
+  MQ_CHECK(static_cast<int>(index.size()) == nv, InvalidInput, "trivial connection: ", index.size(),
+           " indices for ", nv, " vertices");
   const int bad = unbalanced_component(index);
   MQ_CHECK(bad < 0, InvalidInput, "trivial connection: the indices of closed component ", bad,
            " do not sum to N times its Euler characteristic");
@@ -287,7 +287,8 @@ Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index) cons
   // -Delta: (-Delta) u = k - K.
   Eigen::VectorXd rhs(nv);
   const double unit = kTwoPi / N_;
-  for (int v = 0; v < nv; ++v) rhs(v) = interior_[v] ? index[static_cast<size_t>(v)] * unit - K_(v) : 0.0;
+  for (int v = 0; v < nv; ++v)
+    rhs(v) = interior_[v] ? index[static_cast<size_t>(v)] * unit - K_(v) : 0.0;
   return solve_poisson(rhs);
 }
 
@@ -341,7 +342,8 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index,
     double re = 0, im = 0;
     for (const int f : members) {
       const Vector3d q3 = guidance.row(f).transpose();
-      const double len = std::hypot(q3.dot(fr.b1.row(f).transpose()), q3.dot(fr.b2.row(f).transpose()));
+      const double len =
+          std::hypot(q3.dot(fr.b1.row(f).transpose()), q3.dot(fr.b2.row(f).transpose()));
       if (!(len > 0)) continue;
       const Vector3d x0 = V_.row(F_(f, 0)), x1 = V_.row(F_(f, 1)), x2 = V_.row(F_(f, 2));
       const double a = 0.5 * (x1 - x0).cross(x2 - x0).norm() * len;
@@ -354,7 +356,8 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index,
   }
   out.field.N = N_;
   out.field.direction.resize(nf, 3);
-  for (int f = 0; f < nf; ++f) out.field.direction.row(f) = direction_in_frame(theta[f], fr, f).transpose();
+  for (int f = 0; f < nf; ++f)
+    out.field.direction.row(f) = direction_in_frame(theta[f], fr, f).transpose();
   out.field.matching.assign(static_cast<size_t>(ne), 0);
   for (int e = 0; e < ne; ++e) {
     if (!interior_edge(topo_, e)) continue;

@@ -83,10 +83,10 @@ class TrivialConnection {
   std::vector<char> interior_, closed_;
   std::vector<int> component_;
   Eigen::VectorXd K_, area_, weight_, transport_;  // weight_, transport_: #E
-  std::vector<int> row_of_vertex_;                  // -1: no row (boundary, or a closed
-                                                    // component's dropped vertex)
+  std::vector<int> row_of_vertex_;                 // -1: no row (boundary, or a closed
+                                                   // component's dropped vertex)
   int vertex_rows_ = 0;
-  Eigen::SparseMatrix<double> A_;  // (vertex rows + generators) by #E, signed incidence
+  Eigen::SparseMatrix<double> A_;           // (vertex rows + generators) by #E, signed incidence
   std::vector<double> generator_holonomy_;  // Levi-Civita holonomy around each generator
   std::vector<std::vector<int>> component_vertices_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> laplacian_, augmented_;

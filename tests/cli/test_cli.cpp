@@ -44,7 +44,8 @@ TEST(Cli, HelpOfEveryCommand) {
     EXPECT_NE(r.out.find("usage: meshquilt " + cmd), std::string::npos) << cmd << ":\n" << r.out;
     EXPECT_TRUE(r.err.empty()) << cmd << ": " << r.err;
     // The exit statuses, which a farm scheduler's retry rule needs (issue 24).
-    for (const char* status : {"exit status: 0 done; 1 bad input", "2 bad usage", "3 internal error"})
+    for (const char* status :
+         {"exit status: 0 done; 1 bad input", "2 bad usage", "3 internal error"})
       EXPECT_NE(r.out.find(status), std::string::npos) << cmd << " --help lacks '" << status << "'";
   }
   const CliRun v = meshquilt(dir, "--version");

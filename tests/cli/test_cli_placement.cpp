@@ -65,7 +65,8 @@ TEST_F(CliPlacement, StatsCarryTheCheckAndATrueCoverage) {
   EXPECT_EQ(json_value(stats, "flipped_components"), "1");
   EXPECT_NEAR(std::stod(json_value(stats, "coverage")), coverage, 0.02);
   // Kept inside out, the texture grows inside the tube: the coverage is still a fraction.
-  const CliRun c = meshquilt(dir_, job + " --base inside_out.obj --keep-orientation --min-coverage 0");
+  const CliRun c =
+      meshquilt(dir_, job + " --base inside_out.obj --keep-orientation --min-coverage 0");
   ASSERT_EQ(c.status, 0) << c.err;
   stats = slurp(dir_ + "/s.json");
   EXPECT_EQ(json_value(stats, "flipped_components"), "0");

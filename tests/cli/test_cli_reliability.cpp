@@ -210,8 +210,9 @@ TEST_F(Reliability, MessagesInTheUsersTerms) {
   spit(dir_ + "/flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   expect_refused("surface --base grid.off --swatch flat.obj -o o.obj",
                  "flat.obj: the swatch is flat");
-  spit(dir_ + "/huge.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\n"
-                           "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  spit(dir_ + "/huge.obj",
+       "v 0 0 0\nv 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\n"
+       "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
   expect_refused("surface --base huge.obj --swatch sw.obj -o o.obj",
                  "huge.obj: coordinates too large");
 }
@@ -250,8 +251,9 @@ TEST_F(Reliability, GuidanceWithNothingAlongTheSurfaceIsRefused) {
 TEST_F(Reliability, NonManifoldEdgesAreSaid) {
   // The grid's interior edges 1-4 and 4-8 get a third face: a fin folded back over the grid.
   spit(dir_ + "/fin.off", grid_off("3 1 4 8\n", 1));
-  const CliRun r = meshquilt(dir_, "surface --base fin.off --swatch sw.obj --scale 0.3 -o f.obj "
-                                   "--min-coverage 0");
+  const CliRun r = meshquilt(dir_,
+                             "surface --base fin.off --swatch sw.obj --scale 0.3 -o f.obj "
+                             "--min-coverage 0");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("base: 2 non-manifold edges (three or more faces meeting) are borders"),
             std::string::npos)
@@ -266,11 +268,11 @@ TEST_F(Reliability, NonManifoldEdgesAreSaid) {
 // never under the faces written, at most twice them (1.74x here). `fits` follows --max-faces.
 TEST_F(Reliability, EstimateIsOneLineAndHolds) {
   write_mesh(dir_ + "/sphere.obj", test::uv_sphere(1.0, 32, 16));
-  ASSERT_EQ(meshquilt(dir_, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw3.obj --quiet")
-                .status,
-            0);
-  for (const auto& [swatch, lo, hi] : {std::tuple<std::string, double, double>{"sw3.obj", 0.9, 1.1},
-                                       {"sw.obj", 1.0, 2.0}}) {
+  ASSERT_EQ(
+      meshquilt(dir_, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw3.obj --quiet").status,
+      0);
+  for (const auto& [swatch, lo, hi] :
+       {std::tuple<std::string, double, double>{"sw3.obj", 0.9, 1.1}, {"sw.obj", 1.0, 2.0}}) {
     SCOPED_TRACE(swatch);
     const std::string job =
         "surface --base sphere.obj --swatch " + swatch + " --scale 0.15 -o s.obj";
@@ -280,8 +282,8 @@ TEST_F(Reliability, EstimateIsOneLineAndHolds) {
     EXPECT_EQ(listing(dir_), before) << "--estimate wrote something";
     double faces = 0, bytes = 0, seconds = 0;
     int fits = -1;
-    ASSERT_EQ(std::sscanf(e.out.c_str(), "estimate faces %lf bytes %lf seconds %lf fits %d",
-                          &faces, &bytes, &seconds, &fits),
+    ASSERT_EQ(std::sscanf(e.out.c_str(), "estimate faces %lf bytes %lf seconds %lf fits %d", &faces,
+                          &bytes, &seconds, &fits),
               4)
         << e.out;
     EXPECT_EQ(fits, 1);
@@ -296,7 +298,8 @@ TEST_F(Reliability, EstimateIsOneLineAndHolds) {
     EXPECT_NE(small.out.find(" fits 0"), std::string::npos) << small.out;
     for (const char* f : {"s.obj", "s.mtl"}) fs::remove(dir_ + "/" + f);
   }
-  for (const char* f : {"sphere.obj", "sphere.mtl", "sw3.obj", "sw3.mtl"}) fs::remove(dir_ + "/" + f);
+  for (const char* f : {"sphere.obj", "sphere.mtl", "sw3.obj", "sw3.mtl"})
+    fs::remove(dir_ + "/" + f);
 }
 
 // Issue 28: an output name with a line break would split the OBJ's `mtllib` line; one that is not
@@ -309,7 +312,8 @@ TEST_F(Reliability, OutputNamesMustBeText) {
                  "not UTF-8");
   fs::copy_file(dir_ + "/sw.obj", dir_ + "/sw\xff.obj");
   const CliRun r = meshquilt(
-      dir_, "plane --swatch \"$(printf 'sw\\377.obj')\" --size 5 5 -o o.obj --stats s.json --quiet");
+      dir_,
+      "plane --swatch \"$(printf 'sw\\377.obj')\" --size 5 5 -o o.obj --stats s.json --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string stats = slurp(dir_ + "/s.json");
   EXPECT_NE(stats.find("sw\\u00ff.obj"), std::string::npos);

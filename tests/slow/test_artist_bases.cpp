@@ -60,11 +60,11 @@ TriMesh square_mail() {
 
 // What a base must keep (issue 23's targets where they are met; see the README for the rest).
 struct Keep {
-  double share = 0.9;      // interior rings linked as their kind is in the swatch
-  double size = 0.06;      // median size ratio within 1 +- this
-  double size_p99 = 1.3;   // 99th percentile of the size ratio at most
-  double size_max = 1.6;   // largest at most
-  double aspect = 1.1;     // median aspect at most
+  double share = 0.9;     // interior rings linked as their kind is in the swatch
+  double size = 0.06;     // median size ratio within 1 +- this
+  double size_p99 = 1.3;  // 99th percentile of the size ratio at most
+  double size_max = 1.6;  // largest at most
+  double aspect = 1.1;    // median aspect at most
   double density_lo = 0.9, density_hi = 1.1;
 };
 
@@ -138,7 +138,8 @@ TEST(ArtistBases, AutoLeavesTheThreadLayoutWhereItBreaksThreads) {
   const ::mq::Run on_chair = quilt(chair, weave, 0.073);
   EXPECT_FALSE(on_chair.used_global);
   EXPECT_GT(on_chair.embedding.coverage, 0.6);
-  const ::mq::Run on_cup = quilt(read_mesh(test::shared_data("base/cup_mug_11k.off")), weave, 0.145);
+  const ::mq::Run on_cup =
+      quilt(read_mesh(test::shared_data("base/cup_mug_11k.off")), weave, 0.145);
   EXPECT_TRUE(on_cup.used_global);
   EXPECT_GT(on_cup.embedding.coverage, 0.95);
 }

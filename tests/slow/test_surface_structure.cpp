@@ -36,8 +36,8 @@ Result quilt(const TriMesh& base, const TriMesh& swatch, double scale) {
   SurfaceQuiltingOptions o;
   o.scale = scale;
   TranslationCostCpu cost;
-  const SurfaceQuilt q = quilt_surface_auto(base, swatch, o, cost, &r.stats, nullptr, nullptr,
-                                            &r.global);
+  const SurfaceQuilt q =
+      quilt_surface_auto(base, swatch, o, cost, &r.stats, nullptr, nullptr, &r.global);
   TetStretchCpu stretch;
   r.output = embed_quilt(q, {}, stretch, &r.embedding);
   r.structure = summarize_structure(r.output, swatch, &base, r.stats.swatch_scale);

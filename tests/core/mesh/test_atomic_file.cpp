@@ -153,7 +153,6 @@ TEST(AtomicOutputFile, PairsCommitTogether) {
   EXPECT_EQ(test::slurp(dir + "/p.mtl"), "old mtl\n");
   fs::remove_all(dir + "/p.obj");
   EXPECT_EQ(names_in(dir), std::vector<std::string>{"p.mtl"});
-
 }
 
 }  // namespace

@@ -28,8 +28,7 @@ TEST(CornerNormals, SmoothSurfaceHasOneNormalPerVertexEqualToTheVertexNormal) {
   EXPECT_EQ(c.N.rows(), t.V.rows());
   const MatrixX3d VN = vertex_normals(t.V, t.F);
   for (int f = 0; f < t.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k)
-      ASSERT_LT((c.N.row(c.FN(f, k)) - VN.row(t.F(f, k))).norm(), 1e-9);
+    for (int k = 0; k < 3; ++k) ASSERT_LT((c.N.row(c.FN(f, k)) - VN.row(t.F(f, k))).norm(), 1e-9);
 }
 
 TEST(CornerNormals, CreaseAngleDecidesAndBadInputIsRefused) {

@@ -68,7 +68,9 @@ TEST(ElementKinds, ObjMaterialsNameKindsBeforeGroups) {
   const TriMesh m = read_mesh(dir + "/k.obj");
   ASSERT_TRUE(has_kinds(m));
   ASSERT_EQ(m.face_kind.size(), 5u);
-  const auto name = [&](int f) { return m.kinds[static_cast<size_t>(m.face_kind[static_cast<size_t>(f)])]; };
+  const auto name = [&](int f) {
+    return m.kinds[static_cast<size_t>(m.face_kind[static_cast<size_t>(f)])];
+  };
   EXPECT_EQ(name(0), kDefaultKind);
   EXPECT_EQ(name(1), "m1");
   EXPECT_EQ(name(2), "m1");
@@ -240,7 +242,8 @@ TEST(ElementKinds, AppendMergesKindsByName) {
   append_mesh(sum, a);
   append_mesh(sum, c);  // no kinds: kDefaultKind
   EXPECT_EQ(sum.kinds, (std::vector<std::string>{"x", "y", kDefaultKind}));
-  EXPECT_EQ(faces_per_kind(sum), (std::map<std::string, int>{{"x", 24}, {"y", 12}, {kDefaultKind, 12}}));
+  EXPECT_EQ(faces_per_kind(sum),
+            (std::map<std::string, int>{{"x", 24}, {"y", 12}, {kDefaultKind, 12}}));
 }
 
 TEST(ElementKinds, PlanarQuiltingKeepsKindsOfIvyAndWeave) {
@@ -264,7 +267,8 @@ TEST(ElementKinds, PlanarQuiltingKeepsKindsOfIvyAndWeave) {
   for (const int e : l.face_element) ++faces[static_cast<size_t>(e)];
   int max_leaf = 0, min_vine = 1 << 30;
   for (int e = 0; e < l.count; ++e) {
-    const bool leaf = l.kinds[static_cast<size_t>(l.element_kind[static_cast<size_t>(e)])] == "leaf";
+    const bool leaf =
+        l.kinds[static_cast<size_t>(l.element_kind[static_cast<size_t>(e)])] == "leaf";
     (leaf ? max_leaf : min_vine) = leaf ? std::max(max_leaf, faces[static_cast<size_t>(e)])
                                         : std::min(min_vine, faces[static_cast<size_t>(e)]);
   }

@@ -4,7 +4,6 @@
 // semantic allows, POSITION min/max equal to the data, indices inside the vertex range; then
 // read back by tinygltf as an independent reader.
 #include <gtest/gtest.h>
-
 #include <tiny_gltf.h>
 
 #include <cmath>
@@ -182,9 +181,9 @@ TEST(GltfWriter, IvyIsValidWithAMaterialPerKindAndElementIds) {
   const auto& p0 = m.meshes[0].primitives[0];
   const float* N = accessor_data<float>(m, p0.attributes.at("NORMAL"));
   for (size_t i = 0; i < m.accessors[static_cast<size_t>(p0.attributes.at("NORMAL"))].count; ++i)
-    ASSERT_NEAR(std::sqrt(N[3 * i] * N[3 * i] + N[3 * i + 1] * N[3 * i + 1] +
-                          N[3 * i + 2] * N[3 * i + 2]),
-                1.0, 1e-5);
+    ASSERT_NEAR(
+        std::sqrt(N[3 * i] * N[3 * i] + N[3 * i + 1] * N[3 * i + 1] + N[3 * i + 2] * N[3 * i + 2]),
+        1.0, 1e-5);
 }
 
 // Two kinds named alike once sanitised ("a b", "a_b") are two materials of different names

@@ -152,7 +152,7 @@ TEST(OffsetSurface, SmoothingDoesNotDependOnTheTessellation) {
   unscaled *= 180 / M_PI / n;
   std::printf("mean angle to the coarse directions: %.2f deg scaled, %.2f deg fixed steps\n",
               scaled, unscaled);
-  EXPECT_LT(scaled, 3.0);  // measured 1.3 degrees
+  EXPECT_LT(scaled, 3.0);              // measured 1.3 degrees
   EXPECT_LT(scaled, 0.25 * unscaled);  // measured 12.6
 }
 

@@ -120,8 +120,7 @@ TEST(RingSeparation, ObstaclesAndOtherElementsStayPut) {
 // apart, every link kept, and no loop point travels beyond the bound.
 Scene pressed_chain() {
   Scene s;
-  for (int k = 0; k < 5; ++k)
-    s.add(ring(about_x(k % 2 ? M_PI / 2 : 0), Vector3d(1.75 * k, 0, 0)));
+  for (int k = 0; k < 5; ++k) s.add(ring(about_x(k % 2 ? M_PI / 2 : 0), Vector3d(1.75 * k, 0, 0)));
   return s;
 }
 
@@ -164,8 +163,7 @@ TEST(RingSeparation, SameBytesWhateverTheThreadCount) {
 
 TEST(RingSeparation, SizesThatDoNotAgreeAreRefused) {
   Scene s = pressed_chain();
-  EXPECT_THROW(separate_rings(s.V, s.first, s.bins, s.bins, std::vector<char>(4, 1)),
-               InvalidInput);
+  EXPECT_THROW(separate_rings(s.V, s.first, s.bins, s.bins, std::vector<char>(4, 1)), InvalidInput);
   std::vector<Eigen::Index> short_first(s.first.begin(), s.first.end() - 1);
   EXPECT_THROW(separate_rings(s.V, short_first, s.bins, s.bins, std::vector<char>(5, 1)),
                InvalidInput);

@@ -55,8 +55,8 @@ TEST(ConePlacement, WellPlacedConesStay) {
   const MatrixX3i TT = face_adjacency(topo);
   const TrivialConnection tc(m.V, m.F, topo, TT, 2);
   std::vector<int> index(static_cast<size_t>(m.num_vertices()), 0);
-  for (const Vector3d& d : {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1),
-                           Vector3d(-1, -1, 1)})
+  for (const Vector3d& d :
+       {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1), Vector3d(-1, -1, 1)})
     index[nearest_vertex(m, d.normalized())] = 1;
   ConePlacementReport report;
   const std::vector<int> placed =

@@ -64,8 +64,8 @@ void expect_mail(const GlobalRun& r, const Keep& keep, const char* what) {
       "%.3f, 99th %.3f, largest %.3f; aspect median %.3f\n",
       what, s.rings, s.interior_rings, 100 * c.share_matching, s.isolated_rings,
       100 * c.density_ratio, r.global.singular_vertices, r.global.off_surface,
-      r.embedding.removed_self_intersecting, r.embedding.removed_intersecting,
-      c.shape.size_median, c.shape.size_p99, c.shape.size_max, c.shape.aspect_median);
+      r.embedding.removed_self_intersecting, r.embedding.removed_intersecting, c.shape.size_median,
+      c.shape.size_p99, c.shape.size_max, c.shape.aspect_median);
   EXPECT_TRUE(r.global.periodic);
   EXPECT_TRUE(r.global.tiled);
   ASSERT_EQ(c.interior_links, 4);
@@ -124,9 +124,10 @@ TEST(GlobalQuilting, SpikySphereTransitionsAreSymmetries) {
   for (int v = 0; v < 12; ++v) base.V.row(v) *= 1.6;
   base.V *= 3.0;
   const GlobalRun r = run(base, 0.6);
-  std::printf("[ measure  ] spiky sphere: %d cones, %d cancelled pairs, %d pinned, worst transition %.2e\n",
-              r.global.singular_vertices, r.global.cancelled_cone_pairs, r.global.pinned_cones,
-              r.global.worst_transition_error);
+  std::printf(
+      "[ measure  ] spiky sphere: %d cones, %d cancelled pairs, %d pinned, worst transition %.2e\n",
+      r.global.singular_vertices, r.global.cancelled_cone_pairs, r.global.pinned_cones,
+      r.global.worst_transition_error);
   EXPECT_GT(r.global.singular_vertices, 4);
   EXPECT_TRUE(r.global.seamless);
   EXPECT_LT(r.global.worst_transition_error, 0.01);
@@ -142,10 +143,10 @@ TEST(GlobalQuilting, SpikySphereTransitionsAreSymmetries) {
 TEST(GlobalQuilting, UvSpherePolesAreSplitIntoFourCones) {
   TriMesh base = test::uv_sphere(3.0, 32, 16);
   base.V.col(2) *= 1.0001;  // the guidance follows the longest box axis: the poles' one
-  double volume = 0;  // outward: positive
+  double volume = 0;        // outward: positive
   for (int f = 0; f < base.num_faces(); ++f)
-    volume += base.V.row(base.F(f, 0)).dot(
-        base.V.row(base.F(f, 1)).cross(base.V.row(base.F(f, 2))));
+    volume +=
+        base.V.row(base.F(f, 0)).dot(base.V.row(base.F(f, 1)).cross(base.V.row(base.F(f, 2))));
   ASSERT_GT(volume, 0);
   const GlobalRun r = run(base, 0.6);
   std::printf("[ measure  ] UV sphere: %d poles split, %d cones, %d copies, E %.3f -> %.3f\n",

@@ -88,8 +88,8 @@ TEST(LineField, AdjacentOppositeConesCancel) {
   for (int f = 0; f < fx.mesh.num_faces(); ++f) {
     Vector3d c = Vector3d::Zero();
     for (int k = 0; k < 3; ++k) c += fx.mesh.V.row(fx.mesh.F(f, k)).transpose() / 3;
-    const double theta =
-        0.5 * std::atan2(c.y() - cp.y(), c.x() - cp.x()) - 0.5 * std::atan2(c.y() - cq.y(), c.x() - cq.x());
+    const double theta = 0.5 * std::atan2(c.y() - cp.y(), c.x() - cp.x()) -
+                         0.5 * std::atan2(c.y() - cq.y(), c.x() - cq.x());
     d.row(f) << std::cos(theta), std::sin(theta), 0;
   }
   DirectionField f = direction_field_matching(fx.mesh.V, fx.mesh.F, fx.topo, d, 2);

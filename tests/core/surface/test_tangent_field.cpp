@@ -80,8 +80,8 @@ TEST(TangentField, ConstantDirectionOnAPlane) {
         << e.what();
   }
   // Normal to some faces only (a box's top, with a direction along z): followed on the others.
-  const MatrixX3d B = tangent_field_from_direction(test::unit_cube().V, test::unit_cube().F,
-                                                   Vector3d(0, 0, 1));
+  const MatrixX3d B =
+      tangent_field_from_direction(test::unit_cube().V, test::unit_cube().F, Vector3d(0, 0, 1));
   EXPECT_TRUE(B.allFinite());
   EXPECT_THROW(tangent_field_from_direction(grid.V, grid.F, Vector3d::Zero()), InvalidInput);
 }

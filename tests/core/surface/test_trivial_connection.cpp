@@ -36,8 +36,8 @@ int nearest_vertex(const TriMesh& m, const Vector3d& d) {
 
 std::vector<int> tetrahedral_cones(const TriMesh& sphere) {
   std::vector<int> index(static_cast<size_t>(sphere.num_vertices()), 0);
-  for (const Vector3d& d : {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1),
-                           Vector3d(-1, -1, 1)})
+  for (const Vector3d& d :
+       {Vector3d(1, 1, 1), Vector3d(1, -1, -1), Vector3d(-1, 1, -1), Vector3d(-1, -1, 1)})
     index[nearest_vertex(sphere, d.normalized())] = 1;
   return index;
 }
@@ -66,7 +66,8 @@ TEST(TrivialConnection, SphereFieldHasExactlyThePrescribedCones) {
   const MatrixX3d guidance = MatrixX3d::Zero(s.m.num_faces(), 3);
   const ConeMetric cm = trivial_connection(s.m.V, s.m.F, s.topo, s.TT, cones, guidance);
   // Measured again from the directions alone: the same four cones, nothing else.
-  const DirectionField again = direction_field_matching(s.m.V, s.m.F, s.topo, cm.field.direction, 2);
+  const DirectionField again =
+      direction_field_matching(s.m.V, s.m.F, s.topo, cm.field.direction, 2);
   EXPECT_EQ(again.index, cones);
   EXPECT_EQ(cm.field.index, cones);
   // u peaks at the + cones (curvature gathered there) and has mean zero.
@@ -82,8 +83,8 @@ TEST(TrivialConnection, SphereFieldHasExactlyThePrescribedCones) {
 TEST(TrivialConnection, ScaledByItsMetricTheLayoutIsConformal) {
   const Mesh s(test::icosphere(4));
   const std::vector<int> cones = tetrahedral_cones(s.m);
-  const ConeMetric cm = trivial_connection(s.m.V, s.m.F, s.topo, s.TT, cones,
-                                           MatrixX3d::Zero(s.m.num_faces(), 3));
+  const ConeMetric cm =
+      trivial_connection(s.m.V, s.m.F, s.topo, s.TT, cones, MatrixX3d::Zero(s.m.num_faces(), 3));
   GlobalParameterizationOptions unit;
   const double unit_aspect =
       median_aspect(global_parameterization(s.m.V, s.m.F, s.topo, s.TT, cm.field, unit), s.m);
@@ -96,7 +97,7 @@ TEST(TrivialConnection, ScaledByItsMetricTheLayoutIsConformal) {
       median_aspect(global_parameterization(s.m.V, s.m.F, s.topo, s.TT, cm.field, scaled), s.m);
   std::printf("[ measure  ] sphere, median aspect of the layout: unit frames %.3f, e^u %.3f\n",
               unit_aspect, conformal_aspect);
-  EXPECT_GT(unit_aspect, 1.25);     // the misfit spread as stretch and squeeze
+  EXPECT_GT(unit_aspect, 1.25);       // the misfit spread as stretch and squeeze
   EXPECT_LT(conformal_aspect, 1.06);  // integrable: nearly a similarity on every face
 }
 
@@ -113,10 +114,11 @@ TEST(TrivialConnection, FlatOpenSheetIsParallelAndUnscaled) {
 
 TEST(TrivialConnection, TorusClosesAroundBothLoopsWithoutCones) {
   const Mesh t(test::torus(3.0, 1.0, 48, 16));
-  const ConeMetric cm = trivial_connection(t.m.V, t.m.F, t.topo, t.TT,
-                                           std::vector<int>(t.m.num_vertices(), 0),
-                                           MatrixX3d::Zero(t.m.num_faces(), 3));
-  const DirectionField again = direction_field_matching(t.m.V, t.m.F, t.topo, cm.field.direction, 2);
+  const ConeMetric cm =
+      trivial_connection(t.m.V, t.m.F, t.topo, t.TT, std::vector<int>(t.m.num_vertices(), 0),
+                         MatrixX3d::Zero(t.m.num_faces(), 3));
+  const DirectionField again =
+      direction_field_matching(t.m.V, t.m.F, t.topo, cm.field.direction, 2);
   for (const int i : again.index) EXPECT_EQ(i, 0);
   // The torus of revolution is conformally flat with e^u proportional to 1 / (R + r cos):
   // u spans log((R + r) / (R - r)) = log 2.
@@ -131,7 +133,8 @@ TEST(TrivialConnection, OpenCylinderClosesAroundItsHole) {
                                            std::vector<int>(c.m.num_vertices(), 0), guidance);
   // Flat already: no scale, and the field runs along the axis all the way round.
   EXPECT_LT(cm.u.cwiseAbs().maxCoeff(), 1e-6);
-  for (int f = 0; f < c.m.num_faces(); ++f) EXPECT_NEAR(std::abs(cm.field.direction(f, 2)), 1.0, 1e-6);
+  for (int f = 0; f < c.m.num_faces(); ++f)
+    EXPECT_NEAR(std::abs(cm.field.direction(f, 2)), 1.0, 1e-6);
 }
 
 TEST(TrivialConnection, UnbalancedConesAreRefused) {
