@@ -9,7 +9,7 @@
 
 namespace mq {
 
-TriMesh weld_vertices(const TriMesh& mesh, int* merged) {
+TriMesh weld_vertices(const TriMesh& mesh, int* merged, std::vector<int>* source) {
   MQ_CHECK(mesh.V.allFinite(), InvalidInput, "weld_vertices: non-finite vertex position");
   const int nv = mesh.num_vertices();
   auto key = [&mesh](int v) {
@@ -29,6 +29,11 @@ TriMesh weld_vertices(const TriMesh& mesh, int* merged) {
   for (int v = 0; v < nv; ++v)
     if (representative[v] == v) new_index[v] = count++;
   if (merged) *merged = nv - count;
+  if (source) {
+    source->clear();
+    for (int v = 0; v < nv; ++v)
+      if (new_index[v] >= 0) source->push_back(v);
+  }
   if (count == nv) return mesh;
   TriMesh out;
   out.V.resize(count, 3);

@@ -3,6 +3,8 @@
 // which cuts a closed box into separate quads: patches could not grow across its edges.
 #pragma once
 
+#include <vector>
+
 #include "core/mesh/mesh.h"
 
 namespace mq {
@@ -12,7 +14,10 @@ namespace mq {
 // their first occurrence, normals (if any) are dropped when anything was merged. Unused vertices
 // are kept. O(#V log #V), deterministic.
 //   merged  optional output: how many vertices were removed
+//   source  optional output: per vertex of the result, the vertex of `mesh` it is (the group's
+//           first), so the result can follow `mesh` moved (a saved quilt re-embedded)
 // Preconditions: face indices lie in [0, #V). Throws InvalidInput for a non-finite position.
-TriMesh weld_vertices(const TriMesh& mesh, int* merged = nullptr);
+TriMesh weld_vertices(const TriMesh& mesh, int* merged = nullptr,
+                      std::vector<int>* source = nullptr);
 
 }  // namespace mq

@@ -1020,6 +1020,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   quilt.base = job.base;
   quilt.input_base = std::move(job.cleaned);
   quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
   quilt.elements = std::move(placed);
   stats.elements = static_cast<int>(quilt.elements.size());
   for (const SurfaceElement& e : quilt.elements) {

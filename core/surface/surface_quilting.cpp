@@ -416,7 +416,7 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   SurfaceJob job;
   // Exporters split vertices along hard edges; welded, a box's sides form one surface and
   // patches (and elements) can wrap around its edges.
-  job.cleaned = weld_vertices(base_in, &stats.welded_vertices);
+  job.cleaned = weld_vertices(base_in, &stats.welded_vertices, &job.input_vertex);
   std::vector<int> input_face;  // job.cleaned's faces -> base_in's
   job.cleaned = without_duplicate_faces(job.cleaned, input_face, &stats.duplicate_faces);
   // The shell grows along the normal: components turned inside out would hide the texture
@@ -459,6 +459,7 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
       for (int& f : proxy.origin_face) f = input_face[static_cast<size_t>(f)];
       input_face = std::move(proxy.origin_face);
       job.cleaned = std::move(proxy.mesh);
+      job.input_vertex.clear();
       stats.proxy_faces = job.cleaned.num_faces();
       stats.proxy_error = proxy.max_error;
     }
@@ -756,6 +757,7 @@ SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
   quilt.base = base;
   quilt.input_base = std::move(cleaned);
   quilt.refinement = std::move(refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
   {
     ScopedStageTimer timer(times, "post-processing");
     for (size_t id = 0; id < store.elements.size(); ++id)

@@ -47,6 +47,9 @@ struct SurfaceQuilt {
   TriMesh input_base;              // the base as given, coincident vertices welded (or its proxy)
   Refinement refinement;           // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
+  // #V(input_base): the vertex of the base as given each input_base vertex is (empty for a
+  // proxy, whose vertices are none of them): how a saved quilt follows the base moved.
+  std::vector<int> input_vertex;
 };
 
 // Local coordinates on the refined base expressed on the input base: refined faces are affine
@@ -164,10 +167,11 @@ struct SurfaceQuiltingStats {
 // vertices welded and refined, the guidance field on the refined faces (the smooth default when
 // none is given), the swatch scaled to its size on the surface.
 struct SurfaceJob {
-  TriMesh cleaned;        // the base as given, coincident vertices welded (or its proxy)
-  TriMesh base;           // cleaned, refined by longest-edge bisection
-  Refinement refinement;  // base faces in cleaned faces
-  MatrixX3d field;        // #F(base) by 3 unit tangents
+  TriMesh cleaned;                // the base as given, coincident vertices welded (or its proxy)
+  TriMesh base;                   // cleaned, refined by longest-edge bisection
+  Refinement refinement;          // base faces in cleaned faces
+  std::vector<int> input_vertex;  // #V(cleaned): its vertex in the base as given (empty: proxy)
+  MatrixX3d field;                // #F(base) by 3 unit tangents
   EdgeTopology topo;
   MatrixX3i TT;
   double swatch_scale = 0;  // factor applied to the swatch

@@ -1283,6 +1283,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   quilt.base = std::move(job.base);
   quilt.input_base = std::move(job.cleaned);
   quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
   stats.iterations = vs.stems;
   stats.counts.added = static_cast<int>(quilt.elements.size());
   stats.elements = static_cast<int>(quilt.elements.size());
