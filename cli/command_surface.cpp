@@ -8,6 +8,7 @@
 #include "cli/command_line.h"
 #include "cli/commands.h"
 #include "cli/json_writer.h"
+#include "cli/result_check.h"
 #include "cli/run_context.h"
 #include "cli/stats_json.h"
 #include "core/common/errors.h"
@@ -15,6 +16,7 @@
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/shell/quilt_embedding.h"
+#include "core/shell/saved_quilt.h"
 #include "core/shell/surface_coverage.h"
 #include "core/structure/texture_structure.h"
 #include "core/surface/global_quilting.h"
@@ -219,6 +221,10 @@ int run_surface(int argc, char** argv, int first) {
           "faces written), the vines' stems at their spacing, or for the patches a bound of "
           "whole swatch copies (up to 2x over); T is rough (4 us a face on 2 cores, plus 0.5 s); "
           "fits: within --max-faces and --max-memory");
+  cl.option("save-quilt", "FILE",
+            "also save the result in local coordinates over the base (elements, their kinds, "
+            "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
+            "again on the base moved (posed, animated) without a new synthesis");
   add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
@@ -232,6 +238,7 @@ int run_surface(int argc, char** argv, int first) {
   const WriteOptions write_options = output_options(cl);
   std::vector<std::string> outputs = output_files(out_path, write_options);
   outputs.push_back(cl.get("stats"));
+  outputs.push_back(cl.get("save-quilt"));
   check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
 
   SurfaceQuiltingOptions options;
@@ -285,6 +292,11 @@ int run_surface(int argc, char** argv, int first) {
              ": the swatch is flat (no thickness along its smallest side), and surface grows it "
              "in a shell as thick as the swatch; give it thickness, or use plane");
   }
+  // A proxy's vertices are none of the base's, so a quilt over one could not follow the base.
+  if (cl.has("save-quilt") && options.proxy_min_faces > 0 &&
+      base.num_faces() > options.proxy_min_faces)
+    throw UsageError("--save-quilt on a base of over " + std::to_string(options.proxy_min_faces) +
+                     " faces needs --no-proxy (a simplified proxy cannot follow the base)");
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));
@@ -348,44 +360,26 @@ int run_surface(int argc, char** argv, int first) {
            options.scale,
            " (is the swatch larger than the base?); "
            "nothing written");
-  MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
-           " elements placed were removed after embedding (",
-           embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
-           " intersecting others or themselves, ", embedding_stats.removed_below,
-           " inside the base; try a smaller --scale, or --keep-intersecting); nothing written");
   // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
-  // likely cause. Judged against what the swatch covers of its own footprint: a sparse swatch
-  // (vines) cannot cover more of the base than of itself.
+  // likely cause.
   const double own_coverage = swatch_coverage(swatch);
-  const double needed = min_coverage * own_coverage;
-  if (embedding_stats.coverage < needed) {
-    const QuiltEmbeddingStats& e = embedding_stats;
-    const int placed = static_cast<int>(quilt.elements.size());
-    const int removed = e.removed_intersecting + e.removed_self_intersecting + e.removed_below;
-    std::string cause;
-    if (removed > placed / 10)
-      cause = std::to_string(removed) + " of " + std::to_string(placed) +
-              " elements were removed (" +
-              std::to_string(e.removed_intersecting + e.removed_self_intersecting) +
-              " intersecting, " + std::to_string(e.removed_below) +
-              " inside the base: parts of it closer than the shell height?); try a smaller "
-              "--scale";
-    if (e.fallback_area_share > 0.5)
-      cause += std::string(cause.empty() ? "" : "; ") + "the shell map was not built over " +
-               std::to_string(static_cast<int>(std::lround(100 * e.fallback_area_share))) +
-               "% of the base (" + e.fallback_reason + ")";
-    if (cause.empty())
-      cause = std::to_string(placed) +
-              " elements leave the rest bare: the swatch may be too large for the base's parts "
-              "(try a smaller --scale)";
-    MQ_THROW(InvalidInput, "only ", 100 * e.coverage, "% of the base is covered, below ",
-             100 * needed, "% (--min-coverage ", min_coverage, " of the ", 100 * own_coverage,
-             "% the swatch covers of itself): ", cause, "; nothing written");
+  check_embedded_result(static_cast<int>(quilt.elements.size()), result, embedding_stats,
+                        min_coverage, own_coverage, "try a smaller --scale");
+  // The saved quilt: the output in prism coordinates over the base (issue 25).
+  SavedQuilt saved;
+  if (cl.has("save-quilt")) {
+    ScopedStageTimer timer(stats.times, "save quilt");
+    SavedQuiltHeader header;
+    header.base = fingerprint(base);
+    header.origin = "surface --swatch " + cl.get("swatch") + " --method " + method + " --scale " +
+                    cl.get("scale") + " --seed " + cl.get("seed");
+    saved = make_saved_quilt(quilt, result, header);
   }
   {
     ScopedStageTimer timer(stats.times, "write");
     ScopedStageProgress shown(run.progress(), "writing");
     write_output(out_path, result, write_options);
+    if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
   }
   run.progress()->finish();
   const double wall =

@@ -20,6 +20,7 @@ constexpr const char* kUsage =
     "commands:\n"
     "  plane    grow a swatch into a seamless L x W layer\n"
     "  surface  cover a base mesh with the swatch's geometry in a thin shell\n"
+    "  embed    place a saved quilt again on its base, moved (posed, animated)\n"
     "  swatch   generate a sample swatch (chainmail, chainmail-square, weave, apples, ivy)\n"
     "  info     print counts, bounding box and topology of a mesh file\n"
     "  render   render a mesh to a PNG preview\n"
@@ -35,7 +36,7 @@ struct Command {
 constexpr Command kCommands[] = {
     {"info", mq::cli::run_info},       {"swatch", mq::cli::run_swatch},
     {"render", mq::cli::run_render},   {"plane", mq::cli::run_plane},
-    {"surface", mq::cli::run_surface},
+    {"surface", mq::cli::run_surface}, {"embed", mq::cli::run_embed},
 };
 
 }  // namespace

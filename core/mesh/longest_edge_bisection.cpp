@@ -40,7 +40,6 @@ TriMesh bisect_longest_edges(const TriMesh& mesh, double max_edge, int max_faces
   std::vector<int> parent(F.size());
   std::vector<std::array<Vector3d, 3>> corners(F.size());
   std::unordered_map<Edge, std::vector<int>, EdgeHash> edge_faces;
-  std::vector<std::array<int, 2>> midpoints;
   for (size_t f = 0; f < F.size(); ++f) {
     const int fi = static_cast<int>(f);
     F[f] = {mesh.F(fi, 0), mesh.F(fi, 1), mesh.F(fi, 2)};
@@ -70,7 +69,6 @@ TriMesh bisect_longest_edges(const TriMesh& mesh, double max_edge, int max_faces
     edge_faces.erase(it);
     const int m = static_cast<int>(V.size());
     V.push_back(0.5 * (V[static_cast<size_t>(e.first)] + V[static_cast<size_t>(e.second)]));
-    midpoints.push_back({e.first, e.second});
     for (const int f : faces) {
       const auto fs = static_cast<size_t>(f);
       int k = 0;
@@ -108,27 +106,11 @@ TriMesh bisect_longest_edges(const TriMesh& mesh, double max_edge, int max_faces
     out.F.row(static_cast<Eigen::Index>(f)) << F[f][0], F[f][1], F[f][2];
   if (refinement) {
     refinement->parent = std::move(parent);
-    refinement->midpoints = std::move(midpoints);
     refinement->corners.resize(static_cast<Eigen::Index>(F.size()), 9);
     for (size_t f = 0; f < F.size(); ++f)
       for (int k = 0; k < 3; ++k)
         refinement->corners.block<1, 3>(static_cast<Eigen::Index>(f), 3 * Eigen::Index{k}) =
             corners[f][static_cast<size_t>(k)].transpose();
-  }
-  return out;
-}
-
-MatrixX3d refine_positions(const Refinement& refinement, const MatrixX3d& V, int refined_vertices) {
-  const auto added = static_cast<Eigen::Index>(refinement.midpoints.size());
-  MQ_CHECK(V.rows() + added == refined_vertices, InvalidInput, "refine_positions: ", V.rows(),
-           " vertices given for a refinement of ", refined_vertices - added);
-  MatrixX3d out(refined_vertices, 3);
-  out.topRows(V.rows()) = V;
-  for (Eigen::Index i = 0; i < added; ++i) {
-    const auto& [a, b] = refinement.midpoints[static_cast<size_t>(i)];
-    // The same expression as the bisection's, on Vector3d, so the bits agree.
-    const Vector3d m = 0.5 * (Vector3d(out.row(a).transpose()) + Vector3d(out.row(b).transpose()));
-    out.row(V.rows() + i) = m.transpose();
   }
   return out;
 }

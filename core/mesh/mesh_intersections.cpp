@@ -329,6 +329,18 @@ std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3
   return find_pairs(V, F, nullptr, false, false, &active);
 }
 
+std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
+                                                                  const MatrixX3i& F,
+                                                                  const std::vector<char>& active,
+                                                                  const std::vector<int>& label,
+                                                                  bool same_label) {
+  MQ_CHECK(static_cast<Eigen::Index>(active.size()) == F.rows() &&
+               static_cast<Eigen::Index>(label.size()) == F.rows(),
+           InvalidInput, "intersection test: ", active.size(), " active flags and ", label.size(),
+           " labels for ", F.rows(), " faces");
+  return find_pairs(V, F, &label, false, same_label, &active);
+}
+
 std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {
   MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");

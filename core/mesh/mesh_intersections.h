@@ -39,6 +39,15 @@ std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3
                                                                   const MatrixX3i& F,
                                                                   const std::vector<char>& active);
 
+// The same, for labelled faces (#F labels, e.g. the element of each face): only pairs of faces
+// of different labels (same_label false: elements meeting each other) or of one label (true:
+// an element through itself, beyond shared vertices and edges). Same order and throws.
+std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
+                                                                  const MatrixX3i& F,
+                                                                  const std::vector<char>& active,
+                                                                  const std::vector<int>& label,
+                                                                  bool same_label);
+
 // The vertex-connected components (elements, numbered as connected_components numbers them)
 // that intersect themselves: two of their faces overlap beyond a shared vertex or edge (a
 // fold, a tube pressed through itself). Ascending. Throws like intersecting_face_pairs.

@@ -9,8 +9,8 @@
 #include "core/common/errors.h"
 #include "core/common/fnv1a.h"
 #include "core/mesh/atomic_file.h"
+#include "core/mesh/geometry_measures.h"
 #include "core/mesh/input_file.h"
-#include "core/mesh/longest_edge_bisection.h"
 
 namespace mq {
 namespace {
@@ -48,12 +48,6 @@ class Writer {
   void put_rows(const MatrixX3d& X) {  // #rows known to the reader
     for (Eigen::Index r = 0; r < X.rows(); ++r)
       for (int k = 0; k < 3; ++k) put(X(r, k));
-  }
-  void put_local(const std::vector<int>& face, const MatrixX3d& bary,
-                 const Eigen::VectorXd& height) {
-    for (const int f : face) put(static_cast<std::int32_t>(f));
-    put_rows(bary);
-    for (Eigen::Index v = 0; v < height.size(); ++v) put(height(v));
   }
   std::string bytes;
 };
@@ -109,15 +103,6 @@ class Reader {
       for (int k = 0; k < 3; ++k) X(r, k) = get_finite(what);
     return X;
   }
-  void get_local(int n, int faces, std::vector<int>& face, MatrixX3d& bary,
-                 Eigen::VectorXd& height) {
-    need(static_cast<std::size_t>(n) * 36, "local coordinates");
-    face.resize(static_cast<std::size_t>(n));
-    for (int& f : face) f = get_index(faces, "base face");
-    bary = get_rows(n, "barycentric coordinate");
-    height.resize(n);
-    for (int v = 0; v < n; ++v) height(v) = get_finite("height");
-  }
   bool at_end() const { return at_ == bytes_.size(); }
   std::size_t position() const { return at_; }
 
@@ -159,58 +144,56 @@ BaseFingerprint fingerprint(const TriMesh& base) {
   return fp;
 }
 
-std::string serialize_saved_quilt(const SavedQuilt& saved) {
-  MQ_CHECK(little_endian(), InternalError, "saved quilts are written on little-endian machines");
-  const SurfaceQuilt& q = saved.quilt;
-  MQ_CHECK(static_cast<Eigen::Index>(q.input_vertex.size()) == q.input_base.V.rows() &&
-               !q.input_vertex.empty(),
+SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
+                            SavedQuiltHeader header, int* inexact) {
+  MQ_CHECK(static_cast<Eigen::Index>(quilt.input_vertex.size()) == quilt.input_base.V.rows() &&
+               !quilt.input_vertex.empty(),
            InvalidInput,
            "the quilt cannot be saved: its base was simplified to a proxy (a base of over "
            "200,000 faces), whose vertices do not follow the base's; use --no-proxy");
+  SavedQuilt saved;
+  header.shell_height = quilt.shell_height;
+  saved.header = std::move(header);
+  saved.input_vertex = quilt.input_vertex;
+  saved.base.V = quilt.input_base.V;
+  saved.base.F = quilt.input_base.F;
+  saved.output.V = output.V;
+  saved.output.F = output.F;
+  saved.output.kinds = output.kinds;
+  saved.output.face_kind = output.face_kind;
+  saved.coords =
+      locate_in_prisms(saved.base.V, saved.base.F, vertex_normals(saved.base.V, saved.base.F),
+                       quilt.shell_height, output.V, inexact);
+  return saved;
+}
+
+std::string serialize_saved_quilt(const SavedQuilt& saved) {
+  MQ_CHECK(little_endian(), InternalError, "saved quilts are written on little-endian machines");
+  const SavedQuiltHeader& h = saved.header;
   Writer w;
   w.bytes.append(kMagic, sizeof kMagic);
   w.put(kSavedQuiltVersion);
-  w.put(saved.base.vertices);
-  w.put(saved.base.faces);
-  w.put(saved.base.connectivity);
-  w.put(saved.min_coverage);
-  w.put(saved.swatch_coverage);
-  w.put_string(saved.origin);
-  const QuiltEmbeddingOptions& e = saved.embedding;
-  for (const bool b :
-       {e.shell_map, e.optimize_stretch, e.remove_intersecting, e.shrink_to_fit, e.separate_rings})
-    w.put(static_cast<std::uint8_t>(b));
-  w.put(static_cast<std::uint64_t>(e.seed));
-  w.put(q.shell_height);
-  w.put_count(static_cast<Eigen::Index>(q.kinds.size()));
-  for (const std::string& k : q.kinds) w.put_string(k);
-  // The welded base: its vertices as vertices of the base given, its faces.
-  w.put_count(static_cast<Eigen::Index>(q.input_vertex.size()));
-  for (const int v : q.input_vertex) w.put(static_cast<std::int32_t>(v));
-  w.put_faces(q.input_base.F);
-  // The refinement (core/mesh/longest_edge_bisection): parents, corners, midpoints in order.
-  w.put_count(static_cast<Eigen::Index>(q.refinement.parent.size()));
-  for (size_t f = 0; f < q.refinement.parent.size(); ++f) {
-    w.put(static_cast<std::int32_t>(q.refinement.parent[f]));
-    for (int k = 0; k < 9; ++k) w.put(q.refinement.corners(static_cast<Eigen::Index>(f), k));
-  }
-  w.put_count(static_cast<Eigen::Index>(q.refinement.midpoints.size()));
-  for (const auto& [a, b] : q.refinement.midpoints) {
-    w.put(static_cast<std::int32_t>(a));
-    w.put(static_cast<std::int32_t>(b));
-  }
-  w.put_count(q.base.V.rows());
-  w.put_faces(q.base.F);
-  w.put_count(static_cast<Eigen::Index>(q.elements.size()));
-  for (const SurfaceElement& el : q.elements) {
-    w.put(static_cast<std::int32_t>(el.kind));
-    w.put_count(static_cast<Eigen::Index>(el.face.size()));
-    w.put_faces(el.F);
-    w.put_local(el.face, el.barycentric, el.height);
-    w.put(static_cast<std::uint8_t>(el.flat.rows() > 0));
-    w.put_rows(el.flat);
-    w.put(static_cast<std::uint8_t>(!el.through_layout.face.empty()));
-    w.put_local(el.through_layout.face, el.through_layout.barycentric, el.through_layout.height);
+  w.put(h.base.vertices);
+  w.put(h.base.faces);
+  w.put(h.base.connectivity);
+  w.put(h.shell_height);
+  w.put_string(h.origin);
+  // The welded base: its vertices as vertices of the base given, at rest; its faces.
+  w.put_count(static_cast<Eigen::Index>(saved.input_vertex.size()));
+  for (const int v : saved.input_vertex) w.put(static_cast<std::int32_t>(v));
+  w.put_rows(saved.base.V);
+  w.put_faces(saved.base.F);
+  // The output at rest, its kinds, and each vertex's prism coordinates.
+  w.put_count(saved.output.V.rows());
+  w.put_rows(saved.output.V);
+  w.put_faces(saved.output.F);
+  w.put_count(static_cast<Eigen::Index>(saved.output.kinds.size()));
+  for (const std::string& k : saved.output.kinds) w.put_string(k);
+  w.put_count(static_cast<Eigen::Index>(saved.output.face_kind.size()));
+  for (const int k : saved.output.face_kind) w.put(static_cast<std::int32_t>(k));
+  for (int v = 0; v < saved.coords.size(); ++v) {
+    w.put(static_cast<std::int32_t>(saved.coords.face[static_cast<size_t>(v)]));
+    for (int k = 0; k < 3; ++k) w.put(saved.coords.bt(v, k));
   }
   w.put(checksum(w.bytes));
   return std::move(w.bytes);
@@ -235,79 +218,46 @@ SavedQuilt parse_saved_quilt(std::string_view bytes, const std::string& name) {
   in.get<std::uint64_t>();
   in.get<std::uint32_t>();
 
-  SavedQuilt s;
-  s.base.vertices = in.get<std::int64_t>();
-  s.base.faces = in.get<std::int64_t>();
-  s.base.connectivity = in.get<std::uint64_t>();
-  if (s.base.vertices < 3 || s.base.vertices > std::numeric_limits<int>::max() ||
-      s.base.faces < 1 || s.base.faces > std::numeric_limits<int>::max())
-    in.fail("base of ", s.base.vertices, " vertices and ", s.base.faces, " faces");
-  s.min_coverage = in.get_finite("coverage");
-  s.swatch_coverage = in.get_finite("coverage");
-  s.origin = in.get_string("origin");
-  QuiltEmbeddingOptions& e = s.embedding;
-  for (bool* b : {&e.shell_map, &e.optimize_stretch, &e.remove_intersecting, &e.shrink_to_fit,
-                  &e.separate_rings}) {
-    const auto v = in.get<std::uint8_t>();
-    if (v > 1) in.fail("an option flag of ", int{v});
-    *b = v == 1;
-  }
-  e.seed = in.get<std::uint64_t>();
-  SurfaceQuilt& q = s.quilt;
-  q.shell_height = in.get_finite("shell height");
-  if (!(q.shell_height > 0)) in.fail("shell height ", q.shell_height);
-  const int kinds = in.get_count(4, "kind names");
-  for (int k = 0; k < kinds; ++k) q.kinds.push_back(in.get_string("kind name"));
+  SavedQuilt saved;
+  SavedQuiltHeader& h = saved.header;
+  h.base.vertices = in.get<std::int64_t>();
+  h.base.faces = in.get<std::int64_t>();
+  h.base.connectivity = in.get<std::uint64_t>();
+  if (h.base.vertices < 3 || h.base.vertices > std::numeric_limits<int>::max() ||
+      h.base.faces < 1 || h.base.faces > std::numeric_limits<int>::max())
+    in.fail("a base of ", h.base.vertices, " vertices and ", h.base.faces, " faces");
+  h.shell_height = in.get_finite("shell height");
+  if (!(h.shell_height > 0)) in.fail("shell height ", h.shell_height);
+  h.origin = in.get_string("origin");
 
-  const int welded = in.get_count(4, "welded base vertices");
+  const int welded = in.get_count(28, "welded base vertices");
   if (welded < 3) in.fail("a welded base of ", welded, " vertices");
-  q.input_vertex.resize(static_cast<size_t>(welded));
-  for (int& v : q.input_vertex) v = in.get_index(static_cast<int>(s.base.vertices), "base vertex");
-  q.input_base.F = in.get_faces(welded, "welded base face");
-  const int input_faces = q.input_base.num_faces();
-  if (input_faces < 1 || input_faces > s.base.faces) in.fail(input_faces, " welded base faces");
+  saved.input_vertex.resize(static_cast<size_t>(welded));
+  for (int& v : saved.input_vertex)
+    v = in.get_index(static_cast<int>(h.base.vertices), "base vertex");
+  saved.base.V = in.get_rows(welded, "welded base position");
+  saved.base.F = in.get_faces(welded, "welded base face");
+  const int base_faces = saved.base.num_faces();
+  if (base_faces < 1 || base_faces > h.base.faces) in.fail(base_faces, " welded base faces");
 
-  Refinement& ref = q.refinement;
-  const int refined_faces = in.get_count(76, "refined faces");
-  ref.parent.resize(static_cast<size_t>(refined_faces));
-  ref.corners.resize(refined_faces, 9);
-  for (int f = 0; f < refined_faces; ++f) {
-    ref.parent[static_cast<size_t>(f)] = in.get_index(input_faces, "parent face");
-    for (int k = 0; k < 9; ++k) ref.corners(f, k) = in.get_finite("corner coordinate");
+  const int nv = in.get_count(24 + 16, "output vertices");
+  saved.output.V = in.get_rows(nv, "output position");
+  saved.output.F = in.get_faces(nv, "output face");
+  const int kinds = in.get_count(4, "kind names");
+  for (int k = 0; k < kinds; ++k) saved.output.kinds.push_back(in.get_string("kind name"));
+  const int face_kinds = in.get_count(4, "face kinds");
+  if (face_kinds != 0 && face_kinds != saved.output.num_faces())
+    in.fail(face_kinds, " face kinds for ", saved.output.num_faces(), " faces");
+  saved.output.face_kind.resize(static_cast<size_t>(face_kinds));
+  for (int& k : saved.output.face_kind) k = in.get_index(std::max(kinds, 1), "face kind");
+  saved.coords.face.resize(static_cast<size_t>(nv));
+  saved.coords.bt.resize(nv, 3);
+  for (int v = 0; v < nv; ++v) {
+    saved.coords.face[static_cast<size_t>(v)] = in.get_index(base_faces, "base face");
+    for (int k = 0; k < 3; ++k) saved.coords.bt(v, k) = in.get_finite("prism coordinate");
   }
-  const int added = in.get_count(8, "midpoints");
-  ref.midpoints.resize(static_cast<size_t>(added));
-  for (int i = 0; i < added; ++i)
-    for (int& v : ref.midpoints[static_cast<size_t>(i)])
-      v = in.get_index(welded + i, "midpoint end");
-  const int refined_vertices = in.get<std::int32_t>();
-  if (refined_vertices != welded + added)
-    in.fail(refined_vertices, " refined vertices for ", welded, " welded and ", added, " added");
-  q.base.F = in.get_faces(refined_vertices, "refined face");
-  const int base_faces = q.base.num_faces();
-  if (refined_faces != 0 ? refined_faces != base_faces : (added != 0 || q.base.F != q.input_base.F))
-    in.fail("the refinement does not match the refined base (", refined_faces, " and ", base_faces,
-            " faces)");
-
-  const int elements = in.get_count(14, "elements");
-  q.elements.resize(static_cast<size_t>(elements));
-  const int kind_end = std::max(kinds, 1);
-  for (SurfaceElement& el : q.elements) {
-    el.kind = in.get_index(kind_end, "element kind");
-    const int nv = in.get_count(36, "element vertices");
-    el.F = in.get_faces(nv, "element face");
-    in.get_local(nv, base_faces, el.face, el.barycentric, el.height);
-    const auto has_flat = in.get<std::uint8_t>();
-    if (has_flat > 1) in.fail("a flag of ", int{has_flat});
-    if (has_flat) el.flat = in.get_rows(nv, "flat shape");
-    const auto has_layout = in.get<std::uint8_t>();
-    if (has_layout > 1) in.fail("a flag of ", int{has_layout});
-    if (has_layout)
-      in.get_local(nv, base_faces, el.through_layout.face, el.through_layout.barycentric,
-                   el.through_layout.height);
-  }
-  if (!in.at_end()) in.fail("bytes after the last element");
-  return s;
+  if (!in.at_end()) in.fail("bytes after the last vertex");
+  return saved;
 }
 
 void write_saved_quilt(const std::string& path, const SavedQuilt& saved) {
@@ -318,8 +268,8 @@ SavedQuilt read_saved_quilt(const std::string& path) {
   return parse_saved_quilt(read_input_file(path, "saved quilt"), path);
 }
 
-void place_on_base(SurfaceQuilt& quilt, const BaseFingerprint& expected, const TriMesh& base) {
-  const BaseFingerprint got = fingerprint(base);
+MatrixX3d welded_positions(const SavedQuilt& saved, const TriMesh& base) {
+  const BaseFingerprint got = fingerprint(base), expected = saved.header.base;
   MQ_CHECK(got.vertices == expected.vertices && got.faces == expected.faces, InvalidInput,
            "the base has ", got.vertices, " vertices and ", got.faces,
            " faces; the quilt was made on one of ", expected.vertices, " and ", expected.faces,
@@ -328,13 +278,10 @@ void place_on_base(SurfaceQuilt& quilt, const BaseFingerprint& expected, const T
            "the base's faces are not those the quilt was made on (same counts, other "
            "connectivity); embed needs the same mesh, its vertices moved");
   MQ_CHECK(base.V.allFinite(), InvalidInput, "the base has a vertex position that is not finite");
-  MatrixX3d V(static_cast<Eigen::Index>(quilt.input_vertex.size()), 3);
-  for (size_t v = 0; v < quilt.input_vertex.size(); ++v)
-    V.row(static_cast<Eigen::Index>(v)) = base.V.row(quilt.input_vertex[v]);
-  const auto refined =
-      static_cast<int>(quilt.input_vertex.size() + quilt.refinement.midpoints.size());
-  quilt.base.V = refine_positions(quilt.refinement, V, refined);
-  quilt.input_base.V = std::move(V);
+  MatrixX3d V(static_cast<Eigen::Index>(saved.input_vertex.size()), 3);
+  for (size_t v = 0; v < saved.input_vertex.size(); ++v)
+    V.row(static_cast<Eigen::Index>(v)) = base.V.row(saved.input_vertex[v]);
+  return V;
 }
 
 }  // namespace mq

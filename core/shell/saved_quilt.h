@@ -1,16 +1,16 @@
 // A saved quilt (issue 25; paper section 3.2: the output is kept in local coordinates over the
-// base, so the base can be edited or animated without a new synthesis): a SurfaceQuilt with
-// everything but the base's positions, the embedding options of its run and a fingerprint of the
-// base's connectivity. `meshquilt surface --save-quilt` writes one, `meshquilt embed` places it
-// on the base, moved or not, and re-embedding on the unchanged base gives the synthesis's output
-// byte for byte. The format is documented in docs/saved-quilt.md.
+// base, so the base can be edited or animated without a new synthesis): the output of a run, each
+// vertex in prism coordinates over the welded base, with the welded base at rest and a
+// fingerprint of the base's connectivity. `meshquilt surface --save-quilt` writes one,
+// `meshquilt embed` (core/shell/follow_base) places it on the base moved; on the unchanged
+// base that gives the synthesis's output byte for byte.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <string_view>
 
-#include "core/shell/quilt_embedding.h"
+#include "core/shell/prism_coordinates.h"
 #include "core/surface/surface_quilting.h"
 
 namespace mq {
@@ -27,23 +27,34 @@ struct BaseFingerprint {
 // The fingerprint of a base as given (before welding: the file's own vertices and faces).
 BaseFingerprint fingerprint(const TriMesh& base);
 
-struct SavedQuilt {
-  // The quilt with empty positions: input_base.V and base.V have no rows until place_on_base.
-  SurfaceQuilt quilt;
-  QuiltEmbeddingOptions embedding;
+// What a saved quilt keeps beside the geometry.
+struct SavedQuiltHeader {
   BaseFingerprint base;
-  // The run's coverage check (cli: --min-coverage times what the swatch covers of itself).
-  double min_coverage = 0, swatch_coverage = 0;
-  std::string origin;  // what made it, for people: the swatch, method, scale
+  double shell_height = 0;  // H, in the base's units
+  std::string origin;       // what made it, for people: the swatch, method, scale
 };
+
+// The output of a synthesis in prism coordinates over its welded base.
+struct SavedQuilt {
+  SavedQuiltHeader header;
+  // #V(base): the vertex of the base as given each welded base vertex is.
+  std::vector<int> input_vertex;
+  TriMesh base;    // the welded base at rest (V, F)
+  TriMesh output;  // the output at rest (V, F, kinds, face_kind); its elements its components
+  PrismCoordinates coords;  // #V(output), over `base` with its vertex_normals
+};
+
+// The saved quilt of a synthesis: `output` is embed_quilt's result for `quilt`, located in the
+// prisms of quilt.input_base (locate_in_prisms; `inexact` counts the vertices it could not
+// place exactly). Throws InvalidInput for a proxy base (no input_vertex).
+SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
+                            SavedQuiltHeader header, int* inexact = nullptr);
 
 // Current version of the format (the file's 4 bytes after its magic).
 inline constexpr std::uint32_t kSavedQuiltVersion = 1;
 
 // The bytes of a saved quilt: a versioned little-endian binary ending in an FNV-1a 64 checksum
-// of all bytes before it. Positions of the bases are left out (see SavedQuilt::quilt).
-// Preconditions: the quilt's input_vertex is set (not a proxy base) and its arrays have
-// consistent sizes. Throws InvalidInput for a proxy base (no input_vertex).
+// of all bytes before it (layout: docs/saved-quilt.md).
 std::string serialize_saved_quilt(const SavedQuilt& saved);
 
 // Parses what serialize_saved_quilt wrote. `name` names the file in messages. Throws
@@ -57,11 +68,10 @@ SavedQuilt parse_saved_quilt(std::string_view bytes, const std::string& name);
 void write_saved_quilt(const std::string& path, const SavedQuilt& saved);
 SavedQuilt read_saved_quilt(const std::string& path);
 
-// Gives the quilt the positions of `base`, the base it was made on with its vertices moved or
-// not: its welded base from the base's vertices, its refined base by replaying the refinement's
-// midpoints (bit for bit the synthesis's positions on the unmoved base). Throws InvalidInput
-// when base's connectivity differs from `expected` ("the base has N vertices and M faces, the
-// quilt was made on ..." or "the base's faces differ") or a position is not finite.
-void place_on_base(SurfaceQuilt& quilt, const BaseFingerprint& expected, const TriMesh& base);
+// The welded base's positions for `base`, the base the quilt was made on with its vertices
+// moved or not. Throws InvalidInput when base's connectivity differs from the quilt's ("the base
+// has N vertices and M faces, the quilt was made on ..." or "the base's faces differ") or a
+// position is not finite.
+MatrixX3d welded_positions(const SavedQuilt& saved, const TriMesh& base);
 
 }  // namespace mq

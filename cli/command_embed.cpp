@@ -1,0 +1,232 @@
+// meshquilt embed: a saved quilt placed again on its base, moved (posed, sculpted, animated),
+// without a new synthesis (issue 25; paper section 3.2: the output lives in local coordinates
+// over the base, so only the shell map and the post-processing run again).
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli/command_line.h"
+#include "cli/commands.h"
+#include "cli/json_writer.h"
+#include "cli/run_context.h"
+#include "core/common/errors.h"
+#include "core/mesh/atomic_file.h"
+#include "core/mesh/mesh_io.h"
+#include "core/shell/follow_base.h"
+#include "core/shell/saved_quilt.h"
+
+namespace mq::cli {
+
+namespace {
+
+// A name with one printf-style frame number (%d or %0Nd; %% is a literal %).
+class FramePattern {
+ public:
+  FramePattern(const std::string& pattern, const char* option) : pattern_(pattern) {
+    int found = 0;
+    for (size_t i = 0; i < pattern.size(); ++i) {
+      if (pattern[i] != '%') continue;
+      if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
+        ++i;
+        continue;
+      }
+      size_t j = i + 1;
+      int width = 0;
+      while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9' && width < 100)
+        width = 10 * width + (pattern[j++] - '0');
+      if (j >= pattern.size() || pattern[j] != 'd')
+        throw UsageError(std::string(option) + " '" + pattern +
+                         "': a frame number is written %d or %0Nd (e.g. walk_%04d.obj)");
+      at_ = i;
+      end_ = j + 1;
+      width_ = width;
+      ++found;
+      i = j;
+    }
+    if (found != 1)
+      throw UsageError(std::string(option) + " '" + pattern +
+                       "' needs exactly one frame number (%d or %0Nd) with --frames");
+  }
+
+  std::string operator()(int frame) const {
+    std::string number = std::to_string(frame);
+    if (static_cast<int>(number.size()) < width_)
+      number.insert(0, static_cast<size_t>(width_) - number.size(), '0');
+    return unescape(pattern_.substr(0, at_)) + number + unescape(pattern_.substr(end_));
+  }
+
+ private:
+  static std::string unescape(const std::string& s) {
+    std::string out;
+    for (size_t i = 0; i < s.size(); ++i) {
+      out += s[i];
+      if (s[i] == '%' && i + 1 < s.size() && s[i + 1] == '%') ++i;
+    }
+    return out;
+  }
+  std::string pattern_;
+  size_t at_ = 0, end_ = 0;
+  int width_ = 0;
+};
+
+struct FrameResult {
+  int frame = 0;
+  std::string base, output;
+  FollowBaseStats stats;
+  double seconds = 0;
+};
+
+void write_stats(const std::string& path, const std::string& quilt_path,
+                 const SavedQuiltHeader& header, const std::vector<FrameResult>& frames,
+                 int threads, double wall) {
+  JsonWriter j;
+  j.begin_object()
+      .value("command", "embed")
+      .value("quilt", quilt_path)
+      .value("origin", header.origin)
+      .value("threads", threads)
+      .value("wall_seconds", wall)
+      .begin_array("frames");
+  for (const FrameResult& f : frames)
+    j.begin_object()
+        .value("frame", f.frame)
+        .value("base", f.base)
+        .value("output", f.output)
+        .value("seconds", f.seconds)
+        .value("elements", f.stats.elements)
+        .value("rigid", f.stats.rigid)
+        .value("following", f.stats.following)
+        .value("unmoved", f.stats.unmoved)
+        .value("unbent", f.stats.unbent)
+        .value("removed", f.stats.num_removed)
+        .value("largest_rigid_offset", f.stats.largest_rigid_offset)
+        .end_object();
+  j.end_array().end_object();
+  write_file_atomically(path, j.str());
+}
+
+}  // namespace
+
+int run_embed(int argc, char** argv, int first) {
+  CommandLine cl(
+      "embed", "--quilt FILE --base FILE -o OUT [options]",
+      "Places a quilt saved by 'meshquilt surface --save-quilt' on its base again, the same\n"
+      "mesh with its vertices moved (posed, sculpted, smoothed, animated), without a new\n"
+      "synthesis: every output vertex keeps its place in the shell over its base face\n"
+      "(face, barycentric coordinates, height along the normals), compact elements (rings,\n"
+      "leaves) move rigidly as that place moves (turned and carried by the surface, not\n"
+      "stretched), long ones (threads, stems) follow it vertex by vertex. On the unchanged\n"
+      "base the output is the synthesis's, byte for byte. A base of other connectivity is\n"
+      "refused.\n"
+      "\n"
+      "Sequences: with --frames A-B, --base and -o are patterns with one frame number (%d or\n"
+      "%0Nd) and each frame is written on its own, with the same faces and element order in\n"
+      "every frame (a mesh cache). A render farm hands each process a range:\n"
+      "  meshquilt embed --quilt q.mqq --base 'walk_%04d.obj' --frames 1-24 -o 'mail_%04d.ply'\n"
+      "Every frame's base is read and checked before the first is written; each output is\n"
+      "written whole or not at all, so a failed frame can be run again on its own.");
+  cl.option("quilt", "FILE", "a quilt saved by 'surface --save-quilt'");
+  cl.option("base", "FILE", "the base, its vertices moved (a pattern with --frames)");
+  cl.option("output", "FILE", "output mesh (.obj, .ply, .off, .glb; a pattern with --frames)");
+  cl.option("frames", "A-B", "embed frames A to B of the --base pattern, one output each");
+  cl.flag("keep-intersecting",
+          "keep elements as moved even where they press into a neighbour (by default a rigid "
+          "element that would follows the surface instead, and one that still does is removed, "
+          "in every frame of a sequence)");
+  cl.option("rigid-radius", "R",
+            "elements within R shell heights of their centre move rigidly; 0: all follow the "
+            "surface vertex by vertex",
+            "3");
+  add_output_options(cl);
+  add_run_options(cl);
+  if (!cl.parse(argc, argv, first)) return 0;
+  if (!cl.has("quilt")) throw UsageError("--quilt FILE is required");
+  if (!cl.has("base")) throw UsageError("--base FILE is required");
+  if (!cl.has("output")) throw UsageError("-o OUT is required");
+  const WriteOptions write_options = output_options(cl);
+  FollowBaseOptions follow;
+  follow.rigid_radius = cl.get_double("rigid-radius", 0, 0.0, 1e6);
+  follow.resolve_intersections = !cl.has("keep-intersecting");
+
+  // The frames: one (the base and output as given) or a range over two patterns.
+  std::vector<FrameResult> frames;
+  if (cl.has("frames")) {
+    const std::string range = cl.get("frames");
+    int a = 0, b = 0, used = 0;
+    if (std::sscanf(range.c_str(), "%d-%d%n", &a, &b, &used) != 2 ||
+        used != static_cast<int>(range.size()) || a < 0 || b < a || b - a >= 100000)
+      throw UsageError("--frames expects A-B with 0 <= A <= B (at most 100000 frames), got '" +
+                       range + "'");
+    const FramePattern base_name(cl.get("base"), "--base"), out_name(cl.get("output"), "-o");
+    for (int f = a; f <= b; ++f) frames.push_back({f, base_name(f), out_name(f), {}, 0});
+  } else {
+    frames.push_back({0, cl.get("base"), cl.get("output"), {}, 0});
+  }
+  std::vector<std::string> outputs, inputs{cl.get("quilt")};
+  for (const FrameResult& f : frames) {
+    mesh_format_from_path(f.output);
+    for (const std::string& file : output_files(f.output, write_options)) outputs.push_back(file);
+    inputs.push_back(f.base);
+  }
+  outputs.push_back(cl.get("stats"));
+  check_paths(outputs, inputs);
+
+  RunContext run(cl);
+  const auto start = std::chrono::steady_clock::now();
+  const SavedQuilt saved = read_saved_quilt(cl.get("quilt"));
+  const SavedQuiltHeader& header = saved.header;
+  // Every frame's base read and checked first: a missing or mismatched frame fails the run
+  // before anything is written.
+  if (frames.size() > 1)
+    for (const FrameResult& f : frames) try {
+        welded_positions(saved, read_mesh(f.base));
+      } catch (const InvalidInput& e) {
+        MQ_THROW(InvalidInput, f.base, ": ", e.what());
+      }
+  // A sequence removes in every frame what any frame removes (a mesh cache keeps its faces):
+  // a first pass finds them.
+  if (frames.size() > 1 && follow.resolve_intersections) {
+    std::vector<char> removed;
+    for (const FrameResult& f : frames) {
+      FollowBaseStats pass;
+      follow_base(saved, welded_positions(saved, read_mesh(f.base)), follow, &pass);
+      removed.resize(pass.removed.size(), 0);
+      for (size_t e = 0; e < removed.size(); ++e) removed[e] |= pass.removed[e];
+    }
+    follow.remove = std::move(removed);
+    follow.resolve_intersections = false;
+  }
+  for (FrameResult& f : frames) {
+    const auto frame_start = std::chrono::steady_clock::now();
+    MatrixX3d V;
+    try {
+      V = welded_positions(saved, read_mesh(f.base));
+    } catch (const InvalidInput& e) {
+      MQ_THROW(InvalidInput, f.base, ": ", e.what());
+    }
+    const TriMesh result = follow_base(saved, V, follow, &f.stats);
+    {
+      ScopedStageProgress shown(run.progress(), "writing");
+      write_output(f.output, result, write_options);
+    }
+    f.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+    if (!run.quiet())
+      std::printf(
+          "wrote %s: %d faces, %d vertices, %d elements (%d moved rigidly, %d following the "
+          "surface, %d unmoved; %d pressed into a neighbour made to follow the surface, %d "
+          "removed); %.2f s\n",
+          f.output.c_str(), result.num_faces(), result.num_vertices(),
+          f.stats.elements - f.stats.num_removed, f.stats.rigid, f.stats.following, f.stats.unmoved,
+          f.stats.unbent, f.stats.num_removed, f.seconds);
+  }
+  run.progress()->finish();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!run.stats_path().empty())
+    write_stats(run.stats_path(), cl.get("quilt"), header, frames, run.threads(), wall);
+  return 0;
+}
+
+}  // namespace mq::cli
