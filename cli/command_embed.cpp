@@ -99,6 +99,7 @@ void write_stats(const std::string& path, const std::string& quilt_path,
         .value("following", f.stats.following)
         .value("unmoved", f.stats.unmoved)
         .value("unbent", f.stats.unbent)
+        .value("shrunk", f.stats.shrunk)
         .value("removed", f.stats.num_removed)
         .value("largest_rigid_offset", f.stats.largest_rigid_offset)
         .end_object();
@@ -195,7 +196,6 @@ int run_embed(int argc, char** argv, int first) {
       for (size_t e = 0; e < removed.size(); ++e) removed[e] |= pass.removed[e];
     }
     follow.remove = std::move(removed);
-    follow.resolve_intersections = false;
   }
   for (FrameResult& f : frames) {
     const auto frame_start = std::chrono::steady_clock::now();
@@ -216,10 +216,10 @@ int run_embed(int argc, char** argv, int first) {
       std::printf(
           "wrote %s: %d faces, %d vertices, %d elements (%d moved rigidly, %d following the "
           "surface, %d unmoved; %d pressed into a neighbour made to follow the surface, %d "
-          "removed); %.2f s\n",
+          "shrunk, %d removed); %.2f s\n",
           f.output.c_str(), result.num_faces(), result.num_vertices(),
           f.stats.elements - f.stats.num_removed, f.stats.rigid, f.stats.following, f.stats.unmoved,
-          f.stats.unbent, f.stats.num_removed, f.seconds);
+          f.stats.unbent, f.stats.shrunk, f.stats.num_removed, f.seconds);
   }
   run.progress()->finish();
   const double wall =

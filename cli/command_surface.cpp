@@ -15,6 +15,7 @@
 #include "core/mesh/atomic_file.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
+#include "core/shell/follow_base.h"
 #include "core/shell/quilt_embedding.h"
 #include "core/shell/saved_quilt.h"
 #include "core/shell/surface_coverage.h"

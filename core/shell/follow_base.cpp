@@ -30,7 +30,154 @@ Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& covariance) {
   return svd.matrixV() * D * svd.matrixU().transpose();
 }
 
+// Intersection tests among the elements of `out` near a few active ones: the faces of the
+// active elements and of those whose boxes overlap theirs, not the whole output.
+class ElementPairs {
+ public:
+  ElementPairs(TriMesh& out, const std::vector<int>& face_component,
+               const std::vector<std::vector<int>>& faces, int elements)
+      : out_(out),
+        face_component_(face_component),
+        faces_(faces),
+        scaled_(static_cast<size_t>(elements), 0) {}
+
+  // Pairs (a < b) of elements, neither removed, at least one active, that intersect.
+  std::vector<std::pair<int, int>> intersecting(const std::vector<char>& active,
+                                                const std::vector<char>& removed) const {
+    std::vector<std::pair<int, int>> pairs;
+    for (const auto& [f, g] : face_pairs(active, removed, false)) {
+      const int a = face_component_[static_cast<size_t>(f)],
+                b = face_component_[static_cast<size_t>(g)];
+      pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    return pairs;
+  }
+
+  // Active elements folded through themselves.
+  std::vector<int> self_intersecting(const std::vector<char>& active) const {
+    std::vector<int> result;
+    const std::vector<char> none(active.size(), 0);
+    for (const auto& [f, g] : face_pairs(active, none, true))
+      result.push_back(face_component_[static_cast<size_t>(f)]);
+    std::sort(result.begin(), result.end());
+    result.erase(std::unique(result.begin(), result.end()), result.end());
+    return result;
+  }
+
+  // Element e as in `from`, scaled by s about its centroid.
+  void scale(int e, const MatrixX3d& from, double s) {
+    std::vector<int> vs = vertices(e);
+    Vector3d c = Vector3d::Zero();
+    for (const int v : vs) c += from.row(v).transpose();
+    c /= static_cast<double>(vs.size());
+    for (const int v : vs) out_.V.row(v) = (c + s * (from.row(v).transpose() - c)).transpose();
+    scaled_[static_cast<size_t>(e)] = 1;
+  }
+  bool was_scaled(int e) const { return scaled_[static_cast<size_t>(e)] != 0; }
+
+ private:
+  std::vector<int> vertices(int e) const {
+    std::vector<int> vs;
+    for (const int f : faces_[static_cast<size_t>(e)])
+      for (int k = 0; k < 3; ++k) vs.push_back(out_.F(f, k));
+    std::sort(vs.begin(), vs.end());
+    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+    return vs;
+  }
+
+  // Face pairs of the sub-mesh of active elements and their neighbours (boxes overlapping),
+  // in the output's face numbers.
+  std::vector<std::pair<int, int>> face_pairs(const std::vector<char>& active,
+                                              const std::vector<char>& removed,
+                                              bool same_element) const {
+    const int elements = static_cast<int>(faces_.size());
+    std::vector<Eigen::AlignedBox3d> box(static_cast<size_t>(elements));
+    std::vector<int> act;
+    for (int e = 0; e < elements; ++e) {
+      if (removed[static_cast<size_t>(e)]) continue;
+      for (const int f : faces_[static_cast<size_t>(e)])
+        for (int k = 0; k < 3; ++k)
+          box[static_cast<size_t>(e)].extend(Vector3d(out_.V.row(out_.F(f, k))));
+      if (active[static_cast<size_t>(e)]) act.push_back(e);
+    }
+    if (act.empty()) return {};
+    // Candidates: a sweep along x over the boxes, sorted by their lower x.
+    std::vector<int> order;
+    for (int e = 0; e < elements; ++e)
+      if (!removed[static_cast<size_t>(e)]) order.push_back(e);
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      return box[static_cast<size_t>(a)].min().x() < box[static_cast<size_t>(b)].min().x() ||
+             (box[static_cast<size_t>(a)].min().x() == box[static_cast<size_t>(b)].min().x() &&
+              a < b);
+    });
+    std::vector<char> take(static_cast<size_t>(elements), 0);
+    for (const int e : act) take[static_cast<size_t>(e)] = 1;
+    if (!same_element) {
+      std::vector<int> open;  // boxes whose x range still reaches the sweep
+      for (const int e : order) {
+        const auto& be = box[static_cast<size_t>(e)];
+        open.erase(std::remove_if(
+                       open.begin(), open.end(),
+                       [&](int o) { return box[static_cast<size_t>(o)].max().x() < be.min().x(); }),
+                   open.end());
+        for (const int o : open)
+          if ((active[static_cast<size_t>(o)] || active[static_cast<size_t>(e)]) &&
+              be.intersects(box[static_cast<size_t>(o)]))
+            take[static_cast<size_t>(o)] = take[static_cast<size_t>(e)] = 1;
+        open.push_back(e);
+      }
+    }
+    std::vector<int> sub_faces, label;
+    std::vector<char> sub_active;
+    for (int e = 0; e < elements; ++e)
+      if (take[static_cast<size_t>(e)])
+        for (const int f : faces_[static_cast<size_t>(e)]) {
+          sub_faces.push_back(f);
+          label.push_back(e);
+          sub_active.push_back(active[static_cast<size_t>(e)]);
+        }
+    MatrixX3i F(static_cast<Eigen::Index>(sub_faces.size()), 3);
+    for (size_t i = 0; i < sub_faces.size(); ++i)
+      F.row(static_cast<Eigen::Index>(i)) = out_.F.row(sub_faces[i]);
+    std::vector<std::pair<int, int>> result;
+    for (const auto& [f, g] :
+         intersecting_face_pairs_touching(out_.V, F, sub_active, label, same_element))
+      result.emplace_back(sub_faces[static_cast<size_t>(f)], sub_faces[static_cast<size_t>(g)]);
+    return result;
+  }
+
+  TriMesh& out_;
+  const std::vector<int>& face_component_;
+  const std::vector<std::vector<int>>& faces_;
+  std::vector<char> scaled_;
+};
+
 }  // namespace
+
+SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
+                            SavedQuiltHeader header, int* inexact) {
+  MQ_CHECK(static_cast<Eigen::Index>(quilt.input_vertex.size()) == quilt.input_base.V.rows() &&
+               !quilt.input_vertex.empty(),
+           InvalidInput,
+           "the quilt cannot be saved: its base was simplified to a proxy (a base of over "
+           "200,000 faces), whose vertices do not follow the base's; use --no-proxy");
+  SavedQuilt saved;
+  header.shell_height = quilt.shell_height;
+  saved.header = std::move(header);
+  saved.input_vertex = quilt.input_vertex;
+  saved.base.V = quilt.input_base.V;
+  saved.base.F = quilt.input_base.F;
+  saved.output.V = output.V;
+  saved.output.F = output.F;
+  saved.output.kinds = output.kinds;
+  saved.output.face_kind = output.face_kind;
+  saved.coords =
+      locate_in_prisms(saved.base.V, saved.base.F, vertex_normals(saved.base.V, saved.base.F),
+                       quilt.shell_height, output.V, inexact);
+  return saved;
+}
 
 TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBaseOptions& options,
                     FollowBaseStats* stats) {
@@ -104,38 +251,20 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
     offset[static_cast<size_t>(e)] = largest / H;
   });
   // Rigid elements pressed into a neighbour follow the surface instead; what still intersects
-  // goes (the later element of each pair, as the post-processing's removal).
+  // is shrunk about its centre, as the synthesis's post-processing does (95% down to 60%), and
+  // what even that does not free goes (the later element of each pair).
   std::vector<char> removed = options.remove;
   removed.resize(static_cast<size_t>(elements), 0);
-  int unbent = 0;
+  int unbent = 0, shrunk = 0;
   if (options.resolve_intersections) {
-    auto intersecting = [&](const std::vector<char>& element_active) {
-      std::vector<char> active(static_cast<size_t>(out.num_faces()), 0);
-      bool any = false;
-      for (int f = 0; f < out.num_faces(); ++f)
-        any |= (active[static_cast<size_t>(f)] =
-                    element_active[static_cast<size_t>(face_component[static_cast<size_t>(f)])]);
-      std::vector<std::pair<int, int>> pairs;
-      if (!any) return pairs;
-      for (const auto& [f, g] :
-           intersecting_face_pairs_touching(out.V, out.F, active, face_component, false)) {
-        const int a = face_component[static_cast<size_t>(f)],
-                  b = face_component[static_cast<size_t>(g)];
-        if (a != b && !removed[static_cast<size_t>(a)] && !removed[static_cast<size_t>(b)])
-          pairs.emplace_back(std::min(a, b), std::max(a, b));
-      }
-      std::sort(pairs.begin(), pairs.end());
-      pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-      return pairs;
-    };
-    // Only rigid elements that moved away from the surface's motion can newly touch another.
+    ElementPairs pairs_of(out, face_component, faces, elements);
     std::vector<char> active(static_cast<size_t>(elements), 0);
+    // Only rigid elements can newly touch another: following, the surface keeps their gaps.
     for (int e = 0; e < elements; ++e)
-      active[static_cast<size_t>(e)] = kind[static_cast<size_t>(e)] == 1 &&
-                                       offset[static_cast<size_t>(e)] > 0 &&
-                                       !removed[static_cast<size_t>(e)];
+      active[static_cast<size_t>(e)] =
+          kind[static_cast<size_t>(e)] == 1 && !removed[static_cast<size_t>(e)];
     std::vector<char> changed(static_cast<size_t>(elements), 0);
-    for (const auto& [a, b] : intersecting(active))
+    for (const auto& [a, b] : pairs_of.intersecting(active, removed))
       for (const int e : {a, b})
         if (kind[static_cast<size_t>(e)] == 1 && !changed[static_cast<size_t>(e)]) {
           changed[static_cast<size_t>(e)] = 1;
@@ -143,20 +272,26 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
           for (const int f : faces[static_cast<size_t>(e)])
             for (int k = 0; k < 3; ++k) out.V.row(out.F(f, k)) = Q.row(out.F(f, k));
         }
-    for (const auto& [a, b] : intersecting(changed)) {
-      if (removed[static_cast<size_t>(a)] || removed[static_cast<size_t>(b)]) continue;
-      removed[static_cast<size_t>(b)] = 1;
-    }
     // Following the surface can fold an element through itself where the surface creases
-    // (the synthesis removes such elements too).
-    std::vector<char> changed_faces(static_cast<size_t>(out.num_faces()), 0);
-    for (int f = 0; f < out.num_faces(); ++f)
-      changed_faces[static_cast<size_t>(f)] =
-          changed[static_cast<size_t>(face_component[static_cast<size_t>(f)])];
+    // (the synthesis removes such elements too; kept rigid and shrunk instead, more go).
     if (unbent > 0)
-      for (const auto& [f, g] :
-           intersecting_face_pairs_touching(out.V, out.F, changed_faces, face_component, true))
-        removed[static_cast<size_t>(face_component[static_cast<size_t>(f)])] = 1;
+      for (const int e : pairs_of.self_intersecting(changed)) removed[static_cast<size_t>(e)] = 1;
+    std::vector<std::pair<int, int>> pairs = pairs_of.intersecting(changed, removed);
+    const MatrixX3d unshrunk = out.V;
+    std::vector<char> pressed(static_cast<size_t>(elements), 0);
+    for (const double scale : {0.95, 0.9, 0.85, 0.8, 0.7, 0.6}) {
+      if (pairs.empty()) break;
+      std::fill(pressed.begin(), pressed.end(), 0);
+      for (const auto& [a, b] : pairs)
+        pressed[static_cast<size_t>(a)] = pressed[static_cast<size_t>(b)] = 1;
+      for (int e = 0; e < elements; ++e)
+        if (pressed[static_cast<size_t>(e)]) pairs_of.scale(e, unshrunk, scale);
+      pairs = pairs_of.intersecting(pressed, removed);
+    }
+    for (const auto& [a, b] : pairs)
+      if (!removed[static_cast<size_t>(a)]) removed[static_cast<size_t>(b)] = 1;
+    for (int e = 0; e < elements; ++e)
+      shrunk += !removed[static_cast<size_t>(e)] && pairs_of.was_scaled(e);
   }
   if (std::find(removed.begin(), removed.end(), 1) != removed.end()) {
     std::vector<int> keep;
@@ -167,6 +302,7 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
   if (stats) {
     *stats = FollowBaseStats{};
     stats->unbent = unbent;
+    stats->shrunk = shrunk;
     stats->removed = removed;
     stats->num_removed = static_cast<int>(std::count(removed.begin(), removed.end(), 1));
     stats->elements = elements;

@@ -9,16 +9,24 @@
 #include <vector>
 
 #include "core/shell/saved_quilt.h"
+#include "core/surface/surface_quilting.h"
 
 namespace mq {
+
+// The saved quilt of a synthesis: `output` is embed_quilt's result for `quilt`, located in the
+// prisms of quilt.input_base (locate_in_prisms; `inexact` counts the vertices it could not
+// place exactly). Throws InvalidInput for a proxy base (no input_vertex).
+SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
+                            SavedQuiltHeader header, int* inexact = nullptr);
 
 struct FollowBaseOptions {
   // An element whose vertices all lie within this many shell heights of its centroid is
   // compact: it moves rigidly. 0: every element follows the surface.
   double rigid_radius = 3.0;
   // Rigid elements that come to intersect another element (the surface shrinks under them:
-  // the inside of a bend) follow the surface instead; those still intersecting are removed, as
-  // the synthesis's post-processing removes them. false: keep every element as moved.
+  // the inside of a bend) follow the surface instead; those still intersecting are shrunk
+  // (95% to 60% of their size) or else removed, as the synthesis's post-processing does.
+  // false: keep every element as moved.
   bool resolve_intersections = true;
   // Elements removed whatever happens (#elements flags, or empty): a sequence removes the union
   // of what each frame removes, so every frame has the same faces.
@@ -33,6 +41,7 @@ struct FollowBaseStats {
   int following = 0;          // long elements that followed the surface
   int unmoved = 0;            // where the base did not move: kept bit for bit
   int unbent = 0;             // rigid elements that intersected another, made to follow the surface
+  int shrunk = 0;             // then still intersecting, kept at 60-95% of their size
   std::vector<char> removed;  // #elements: removed (intersecting after that, or asked to)
   int num_removed = 0;
   // Over the moved elements: the largest displacement, in shell heights, of a vertex from where

@@ -9,7 +9,6 @@
 #include "core/common/errors.h"
 #include "core/common/fnv1a.h"
 #include "core/mesh/atomic_file.h"
-#include "core/mesh/geometry_measures.h"
 #include "core/mesh/input_file.h"
 
 namespace mq {
@@ -142,29 +141,6 @@ BaseFingerprint fingerprint(const TriMesh& base) {
     }
   fp.connectivity = h;
   return fp;
-}
-
-SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
-                            SavedQuiltHeader header, int* inexact) {
-  MQ_CHECK(static_cast<Eigen::Index>(quilt.input_vertex.size()) == quilt.input_base.V.rows() &&
-               !quilt.input_vertex.empty(),
-           InvalidInput,
-           "the quilt cannot be saved: its base was simplified to a proxy (a base of over "
-           "200,000 faces), whose vertices do not follow the base's; use --no-proxy");
-  SavedQuilt saved;
-  header.shell_height = quilt.shell_height;
-  saved.header = std::move(header);
-  saved.input_vertex = quilt.input_vertex;
-  saved.base.V = quilt.input_base.V;
-  saved.base.F = quilt.input_base.F;
-  saved.output.V = output.V;
-  saved.output.F = output.F;
-  saved.output.kinds = output.kinds;
-  saved.output.face_kind = output.face_kind;
-  saved.coords =
-      locate_in_prisms(saved.base.V, saved.base.F, vertex_normals(saved.base.V, saved.base.F),
-                       quilt.shell_height, output.V, inexact);
-  return saved;
 }
 
 std::string serialize_saved_quilt(const SavedQuilt& saved) {

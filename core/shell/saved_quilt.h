@@ -9,9 +9,10 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "core/mesh/mesh.h"
 #include "core/shell/prism_coordinates.h"
-#include "core/surface/surface_quilting.h"
 
 namespace mq {
 
@@ -43,12 +44,6 @@ struct SavedQuilt {
   TriMesh output;  // the output at rest (V, F, kinds, face_kind); its elements its components
   PrismCoordinates coords;  // #V(output), over `base` with its vertex_normals
 };
-
-// The saved quilt of a synthesis: `output` is embed_quilt's result for `quilt`, located in the
-// prisms of quilt.input_base (locate_in_prisms; `inexact` counts the vertices it could not
-// place exactly). Throws InvalidInput for a proxy base (no input_vertex).
-SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
-                            SavedQuiltHeader header, int* inexact = nullptr);
 
 // Current version of the format (the file's 4 bytes after its magic).
 inline constexpr std::uint32_t kSavedQuiltVersion = 1;
