@@ -20,7 +20,8 @@ void check(const mq::SavedQuilt& q) {
   if (nf > 0 && (q.base.F.minCoeff() < 0 || q.base.F.maxCoeff() >= nb)) __builtin_trap();
   if (q.output.num_faces() > 0 && (q.output.F.minCoeff() < 0 || q.output.F.maxCoeff() >= nv))
     __builtin_trap();
-  if (q.coords.size() != nv || !q.coords.bt.allFinite() || !q.output.V.allFinite())
+  if (q.coords.size() != nv || !q.coords.bary.allFinite() || !q.coords.height.allFinite() ||
+      !q.output.V.allFinite())
     __builtin_trap();
   for (const int f : q.coords.face)
     if (f < 0 || f >= nf) __builtin_trap();

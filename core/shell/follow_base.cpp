@@ -214,10 +214,11 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
     bool moved = false;
     for (size_t i = 0; i < vs.size(); ++i) {
       const int v = vs[i];
-      const int f = saved.coords.face[static_cast<size_t>(v)];
-      const Vector3d bt = saved.coords.bt.row(v).transpose();
+      const int f = saved.coords.face(v);
+      const Vector3d b = saved.coords.bary.row(v).transpose();
+      const double h = saved.coords.height(v);
       const Vector3d d =
-          prism_point(V, F, N, H, f, bt) - prism_point(saved.base.V, F, N_rest, H, f, bt);
+          prism_point(V, F, N, f, b, h) - prism_point(saved.base.V, F, N_rest, f, b, h);
       moved = moved || (d.array() != 0.0).any();
       q[i] = P.row(v).transpose() + d;
       Q.row(v) = q[i].transpose();

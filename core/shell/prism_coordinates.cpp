@@ -10,25 +10,25 @@
 
 namespace mq {
 
-Vector3d prism_point(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N, double H, int face,
-                     const Vector3d& bt) {
-  const double b[3] = {bt(0), bt(1), 1.0 - bt(0) - bt(1)};
+Vector3d prism_point(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N, int face,
+                     const Vector3d& b, double h) {
   Vector3d p = Vector3d::Zero();
   for (int k = 0; k < 3; ++k) {
     const int v = F(face, k);
-    p += b[k] * (V.row(v).transpose() + (bt(2) * H) * N.row(v).transpose());
+    p += b(k) * (V.row(v).transpose() + h * N.row(v).transpose());
   }
   return p;
 }
 
-PrismCoordinates locate_in_prisms(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N,
+LocalCoordinates locate_in_prisms(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& N,
                                   double H, const MatrixX3d& P, int* inexact) {
   MQ_CHECK(F.rows() > 0, InvalidInput, "locate_in_prisms: empty base");
   MQ_CHECK(std::isfinite(H) && H > 0, InvalidInput, "locate_in_prisms: shell height ", H);
   const ClosestPointQuery query(V, F);
-  PrismCoordinates out;
-  out.face.assign(static_cast<size_t>(P.rows()), 0);
-  out.bt.resize(P.rows(), 3);
+  LocalCoordinates out;
+  out.face.resize(P.rows());
+  out.bary.resize(P.rows(), 3);
+  out.height.resize(P.rows());
   std::atomic<int> failed{0};
   tbb::parallel_for(Eigen::Index{0}, P.rows(), [&](Eigen::Index i) {
     const Vector3d p = P.row(i).transpose();
@@ -41,9 +41,13 @@ PrismCoordinates locate_in_prisms(const MatrixX3d& V, const MatrixX3i& F, const 
                    v2 = V.row(F(f, 2)).transpose();
     const Vector3d n0 = N.row(F(f, 0)).transpose(), n1 = N.row(F(f, 1)).transpose(),
                    n2 = N.row(F(f, 2)).transpose();
+    // x = (b0, b1, t): b2 = 1 - b0 - b1, the height t H.
+    auto point = [&](const Vector3d& y) {
+      return prism_point(V, F, N, f, Vector3d(y(0), y(1), 1.0 - y(0) - y(1)), y(2) * H);
+    };
     bool exact = false;
     for (int step = 0; step < 8; ++step) {
-      const Vector3d r = prism_point(V, F, N, H, f, x) - p;
+      const Vector3d r = point(x) - p;
       if (r.norm() <= 1e-9 * H) {
         exact = true;
         break;
@@ -57,13 +61,14 @@ PrismCoordinates locate_in_prisms(const MatrixX3d& V, const MatrixX3i& F, const 
       x -= lu.solve(r);
       if (!x.allFinite()) break;
     }
-    if (!exact) exact = x.allFinite() && (prism_point(V, F, N, H, f, x) - p).norm() <= 1e-9 * H;
+    if (!exact) exact = x.allFinite() && (point(x) - p).norm() <= 1e-9 * H;
     if (!exact) {
       x = start;
       failed.fetch_add(1, std::memory_order_relaxed);
     }
-    out.face[static_cast<size_t>(i)] = f;
-    out.bt.row(i) = x.transpose();
+    out.face(i) = f;
+    out.bary.row(i) << x(0), x(1), 1.0 - x(0) - x(1);
+    out.height(i) = x(2) * H;
   });
   if (inexact) *inexact = failed.load();
   return out;

@@ -168,8 +168,9 @@ std::string serialize_saved_quilt(const SavedQuilt& saved) {
   w.put_count(static_cast<Eigen::Index>(saved.output.face_kind.size()));
   for (const int k : saved.output.face_kind) w.put(static_cast<std::int32_t>(k));
   for (int v = 0; v < saved.coords.size(); ++v) {
-    w.put(static_cast<std::int32_t>(saved.coords.face[static_cast<size_t>(v)]));
-    for (int k = 0; k < 3; ++k) w.put(saved.coords.bt(v, k));
+    w.put(static_cast<std::int32_t>(saved.coords.face(v)));
+    for (int k = 0; k < 3; ++k) w.put(saved.coords.bary(v, k));
+    w.put(saved.coords.height(v));
   }
   w.put(checksum(w.bytes));
   return std::move(w.bytes);
@@ -216,7 +217,7 @@ SavedQuilt parse_saved_quilt(std::string_view bytes, const std::string& name) {
   const int base_faces = saved.base.num_faces();
   if (base_faces < 1 || base_faces > h.base.faces) in.fail(base_faces, " welded base faces");
 
-  const int nv = in.get_count(24 + 16, "output vertices");
+  const int nv = in.get_count(24 + 36, "output vertices");
   saved.output.V = in.get_rows(nv, "output position");
   saved.output.F = in.get_faces(nv, "output face");
   const int kinds = in.get_count(4, "kind names");
@@ -226,11 +227,13 @@ SavedQuilt parse_saved_quilt(std::string_view bytes, const std::string& name) {
     in.fail(face_kinds, " face kinds for ", saved.output.num_faces(), " faces");
   saved.output.face_kind.resize(static_cast<size_t>(face_kinds));
   for (int& k : saved.output.face_kind) k = in.get_index(std::max(kinds, 1), "face kind");
-  saved.coords.face.resize(static_cast<size_t>(nv));
-  saved.coords.bt.resize(nv, 3);
+  saved.coords.face.resize(nv);
+  saved.coords.bary.resize(nv, 3);
+  saved.coords.height.resize(nv);
   for (int v = 0; v < nv; ++v) {
-    saved.coords.face[static_cast<size_t>(v)] = in.get_index(base_faces, "base face");
-    for (int k = 0; k < 3; ++k) saved.coords.bt(v, k) = in.get_finite("prism coordinate");
+    saved.coords.face(v) = in.get_index(base_faces, "base face");
+    for (int k = 0; k < 3; ++k) saved.coords.bary(v, k) = in.get_finite("barycentric coordinate");
+    saved.coords.height(v) = in.get_finite("height");
   }
   if (!in.at_end()) in.fail("bytes after the last vertex");
   return saved;

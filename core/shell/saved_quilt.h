@@ -42,7 +42,7 @@ struct SavedQuilt {
   std::vector<int> input_vertex;
   TriMesh base;    // the welded base at rest (V, F)
   TriMesh output;  // the output at rest (V, F, kinds, face_kind); its elements its components
-  PrismCoordinates coords;  // #V(output), over `base` with its vertex_normals
+  LocalCoordinates coords;  // #V(output), in the prisms over `base` (prism_coordinates)
 };
 
 // Current version of the format (the file's 4 bytes after its magic).

@@ -5,22 +5,11 @@
 
 #include <Eigen/Core>
 
+#include "core/mesh/local_coordinates.h"
 #include "core/mesh/mesh.h"
 #include "core/shell/shell_map.h"
 
 namespace mq {
-
-// Local coordinates of #P points over a base mesh.
-//   face    #P base face ids
-//   bary    #P by 3 barycentric coordinates (b0, b1, b2) in face's corner order, >= 0, sum 1
-//   height  #P heights h above the base, 0 <= h <= H (the shell height)
-struct LocalCoordinates {
-  Eigen::VectorXi face;
-  MatrixX3d bary;
-  Eigen::VectorXd height;
-
-  int size() const { return static_cast<int>(face.size()); }
-};
 
 // Precomputed point location in the texture tets of a shell map: per texture tet its inverse
 // edge matrix, and per chart a uniform 2D grid over the (u, v) bounding boxes of its tets.

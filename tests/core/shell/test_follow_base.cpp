@@ -1,14 +1,13 @@
 // A saved quilt on its base moved (issue 25): prism coordinates locate and place points
 // exactly; on the unmoved base the output is kept bit for bit; compact elements move rigidly
 // with the surface, long ones follow it.
-#include "core/shell/follow_base.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "core/mesh/geometry_measures.h"
+#include "core/shell/follow_base.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -26,16 +25,16 @@ TEST(PrismCoordinates, PointsInTheShellAreLocatedExactly) {
     P.row(i) = (d.normalized() * (1.0 + test::uniform(rng, 0.0, H))).transpose();
   }
   int inexact = -1;
-  const PrismCoordinates c = locate_in_prisms(sphere.V, sphere.F, N, H, P, &inexact);
+  const LocalCoordinates c = locate_in_prisms(sphere.V, sphere.F, N, H, P, &inexact);
   EXPECT_EQ(inexact, 0);
   for (int i = 0; i < P.rows(); ++i) {
-    const Vector3d bt = c.bt.row(i).transpose();
-    EXPECT_LE((prism_point(sphere.V, sphere.F, N, H, c.face[static_cast<size_t>(i)], bt) -
-               P.row(i).transpose())
+    const Vector3d b = c.bary.row(i).transpose();
+    EXPECT_LE((prism_point(sphere.V, sphere.F, N, c.face(i), b, c.height(i)) - P.row(i).transpose())
                   .norm(),
               1e-9 * H);
-    EXPECT_GT(bt(2), -0.5);
-    EXPECT_LT(bt(2), 1.5);
+    EXPECT_NEAR(b.sum(), 1.0, 1e-12);
+    EXPECT_GT(c.height(i), -0.5 * H);
+    EXPECT_LT(c.height(i), 1.5 * H);
   }
 }
 

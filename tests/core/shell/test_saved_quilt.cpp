@@ -1,10 +1,9 @@
 // The saved-quilt format (issue 25): what is written reads back equal, and a truncated,
 // corrupted or mismatched file is refused in one line, never read into something unsafe.
-#include "core/shell/saved_quilt.h"
-
 #include <gtest/gtest.h>
 
 #include "core/common/errors.h"
+#include "core/shell/saved_quilt.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -24,15 +23,15 @@ SavedQuilt small_quilt() {
   q.output.F.resize(8, 3);
   for (int e = 0; e < 2; ++e) {
     const double x = 0.25 + 0.5 * e;
-    q.output.V.middleRows(4 * e, 4) << x, 0.5, 0.01, x + 0.1, 0.5, 0.01, x, 0.6, 0.01, x, 0.5,
-        0.08;
+    q.output.V.middleRows(4 * e, 4) << x, 0.5, 0.01, x + 0.1, 0.5, 0.01, x, 0.6, 0.01, x, 0.5, 0.08;
     q.output.F.middleRows(4 * e, 4) << 0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2;
     q.output.F.middleRows(4 * e, 4).array() += 4 * e;
   }
   q.output.kinds = {"ring", "leaf"};
   q.output.face_kind = {0, 0, 0, 0, 1, 1, 1, 1};
-  q.coords.face.assign(8, 4);
-  q.coords.bt = MatrixX3d::Constant(8, 3, 0.25);
+  q.coords.face = Eigen::VectorXi::Constant(8, 4);
+  q.coords.bary = MatrixX3d::Constant(8, 3, 1.0 / 3);
+  q.coords.height = Eigen::VectorXd::Constant(8, 0.02);
   return q;
 }
 
@@ -51,7 +50,8 @@ TEST(SavedQuilt, ReadsBackWhatWasWritten) {
   EXPECT_EQ(r.output.kinds, q.output.kinds);
   EXPECT_EQ(r.output.face_kind, q.output.face_kind);
   EXPECT_EQ(r.coords.face, q.coords.face);
-  EXPECT_EQ(r.coords.bt, q.coords.bt);
+  EXPECT_EQ(r.coords.bary, q.coords.bary);
+  EXPECT_EQ(r.coords.height, q.coords.height);
   EXPECT_EQ(serialize_saved_quilt(r), bytes);
 }
 
