@@ -10,5 +10,6 @@ int run_render(int argc, char** argv, int first);
 int run_plane(int argc, char** argv, int first);
 int run_surface(int argc, char** argv, int first);
 int run_embed(int argc, char** argv, int first);
+int run_edit(int argc, char** argv, int first);
 
 }  // namespace mq::cli

@@ -21,6 +21,7 @@ constexpr const char* kUsage =
     "  plane    grow a swatch into a seamless L x W layer\n"
     "  surface  cover a base mesh with the swatch's geometry in a thin shell\n"
     "  embed    place a saved quilt again on its base, moved (posed, animated)\n"
+    "  edit     remove elements of a saved quilt or give them materials\n"
     "  swatch   generate a sample swatch (chainmail, chainmail-square, weave, apples, ivy)\n"
     "  info     print counts, bounding box and topology of a mesh file\n"
     "  render   render a mesh to a PNG preview\n"
@@ -37,6 +38,7 @@ constexpr Command kCommands[] = {
     {"info", mq::cli::run_info},       {"swatch", mq::cli::run_swatch},
     {"render", mq::cli::run_render},   {"plane", mq::cli::run_plane},
     {"surface", mq::cli::run_surface}, {"embed", mq::cli::run_embed},
+    {"edit", mq::cli::run_edit},
 };
 
 }  // namespace

@@ -135,6 +135,17 @@ KindMaterial kind_material(const std::string& kind) {
   if (kind == "leaf") return {0.16, 0.42, 0.10, 0.0, 0.55};
   if (kind == "apple") return {0.70, 0.10, 0.08, 0.0, 0.45};
   if (kind == kDefaultKind) return m;
+  // color_RRGGBB: that colour (sRGB hex, given by `meshquilt edit --color`), stored linear.
+  if (kind.size() == 12 && kind.compare(0, 6, "color_") == 0 &&
+      kind.find_first_not_of("0123456789abcdefABCDEF", 6) == std::string::npos) {
+    double* channel[3] = {&m.r, &m.g, &m.b};
+    for (int c = 0; c < 3; ++c) {
+      const double srgb =
+          std::stoi(kind.substr(6 + 2 * static_cast<size_t>(c), 2), nullptr, 16) / 255.0;
+      *channel[c] = srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4);
+    }
+    return m;
+  }
   // A hue from the name at fixed saturation and value.
   std::uint64_t h = kFnv1aOffset;
   fnv1a(h, kind.data(), kind.size());

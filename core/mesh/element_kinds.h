@@ -62,8 +62,9 @@ ElementLabels element_labels(const TriMesh& mesh);
 
 // How a kind looks in the files that carry materials (OBJ .mtl, glTF): a base colour (linear
 // RGB in [0, 1]) and metal-roughness parameters. The sample kinds have fitting looks (steel
-// rings, two yarn shades, bark vine, green leaves, red apples); any other name gets a colour
-// from a hash of it, so the same name looks the same in every file.
+// rings, two yarn shades, bark vine, green leaves, red apples); a name color_RRGGBB (sRGB in
+// hexadecimal) that colour; any other name a colour from a hash of it, so the same name looks
+// the same in every file.
 struct KindMaterial {
   double r = 0.7, g = 0.7, b = 0.7;
   double metallic = 0;

@@ -10,6 +10,7 @@
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
+#include "core/shell/element_editing.h"
 
 namespace mq {
 
@@ -294,12 +295,8 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
     for (int e = 0; e < elements; ++e)
       shrunk += !removed[static_cast<size_t>(e)] && pairs_of.was_scaled(e);
   }
-  if (std::find(removed.begin(), removed.end(), 1) != removed.end()) {
-    std::vector<int> keep;
-    for (int f = 0; f < out.num_faces(); ++f)
-      if (!removed[static_cast<size_t>(face_component[static_cast<size_t>(f)])]) keep.push_back(f);
-    out = extract_faces(out, keep);  // kinds and face kinds carried
-  }
+  if (std::find(removed.begin(), removed.end(), 1) != removed.end())
+    out = without_elements(out, face_component, removed);
   if (stats) {
     *stats = FollowBaseStats{};
     stats->unbent = unbent;

@@ -10,6 +10,7 @@
 
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_topology.h"
 #include "tests/cli/cli_support.h"
 #include "tests/test_support.h"
 
@@ -85,13 +86,11 @@ TEST_F(CliEmbed, ABendingTubeIn24FramesKeepsItsFacesAndNothingIntersects) {
     EXPECT_TRUE(intersecting_face_pairs(m.V, m.F).empty()) << name;
     // Motion per frame: no more than the base's own plus the shell height.
     if (m.num_vertices() == previous.num_vertices()) {
-      const double base_motion =
-          (bent(tube_, 60.0 * k / 23).V - bent(tube_, 60.0 * (k - 1) / 23).V)
-              .rowwise()
-              .norm()
-              .maxCoeff();
-      EXPECT_LE((m.V - previous.V).rowwise().norm().maxCoeff(), base_motion + shell_height)
-          << name;
+      const double base_motion = (bent(tube_, 60.0 * k / 23).V - bent(tube_, 60.0 * (k - 1) / 23).V)
+                                     .rowwise()
+                                     .norm()
+                                     .maxCoeff();
+      EXPECT_LE((m.V - previous.V).rowwise().norm().maxCoeff(), base_motion + shell_height) << name;
     }
     previous = m;
   }
@@ -120,6 +119,32 @@ TEST_F(CliEmbed, BadQuiltsOtherBasesAndMissingFramesAreRefusedWritingNothing) {
   EXPECT_NE(r.err.find("f_2.obj"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ + "/o_0.ply"));
   r = meshquilt(dir_, "embed --quilt q.mqq --base 'f_.obj' --frames 0-2 -o 'o_%d.ply'");
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
+TEST_F(CliEmbed, EditedQuiltsLoseElementsAndTakeMaterials) {
+  CliRun r = meshquilt(dir_, "edit --quilt q.mqq -o fewer.mqq --ids 0,2-4 --remove");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("4 of "), std::string::npos) << r.out;
+  r = meshquilt(dir_, "edit --quilt fewer.mqq -o orange.mqq --sphere 1 0 1 0.5 --color ff8800");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = meshquilt(dir_, "embed --quilt orange.mqq --base tube.obj -o edited.obj --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const TriMesh rest = read_mesh(dir_ + "/rest.ply"), edited = read_mesh(dir_ + "/edited.obj");
+  std::vector<int> component;
+  EXPECT_EQ(connected_components(edited.F, edited.num_vertices(), component) + 4,
+            connected_components(rest.F, rest.num_vertices(), component));
+  EXPECT_NE(slurp(dir_ + "/edited.mtl").find("newmtl color_ff8800\nKd 1.0000 0.2462 0.0000"),
+            std::string::npos);
+  // Bad edits: one line, nothing written.
+  for (const std::string& bad : {std::string("--kind nothing --remove"),
+                                 std::string("--ids 100000 --remove"), std::string("--remove")}) {
+    r = meshquilt(dir_, "edit --quilt q.mqq -o bad.mqq " + bad);
+    EXPECT_EQ(r.status, 1) << bad;
+    EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad.mqq")) << bad;
+  }
+  r = meshquilt(dir_, "edit --quilt q.mqq -o bad.mqq --remove --material x");
   EXPECT_EQ(r.status, 2) << r.err;
 }
 
