@@ -589,14 +589,37 @@ class PlyValueSource {
   long long index_ = 0;
 };
 
-TriMesh read_ply(const std::string& path, const std::string& data) {
-  TextCursor c(path, data.data(), data.data() + data.size());
-  if (c.word() != "ply") c.fail("missing 'ply' magic");
-  c.skip_line();
+// A PLY header, up to end_header.
+struct PlyHeader {
   PlyEncoding encoding = PlyEncoding::Ascii;
-  bool have_format = false;
   std::vector<PlyElement> elements;
   std::vector<std::pair<long long, std::string>> kind_names;  // "comment kind K NAME" lines
+};
+
+// A "property" line after its keyword: a scalar or a list, of the last element.
+void read_ply_property(TextCursor& c, std::vector<PlyElement>& elements) {
+  if (elements.empty()) c.fail("property before any element");
+  PlyProperty prop;
+  std::string type = c.word();
+  if (type == "list") {
+    prop.is_list = true;
+    const std::string count_type = c.word();
+    if (!parse_ply_type(count_type, prop.count_type) || !ply_is_integer(prop.count_type))
+      c.fail("unsupported PLY list count type '" + count_type + "'");
+    type = c.word();
+  }
+  if (!parse_ply_type(type, prop.type)) c.fail("unsupported PLY property type '" + type + "'");
+  prop.name = c.word();
+  if (prop.name.empty()) c.fail("property without a name");
+  elements.back().properties.push_back(prop);
+}
+
+// The header's lines up to end_header; the cursor is left at the body.
+PlyHeader read_ply_header(TextCursor& c) {
+  if (c.word() != "ply") c.fail("missing 'ply' magic");
+  c.skip_line();
+  PlyHeader h;
+  bool have_format = false;
   for (;;) {
     if (c.eof()) c.fail("unexpected end of file in header (no end_header)");
     const std::string key = c.word();
@@ -606,11 +629,11 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
     } else if (key == "format") {
       const std::string f = c.word();
       if (f == "ascii")
-        encoding = PlyEncoding::Ascii;
+        h.encoding = PlyEncoding::Ascii;
       else if (f == "binary_little_endian")
-        encoding = PlyEncoding::BinaryLittle;
+        h.encoding = PlyEncoding::BinaryLittle;
       else if (f == "binary_big_endian")
-        encoding = PlyEncoding::BinaryBig;
+        h.encoding = PlyEncoding::BinaryBig;
       else
         c.fail("unsupported PLY format '" + f + "'");
       have_format = true;
@@ -621,46 +644,45 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
       e.count = c.read_int("element count");
       if (e.count < 0 || e.count > std::numeric_limits<int>::max())
         c.fail("invalid element count " + std::to_string(e.count));
-      elements.push_back(e);
+      h.elements.push_back(e);
     } else if (key == "property") {
-      if (elements.empty()) c.fail("property before any element");
-      PlyProperty prop;
-      std::string type = c.word();
-      if (type == "list") {
-        prop.is_list = true;
-        const std::string count_type = c.word();
-        if (!parse_ply_type(count_type, prop.count_type) || !ply_is_integer(prop.count_type))
-          c.fail("unsupported PLY list count type '" + count_type + "'");
-        type = c.word();
-      }
-      if (!parse_ply_type(type, prop.type)) c.fail("unsupported PLY property type '" + type + "'");
-      prop.name = c.word();
-      if (prop.name.empty()) c.fail("property without a name");
-      elements.back().properties.push_back(prop);
+      read_ply_property(c, h.elements);
     } else if (key == "comment") {
-      if (c.word() == "kind" && kind_names.size() < (1 << 16)) {
+      if (c.word() == "kind" && h.kind_names.size() < (1 << 16)) {
         c.skip_blanks();
         if (std::isdigit(static_cast<unsigned char>(c.peek()))) {
           const long long k = c.read_int("kind number");
-          kind_names.emplace_back(k, sanitized_kind(c.rest_of_line()));
+          h.kind_names.emplace_back(k, sanitized_kind(c.rest_of_line()));
         }
       }
     } else if (key != "obj_info" && !key.empty()) {
       c.fail("unexpected PLY header keyword '" + key + "'");
     }
-    if (key != "end_header") c.skip_line();
+    c.skip_line();
   }
   if (!have_format) c.fail("PLY header lacks a format line");
+  return h;
+}
 
-  // Locate the vertex coordinates, normals and face index list.
-  const PlyElement* vertex_el = nullptr;
-  const PlyElement* face_el = nullptr;
+// Where the mesh lies in a PLY file's elements: the (first) vertex and face elements, what
+// each vertex property holds, the kind property and the face index list.
+struct PlyLayout {
+  const PlyElement* vertex = nullptr;
+  const PlyElement* face = nullptr;
+  std::vector<int> vslot;  // per vertex property: 0..2 position, 3..5 normal, -1 skipped
+  bool has_normals = false;
+  int kind_prop = -1;   // the vertex property `kind`, or -1
+  int index_prop = -1;  // the face property vertex_indices (or vertex_index)
+};
+
+PlyLayout locate_ply_mesh(TextCursor& c, const std::vector<PlyElement>& elements) {
+  PlyLayout l;
   for (const auto& e : elements) {
-    if (e.name == "vertex" && !vertex_el) vertex_el = &e;
-    if (e.name == "face" && !face_el) face_el = &e;
+    if (e.name == "vertex" && !l.vertex) l.vertex = &e;
+    if (e.name == "face" && !l.face) l.face = &e;
   }
-  if (!vertex_el) c.fail("PLY header has no vertex element");
-  if (!face_el || face_el->count == 0) c.fail("no faces");
+  if (!l.vertex) c.fail("PLY header has no vertex element");
+  if (!l.face || l.face->count == 0) c.fail("no faces");
   auto find_scalar = [&](const PlyElement& e, const char* name) {
     for (size_t i = 0; i < e.properties.size(); ++i)
       if (e.properties[i].name == name) {
@@ -669,43 +691,44 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
       }
     return -1;
   };
-  // slot[i]: 0..2 position, 3..5 normal, -1 skipped
-  std::vector<int> vslot(vertex_el->properties.size(), -1);
+  l.vslot.assign(l.vertex->properties.size(), -1);
   const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
   int found[6];
-  for (int k = 0; k < 6; ++k) found[k] = find_scalar(*vertex_el, names[k]);
+  for (int k = 0; k < 6; ++k) found[k] = find_scalar(*l.vertex, names[k]);
   if (found[0] < 0 || found[1] < 0 || found[2] < 0)
     c.fail("PLY vertex element lacks an x, y or z property");
-  const bool has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
-  for (int k = 0; k < (has_normals ? 6 : 3); ++k) vslot[static_cast<size_t>(found[k])] = k;
+  l.has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
+  for (int k = 0; k < (l.has_normals ? 6 : 3); ++k) l.vslot[static_cast<size_t>(found[k])] = k;
   // Kinds (element_kinds.h): an integer vertex property `kind`; a face takes its first vertex's.
-  const int kind_prop = find_scalar(*vertex_el, "kind");
-  if (kind_prop >= 0 && !ply_is_integer(vertex_el->properties[static_cast<size_t>(kind_prop)].type))
+  l.kind_prop = find_scalar(*l.vertex, "kind");
+  if (l.kind_prop >= 0 && !ply_is_integer(l.vertex->properties[size_t(l.kind_prop)].type))
     c.fail("vertex property 'kind' is not an integer");
-  int index_prop = -1;
-  for (size_t i = 0; i < face_el->properties.size(); ++i) {
-    const PlyProperty& p = face_el->properties[i];
+  for (size_t i = 0; i < l.face->properties.size(); ++i) {
+    const PlyProperty& p = l.face->properties[i];
     if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
       if (!ply_is_integer(p.type)) c.fail("face index list has non-integer type");
-      index_prop = static_cast<int>(i);
+      l.index_prop = static_cast<int>(i);
       break;
     }
   }
-  if (index_prop < 0) c.fail("PLY face element lacks a vertex_indices list");
+  if (l.index_prop < 0) c.fail("PLY face element lacks a vertex_indices list");
+  return l;
+}
 
-  // Declared counts are checked against the bytes left before anything is allocated: every
-  // item takes at least its scalars' and list counts' sizes in binary, 2 bytes (a digit and a
-  // separator) per value in ASCII. An element with no properties takes no bytes at all: it is
-  // not iterated (its count is meaningless).
+// Declared counts are checked against the bytes left before anything is allocated: every
+// item takes at least its scalars' and list counts' sizes in binary, 2 bytes (a digit and a
+// separator) per value in ASCII. An element with no properties takes no bytes at all: it is
+// not iterated (its count is meaningless).
+void check_ply_counts(TextCursor& c, const PlyHeader& h, const PlyLayout& l) {
+  const bool ascii = h.encoding == PlyEncoding::Ascii;
   long long needed = 0;
-  for (const PlyElement& e : elements) {
+  for (const PlyElement& e : h.elements) {
     long long per_item = 0;
     for (const PlyProperty& p : e.properties)
-      per_item += encoding == PlyEncoding::Ascii ? 2 : ply_size(p.is_list ? p.count_type : p.type);
-    if (&e == face_el && per_item > 0)  // at least 3 indices per face
-      per_item += 3 * (encoding == PlyEncoding::Ascii
-                           ? 2
-                           : ply_size(face_el->properties[static_cast<size_t>(index_prop)].type));
+      per_item += ascii ? 2 : ply_size(p.is_list ? p.count_type : p.type);
+    if (&e == l.face && per_item > 0)  // at least 3 indices per face
+      per_item +=
+          3 * (ascii ? 2 : ply_size(l.face->properties[static_cast<size_t>(l.index_prop)].type));
     needed += per_item * e.count;  // <= 2^31 * (8 + 24) * #properties: no overflow
     // Small counts go on to the parse, whose messages say where the data end.
     if (e.count > (1 << 16) && needed > c.remaining() + 1)
@@ -713,76 +736,112 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
              " needs more data than the file's " + std::to_string(c.remaining()) +
              " remaining bytes");
   }
+}
 
-  const long long nv = vertex_el->count;
-  std::vector<double> V(static_cast<size_t>(3 * nv)), N;
-  std::vector<int> vertex_kind(kind_prop >= 0 ? static_cast<size_t>(nv) : 0);
-  if (has_normals) N.resize(static_cast<size_t>(3 * nv));
+// What a PLY body holds of the mesh: positions, normals, vertex kinds (#V each, when present)
+// and the faces, polygons fanned into triangles.
+struct PlyBody {
+  std::vector<double> V, N;
+  std::vector<int> vertex_kind;
   std::vector<int> F;
-  F.reserve(static_cast<size_t>(3 * face_el->count));
-  std::vector<int> poly;
+  std::vector<int> poly;  // scratch: the face being read
+};
 
-  const bool swap = encoding != PlyEncoding::Ascii &&
-                    (encoding == PlyEncoding::BinaryLittle) != host_is_little_endian();
-  PlyBinaryReader binary(path, c.pos(), data.data() + data.size(), swap);
-  for (const PlyElement& e : elements) {
-    PlyValueSource src(&c, encoding == PlyEncoding::Ascii ? nullptr : &binary, &e.name);
-    const bool is_vertex = &e == vertex_el, is_face = &e == face_el;
-    if (e.properties.empty()) continue;  // no bytes to read
-    for (long long i = 0; i < e.count; ++i) {
-      src.begin_item(i);
-      for (size_t pi = 0; pi < e.properties.size(); ++pi) {
-        const PlyProperty& p = e.properties[pi];
-        if (is_vertex && vslot[pi] >= 0) {
-          const int k = vslot[pi];
-          const double v = src.read_double(p.type, k < 3 ? "vertex coordinate" : "normal");
-          (k < 3 ? V : N)[static_cast<size_t>(3 * i + k % 3)] = v;
-        } else if (is_vertex && static_cast<int>(pi) == kind_prop) {
-          const long long k = src.read_integer(p.type, "kind");
-          if (k < 0 || k >= (1 << 16)) src.fail("kind " + std::to_string(k) + " out of range");
-          vertex_kind[static_cast<size_t>(i)] = static_cast<int>(k);
-        } else if (is_face && static_cast<int>(pi) == index_prop) {
-          const long long n = src.read_integer(p.count_type, "face vertex count");
-          if (n < 3) src.fail("face with " + std::to_string(n) + " vertices (need at least 3)");
-          poly.clear();
-          for (long long j = 0; j < n; ++j) {
-            const long long v = src.read_integer(p.type, "vertex index");
-            if (v < 0 || v >= nv)
-              src.fail("vertex index " + std::to_string(v) + " out of range (" +
-                       std::to_string(nv) + " vertices)");
-            poly.push_back(static_cast<int>(v));
-          }
-          for (size_t j = 1; j + 1 < poly.size(); ++j) {
-            F.push_back(poly[0]);
-            F.push_back(poly[j]);
-            F.push_back(poly[j + 1]);
-          }
-        } else if (p.is_list) {
-          const long long n = src.read_integer(p.count_type, "list count");
-          if (n < 0) src.fail("negative list count");
-          src.skip(p.type, n);
-        } else {
-          src.skip(p.type);
-        }
-      }
+// One face's index list, fanned into triangles.
+void read_ply_face(PlyValueSource& src, const PlyProperty& p, long long nv, PlyBody& body) {
+  const long long n = src.read_integer(p.count_type, "face vertex count");
+  if (n < 3) src.fail("face with " + std::to_string(n) + " vertices (need at least 3)");
+  std::vector<int>& poly = body.poly;
+  poly.clear();
+  for (long long j = 0; j < n; ++j) {
+    const long long v = src.read_integer(p.type, "vertex index");
+    if (v < 0 || v >= nv)
+      src.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) +
+               " vertices)");
+    poly.push_back(static_cast<int>(v));
+  }
+  for (size_t j = 1; j + 1 < poly.size(); ++j) {
+    body.F.push_back(poly[0]);
+    body.F.push_back(poly[j]);
+    body.F.push_back(poly[j + 1]);
+  }
+}
+
+// Item i of element e: the values the mesh needs into `body`, the others skipped.
+void read_ply_item(PlyValueSource& src, const PlyElement& e, long long i, const PlyLayout& l,
+                   PlyBody& body) {
+  const bool is_vertex = &e == l.vertex, is_face = &e == l.face;
+  src.begin_item(i);
+  for (size_t pi = 0; pi < e.properties.size(); ++pi) {
+    const PlyProperty& p = e.properties[pi];
+    if (is_vertex && l.vslot[pi] >= 0) {
+      const int k = l.vslot[pi];
+      const double v = src.read_double(p.type, k < 3 ? "vertex coordinate" : "normal");
+      (k < 3 ? body.V : body.N)[static_cast<size_t>(3 * i + k % 3)] = v;
+    } else if (is_vertex && static_cast<int>(pi) == l.kind_prop) {
+      const long long k = src.read_integer(p.type, "kind");
+      if (k < 0 || k >= (1 << 16)) src.fail("kind " + std::to_string(k) + " out of range");
+      body.vertex_kind[static_cast<size_t>(i)] = static_cast<int>(k);
+    } else if (is_face && static_cast<int>(pi) == l.index_prop) {
+      read_ply_face(src, p, l.vertex->count, body);
+    } else if (p.is_list) {
+      const long long n = src.read_integer(p.count_type, "list count");
+      if (n < 0) src.fail("negative list count");
+      src.skip(p.type, n);
+    } else {
+      src.skip(p.type);
     }
   }
-  TriMesh m = make_mesh(V, F);
-  if (has_normals) m.N = Eigen::Map<const MatrixX3d>(N.data(), m.V.rows(), 3);
-  if (kind_prop >= 0) {
-    int top = 0;
-    for (const int k : vertex_kind) top = std::max(top, k);
-    m.kinds.resize(static_cast<size_t>(top) + 1);
-    for (const auto& [k, name] : kind_names)
-      if (k <= top) m.kinds[static_cast<size_t>(k)] = name;
-    for (size_t k = 0; k < m.kinds.size(); ++k)
-      if (m.kinds[k].empty()) m.kinds[k] = "kind_" + std::to_string(k);
-    m.face_kind.resize(static_cast<size_t>(m.F.rows()));
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-      m.face_kind[static_cast<size_t>(f)] = vertex_kind[static_cast<size_t>(m.F(f, 0))];
-    remove_unused_kinds(m);
+}
+
+// Every element's items in file order, in either encoding.
+PlyBody read_ply_body(TextCursor& c, const PlyHeader& h, const PlyLayout& l,
+                      const std::string& path, const std::string& data) {
+  const long long nv = l.vertex->count;
+  PlyBody body;
+  body.V.resize(static_cast<size_t>(3 * nv));
+  body.vertex_kind.resize(l.kind_prop >= 0 ? static_cast<size_t>(nv) : 0);
+  if (l.has_normals) body.N.resize(static_cast<size_t>(3 * nv));
+  body.F.reserve(static_cast<size_t>(3 * l.face->count));
+  const bool swap = h.encoding != PlyEncoding::Ascii &&
+                    (h.encoding == PlyEncoding::BinaryLittle) != host_is_little_endian();
+  PlyBinaryReader binary(path, c.pos(), data.data() + data.size(), swap);
+  for (const PlyElement& e : h.elements) {
+    PlyValueSource src(&c, h.encoding == PlyEncoding::Ascii ? nullptr : &binary, &e.name);
+    if (e.properties.empty()) continue;  // no bytes to read
+    for (long long i = 0; i < e.count; ++i) read_ply_item(src, e, i, l, body);
   }
+  return body;
+}
+
+// The mesh of a PLY body; with vertex kinds, each face takes its first vertex's, named by the
+// header's "comment kind" lines (kind_K where none names it).
+TriMesh ply_mesh(const PlyBody& body, const PlyLayout& l,
+                 const std::vector<std::pair<long long, std::string>>& kind_names) {
+  TriMesh m = make_mesh(body.V, body.F);
+  if (l.has_normals) m.N = Eigen::Map<const MatrixX3d>(body.N.data(), m.V.rows(), 3);
+  if (l.kind_prop < 0) return m;
+  int top = 0;
+  for (const int k : body.vertex_kind) top = std::max(top, k);
+  m.kinds.resize(static_cast<size_t>(top) + 1);
+  for (const auto& [k, name] : kind_names)
+    if (k <= top) m.kinds[static_cast<size_t>(k)] = name;
+  for (size_t k = 0; k < m.kinds.size(); ++k)
+    if (m.kinds[k].empty()) m.kinds[k] = "kind_" + std::to_string(k);
+  m.face_kind.resize(static_cast<size_t>(m.F.rows()));
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    m.face_kind[static_cast<size_t>(f)] = body.vertex_kind[static_cast<size_t>(m.F(f, 0))];
+  remove_unused_kinds(m);
   return m;
+}
+
+TriMesh read_ply(const std::string& path, const std::string& data) {
+  TextCursor c(path, data.data(), data.data() + data.size());
+  const PlyHeader header = read_ply_header(c);
+  const PlyLayout layout = locate_ply_mesh(c, header.elements);
+  check_ply_counts(c, header, layout);
+  const PlyBody body = read_ply_body(c, header, layout, path, data);
+  return ply_mesh(body, layout, header.kind_names);
 }
 
 // ---------------------------------------------------------------------------------------------
