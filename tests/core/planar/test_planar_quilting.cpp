@@ -290,5 +290,17 @@ TEST(PlanarQuilting, PatchOptionsOutOfRangeAreRefused) {
   EXPECT_THROW(o.validate(), InvalidInput);
 }
 
+TEST(PlanarQuilting, OptionsOutOfRangeAreRefused) {
+  PlanarQuiltingOptions o;
+  EXPECT_THROW(o.validate(), InvalidInput);  // no size
+  o.length = o.width = 4;
+  EXPECT_NO_THROW(o.validate());
+  o.cell_size = -1;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o.cell_size = 0;
+  o.subpatch_fraction = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
+}
+
 }  // namespace
 }  // namespace mq
