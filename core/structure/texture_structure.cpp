@@ -824,6 +824,158 @@ int common_count(const std::vector<int>& histogram, int rings) {
 
 }  // namespace
 
+namespace {
+
+// What a swatch kind's elements gather before their medians: the link counts of its rings
+// that are not degenerate, their folds and the elements' principal extents.
+struct KindSamples {
+  std::vector<int> histogram;
+  std::vector<double> folds;
+  std::array<std::vector<double>, 3> extents;
+};
+
+// Adds one swatch element (its figures e and its mesh part) to its kind: counts, samples and,
+// unless a similarity takes one of the kind's shapes of as many vertices onto it, a new shape
+// (the rings of a sheet are one shape; apples of varied sizes and squash are many).
+void add_to_kind(const ElementStructure& e, const TriMesh& part, SwatchKind& kind,
+                 KindSamples& samples) {
+  ++kind.elements;
+  kind.rings += e.ring_shaped ? 1 : 0;
+  kind.long_elements += e.long_element ? 1 : 0;
+  if (e.ring && !e.degenerate()) {
+    if (samples.histogram.size() <= static_cast<size_t>(e.links))
+      samples.histogram.resize(static_cast<size_t>(e.links) + 1, 0);
+    ++samples.histogram[static_cast<size_t>(e.links)];
+  }
+  if (e.ring_shaped) samples.folds.push_back(e.fold);
+  Vector3d s;
+  Eigen::Matrix3d axes;
+  principal_extents(part.V, s, &axes);
+  for (int a = 0; a < 3; ++a) samples.extents[a].push_back(s(a));
+  const MatrixX3d centred = part.V.rowwise() - part.V.colwise().mean();
+  int same_count = 0;
+  bool known = false;
+  for (const SwatchKind::Shape& shape : kind.shapes) {
+    if (shape.V.rows() != centred.rows()) continue;
+    ++same_count;
+    if (similarity_residual(shape.V, centred) < 1e-8) {
+      known = true;
+      break;
+    }
+  }
+  if (!known && same_count < 16) kind.shapes.push_back({centred, axes.leftCols<2>()});
+}
+
+// Per kind: ring-ness, link count, fold, extents and the distinct shapes of its elements.
+std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport& r) {
+  std::vector<int> fc;
+  const int ne = connected_components(mesh.F, mesh.num_vertices(), fc);
+  const std::vector<std::vector<int>> groups = component_faces(fc, ne);
+  std::vector<SwatchKind> kinds(r.kinds.size());
+  std::vector<KindSamples> samples(r.kinds.size());
+  for (size_t k = 0; k < r.kinds.size(); ++k) kinds[k].name = r.kinds[k];
+  for (int c = 0; c < ne; ++c) {
+    const ElementStructure& e = r.elements[static_cast<size_t>(c)];
+    const size_t k = static_cast<size_t>(e.kind);
+    add_to_kind(e, extract_faces(mesh, groups[static_cast<size_t>(c)]), kinds[k], samples[k]);
+  }
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    SwatchKind& kind = kinds[k];
+    kind.ring = 2 * kind.rings > kind.elements;
+    kind.compact = 2 * kind.long_elements <= kind.elements;
+    int judged = 0;
+    for (const int h : samples[k].histogram) judged += h;
+    if (kind.ring) kind.interior_links = common_count(samples[k].histogram, judged);
+    kind.fold = median(samples[k].folds);
+    for (int a = 0; a < 3; ++a) kind.extents(a) = median(samples[k].extents[a]);
+  }
+  return kinds;
+}
+
+// The element centres in the swatch plane (z is the thickness axis after prepare_swatch), with
+// their box and each one's neighbours within four spacings (they bound every cell that closes
+// at all in a sheet).
+class SwatchCentres {
+ public:
+  explicit SwatchCentres(const StructureReport& r)
+      : n_(static_cast<int>(r.elements.size())),
+        c_(static_cast<size_t>(n_)),
+        radius_(4 * (r.median_spacing > 0 ? r.median_spacing : r.median_size)),
+        grid_(std::max(radius_, 1e-12)) {
+    lo_ = Vector2d::Constant(std::numeric_limits<double>::infinity());
+    hi_ = -lo_;
+    for (int i = 0; i < n_; ++i) {
+      c_[i] = r.elements[i].centre.head<2>();
+      lo_ = lo_.cwiseMin(c_[i]);
+      hi_ = hi_.cwiseMax(c_[i]);
+    }
+    for (int i = 0; i < n_; ++i)
+      grid_.insert_box(i, Vector3d(c_[i].x(), c_[i].y(), 0), Vector3d(c_[i].x(), c_[i].y(), 0));
+  }
+  std::vector<int> near(int i) const {
+    const Vector3d p(c_[i].x(), c_[i].y(), 0), d(radius_, radius_, 0);
+    std::vector<int> ids;
+    for (const int j : grid_.query_box(p - d, p + d))
+      if (j != i && (c_[j] - c_[i]).norm() <= radius_) ids.push_back(j);
+    return ids;
+  }
+  // The mean area of the Voronoi cells that close inside the centres' box: elements per unit
+  // area, 0 when no cell closes.
+  double closed_cell_density() const {
+    const double tol = 1e-9 * std::max(1.0, (hi_ - lo_).norm());
+    double closed_area = 0;
+    int closed = 0;
+    for (int i = 0; i < n_ && n_ > 1; ++i) {
+      std::vector<Vector2d> cell = {lo_, Vector2d(hi_.x(), lo_.y()), hi_,
+                                    Vector2d(lo_.x(), hi_.y())};
+      for (const int j : near(i)) {
+        if (cell.empty()) break;
+        cell = clip(cell, 0.5 * (c_[i] + c_[j]), c_[j] - c_[i]);
+      }
+      bool inside = cell.size() >= 3;
+      for (const Vector2d& p : cell)
+        if (p.x() <= lo_.x() + tol || p.y() <= lo_.y() + tol || p.x() >= hi_.x() - tol ||
+            p.y() >= hi_.y() - tol)
+          inside = false;
+      if (!inside) continue;
+      closed_area += polygon_area(cell);
+      ++closed;
+    }
+    return closed > 0 && closed_area > 0 ? closed / closed_area : 0;
+  }
+  // 1 / the median area of the parallelogram of each centre's two nearest independent
+  // neighbours (exact for a lattice); 0 when there is none.
+  double lattice_cell_density() const {
+    std::vector<double> cells;
+    for (int i = 0; i < n_; ++i) {
+      std::vector<std::pair<double, int>> byd;
+      for (const int j : near(i)) byd.emplace_back((c_[j] - c_[i]).norm(), j);
+      std::sort(byd.begin(), byd.end());
+      if (byd.empty()) continue;
+      const Vector2d v1 = c_[byd[0].second] - c_[i];
+      for (size_t k = 1; k < byd.size(); ++k) {
+        const Vector2d v2 = c_[byd[k].second] - c_[i];
+        const double cross = std::abs(v1.x() * v2.y() - v1.y() * v2.x());
+        if (cross > 0.2 * v1.norm() * v2.norm()) {
+          cells.push_back(cross);
+          break;
+        }
+      }
+    }
+    const double m = median(cells);
+    return m > 0 ? 1.0 / m : 0;
+  }
+
+ private:
+  int n_;
+  std::vector<Vector2d> c_;
+  Vector2d lo_, hi_;
+  double radius_;
+  HashGrid3 grid_;
+};
+
+}  // namespace
+
 SwatchStructure measure_swatch_structure(const TriMesh& swatch) {
   SwatchStructure out;
   const PreparedSwatch prepared = prepare_swatch(swatch);
@@ -832,122 +984,12 @@ SwatchStructure measure_swatch_structure(const TriMesh& swatch) {
   out.report = measure_structure(prepared.mesh, own);
   const StructureReport& r = out.report;
   out.interior_links = common_count(r.link_histogram, r.rings - r.degenerate_rings());
-
-  // Per kind: ring-ness, link count, fold, extents and the distinct shapes of its elements.
-  std::vector<int> fc;
-  const int ne = connected_components(prepared.mesh.F, prepared.mesh.num_vertices(), fc);
-  const std::vector<std::vector<int>> groups = component_faces(fc, ne);
-  out.kinds.resize(r.kinds.size());
-  std::vector<std::vector<int>> histograms(r.kinds.size());
-  std::vector<std::vector<double>> folds(r.kinds.size());
-  std::vector<std::array<std::vector<double>, 3>> extents(r.kinds.size());
-  for (size_t k = 0; k < r.kinds.size(); ++k) out.kinds[k].name = r.kinds[k];
-  for (int c = 0; c < ne; ++c) {
-    const ElementStructure& e = r.elements[static_cast<size_t>(c)];
-    const size_t k = static_cast<size_t>(e.kind);
-    SwatchKind& kind = out.kinds[k];
-    ++kind.elements;
-    kind.rings += e.ring_shaped ? 1 : 0;
-    kind.long_elements += e.long_element ? 1 : 0;
-    if (e.ring && !e.degenerate()) {
-      if (histograms[k].size() <= static_cast<size_t>(e.links))
-        histograms[k].resize(static_cast<size_t>(e.links) + 1, 0);
-      ++histograms[k][static_cast<size_t>(e.links)];
-    }
-    if (e.ring_shaped) folds[k].push_back(e.fold);
-    const TriMesh part = extract_faces(prepared.mesh, groups[static_cast<size_t>(c)]);
-    Vector3d s;
-    Eigen::Matrix3d axes;
-    principal_extents(part.V, s, &axes);
-    for (int a = 0; a < 3; ++a) extents[k][a].push_back(s(a));
-    // A new shape unless a similarity takes one of the kind's shapes of as many vertices onto
-    // it (the rings of a sheet are one shape; apples of varied sizes and squash are many).
-    const MatrixX3d centred = part.V.rowwise() - part.V.colwise().mean();
-    int same_count = 0;
-    bool known = false;
-    for (const SwatchKind::Shape& shape : kind.shapes) {
-      if (shape.V.rows() != centred.rows()) continue;
-      ++same_count;
-      if (similarity_residual(shape.V, centred) < 1e-8) {
-        known = true;
-        break;
-      }
-    }
-    if (!known && same_count < 16) kind.shapes.push_back({centred, axes.leftCols<2>()});
-  }
-  for (size_t k = 0; k < out.kinds.size(); ++k) {
-    SwatchKind& kind = out.kinds[k];
-    kind.ring = 2 * kind.rings > kind.elements;
-    kind.compact = 2 * kind.long_elements <= kind.elements;
-    int judged = 0;
-    for (const int h : histograms[k]) judged += h;
-    if (kind.ring) kind.interior_links = common_count(histograms[k], judged);
-    kind.fold = median(folds[k]);
-    for (int a = 0; a < 3; ++a) kind.extents(a) = median(extents[k][a]);
-  }
-
-  // Density from Voronoi cells in the swatch plane (z is the thickness axis after prepare).
-  const int n = static_cast<int>(r.elements.size());
-  std::vector<Vector2d> c(static_cast<size_t>(n));
-  Vector2d lo = Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (int i = 0; i < n; ++i) {
-    c[i] = r.elements[i].centre.head<2>();
-    lo = lo.cwiseMin(c[i]);
-    hi = hi.cwiseMax(c[i]);
-  }
-  const double tol = 1e-9 * std::max(1.0, (hi - lo).norm());
-  // Neighbours within four spacings bound every cell that closes at all in a sheet.
-  const double radius = 4 * (r.median_spacing > 0 ? r.median_spacing : r.median_size);
-  HashGrid3 grid(std::max(radius, 1e-12));
-  for (int i = 0; i < n; ++i)
-    grid.insert_box(i, Vector3d(c[i].x(), c[i].y(), 0), Vector3d(c[i].x(), c[i].y(), 0));
-  auto near = [&](int i) {
-    const Vector3d p(c[i].x(), c[i].y(), 0), d(radius, radius, 0);
-    std::vector<int> ids;
-    for (const int j : grid.query_box(p - d, p + d))
-      if (j != i && (c[j] - c[i]).norm() <= radius) ids.push_back(j);
-    return ids;
-  };
-  double closed_area = 0;
-  int closed = 0;
-  for (int i = 0; i < n && n > 1; ++i) {
-    std::vector<Vector2d> cell = {lo, Vector2d(hi.x(), lo.y()), hi, Vector2d(lo.x(), hi.y())};
-    for (const int j : near(i)) {
-      if (cell.empty()) break;
-      cell = clip(cell, 0.5 * (c[i] + c[j]), c[j] - c[i]);
-    }
-    bool inside = cell.size() >= 3;
-    for (const Vector2d& p : cell)
-      if (p.x() <= lo.x() + tol || p.y() <= lo.y() + tol || p.x() >= hi.x() - tol ||
-          p.y() >= hi.y() - tol)
-        inside = false;
-    if (!inside) continue;
-    closed_area += polygon_area(cell);
-    ++closed;
-  }
-  if (closed > 0 && closed_area > 0) {
-    out.density = closed / closed_area;
-    return out;
-  }
-  // No closed cell: the lattice cell of each centre's two nearest independent neighbours.
-  std::vector<double> cells;
-  for (int i = 0; i < n; ++i) {
-    std::vector<std::pair<double, int>> byd;
-    for (const int j : near(i)) byd.emplace_back((c[j] - c[i]).norm(), j);
-    std::sort(byd.begin(), byd.end());
-    if (byd.empty()) continue;
-    const Vector2d v1 = c[byd[0].second] - c[i];
-    for (size_t k = 1; k < byd.size(); ++k) {
-      const Vector2d v2 = c[byd[k].second] - c[i];
-      const double cross = std::abs(v1.x() * v2.y() - v1.y() * v2.x());
-      if (cross > 0.2 * v1.norm() * v2.norm()) {
-        cells.push_back(cross);
-        break;
-      }
-    }
-  }
-  const double m = median(cells);
-  out.density = m > 0 ? 1.0 / m : 0;
+  out.kinds = swatch_kinds(prepared.mesh, r);
+  // Density from Voronoi cells in the swatch plane; when no cell closes (a sheet two elements
+  // wide), from the lattice cell of each centre's nearest neighbours.
+  const SwatchCentres centres(r);
+  out.density = centres.closed_cell_density();
+  if (!(out.density > 0)) out.density = centres.lattice_cell_density();
   return out;
 }
 
