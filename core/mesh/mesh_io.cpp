@@ -174,125 +174,155 @@ TriMesh make_mesh(const std::vector<double>& V, const std::vector<int>& F) {
 // ---------------------------------------------------------------------------------------------
 // OBJ
 
-TriMesh read_obj(const std::string& path, const std::string& data) {
-  TextCursor c(path, data.data(), data.data() + data.size());
-  std::vector<double> V, N;
-  std::vector<int> F, FN;  // FN: normal index per triangle corner, -1 when absent
-  std::vector<std::pair<int, int>> corners;
-  V.reserve(data.size() / 16);
-  F.reserve(data.size() / 8);
-  bool all_corners_have_normals = true;
-  // Kinds (element_kinds.h): a face's kind is its material (usemtl), else its group (g or o).
-  std::string material, group;
-  std::vector<std::string> kinds;
-  std::unordered_map<std::string, int> kind_of_name;
-  std::vector<int> face_kind;
-  int current_kind = -1;  // -1: no name seen yet
-  const auto kind_id = [&](const std::string& name) {
-    const auto [it, added] = kind_of_name.emplace(name, static_cast<int>(kinds.size()));
-    if (added) kinds.push_back(name);
-    return it->second;
-  };
-  const auto update_kind = [&] {
-    const std::string& name = material.empty() ? group : material;
-    if (name.empty() && current_kind < 0) return;
-    if (current_kind < 0) face_kind.assign(F.size() / 3, kind_id(kDefaultKind));
-    current_kind = kind_id(sanitized_kind(name));
-  };
-
-  while (!c.eof()) {
-    c.skip_blanks();
-    const char c0 = c.peek(), c1 = c.peek(1);
-    if (c0 == 'v' && is_blank(c1)) {
-      c.advance(1);
-      for (int k = 0; k < 3; ++k) V.push_back(c.read_double("vertex coordinate"));
-    } else if (c0 == 'v' && c1 == 'n' && is_blank(c.peek(2))) {
-      c.advance(2);
-      for (int k = 0; k < 3; ++k) N.push_back(c.read_double("normal coordinate"));
-    } else if (c0 == 'f' && is_blank(c1)) {
-      c.advance(1);
-      corners.clear();
-      const long long nv = static_cast<long long>(V.size() / 3);
-      const long long nn = static_cast<long long>(N.size() / 3);
-      for (;;) {
-        c.skip_blanks();
-        if (c.at_eol()) break;
-        const long long vi = c.read_int("vertex index", '/');
-        long long ni = 0;
-        if (c.peek() == '/') {
-          c.advance(1);
-          if (c.peek() != '/') {
-            if (!is_space(c.peek()) && c.peek() != '\0') c.read_int("texture index", '/');
-          }
-          if (c.peek() == '/') {
-            c.advance(1);
-            ni = c.read_int("normal index");
-          }
-        }
-        const long long v = vi > 0 ? vi - 1 : nv + vi;
-        if (vi == 0 || v < 0 || v >= nv)
-          c.fail("vertex index " + std::to_string(vi) + " out of range (" + std::to_string(nv) +
-                 " vertices defined so far)");
-        int n = -1;
-        if (ni != 0) {
-          const long long nn_idx = ni > 0 ? ni - 1 : nn + ni;
-          if (nn_idx < 0 || nn_idx >= nn)
-            c.fail("normal index " + std::to_string(ni) + " out of range (" + std::to_string(nn) +
-                   " normals defined so far)");
-          n = static_cast<int>(nn_idx);
-        }
-        corners.emplace_back(static_cast<int>(v), n);
-      }
-      if (corners.size() < 3)
-        c.fail("face with " + std::to_string(corners.size()) + " vertices (need at least 3)");
-      for (size_t i = 1; i + 1 < corners.size(); ++i) {
-        for (size_t k : {size_t(0), i, i + 1}) {
-          F.push_back(corners[k].first);
-          FN.push_back(corners[k].second);
-          all_corners_have_normals &= corners[k].second >= 0;
-        }
-        if (current_kind >= 0) face_kind.push_back(current_kind);
-      }
-    } else if ((c0 == 'g' || c0 == 'o') && is_blank(c1)) {
-      c.advance(1);
-      group = c.rest_of_line();
-      update_kind();
-    } else if (c.remaining() > 7 && std::memcmp(c.pos(), "usemtl", 6) == 0 && is_blank(c.peek(6))) {
-      c.advance(6);
-      material = c.rest_of_line();
-      if (material == "(null)") material.clear();  // what some exporters write for "none"
-      update_kind();
-    }
-    // Everything else (vt, s, mtllib, l, comments) and trailing values such as
-    // the optional w or vertex colours are ignored.
-    c.skip_line();
+// The OBJ lines a mesh needs (v, vn, f, g, o, usemtl), read line by line; everything else
+// (vt, s, mtllib, l, comments) and trailing values such as the optional w or vertex colours
+// are ignored.
+class ObjParser {
+ public:
+  ObjParser(TextCursor& c, size_t bytes) : c_(c) {
+    V_.reserve(bytes / 16);
+    F_.reserve(bytes / 8);
   }
-  if (F.empty()) c.fail("no faces");
 
-  TriMesh m = make_mesh(V, F);
-  if (current_kind >= 0) {
-    m.kinds = std::move(kinds);
-    m.face_kind = std::move(face_kind);
-    remove_unused_kinds(m);
+  void parse() {
+    while (!c_.eof()) {
+      c_.skip_blanks();
+      const char c0 = c_.peek(), c1 = c_.peek(1);
+      if (c0 == 'v' && is_blank(c1)) {
+        c_.advance(1);
+        for (int k = 0; k < 3; ++k) V_.push_back(c_.read_double("vertex coordinate"));
+      } else if (c0 == 'v' && c1 == 'n' && is_blank(c_.peek(2))) {
+        c_.advance(2);
+        for (int k = 0; k < 3; ++k) N_.push_back(c_.read_double("normal coordinate"));
+      } else if (c0 == 'f' && is_blank(c1)) {
+        c_.advance(1);
+        read_face();
+      } else if ((c0 == 'g' || c0 == 'o') && is_blank(c1)) {
+        c_.advance(1);
+        group_ = c_.rest_of_line();
+        update_kind();
+      } else if (c_.remaining() > 7 && std::memcmp(c_.pos(), "usemtl", 6) == 0 &&
+                 is_blank(c_.peek(6))) {
+        c_.advance(6);
+        material_ = c_.rest_of_line();
+        if (material_ == "(null)") material_.clear();  // what some exporters write for "none"
+        update_kind();
+      }
+      c_.skip_line();
+    }
+    if (F_.empty()) c_.fail("no faces");
+  }
+
+  TriMesh mesh() {
+    TriMesh m = make_mesh(V_, F_);
+    if (current_kind_ >= 0) {
+      m.kinds = std::move(kinds_);
+      m.face_kind = std::move(face_kind_);
+      remove_unused_kinds(m);
+    }
+    attach_vertex_normals(m);
+    return m;
+  }
+
+ private:
+  // One corner "v", "v/t", "v//n" or "v/t/n" (indices from 1, or negative from the end):
+  // its vertex and normal (-1: none).
+  std::pair<int, int> read_corner(long long nv, long long nn) {
+    const long long vi = c_.read_int("vertex index", '/');
+    long long ni = 0;
+    if (c_.peek() == '/') {
+      c_.advance(1);
+      if (c_.peek() != '/') {
+        if (!is_space(c_.peek()) && c_.peek() != '\0') c_.read_int("texture index", '/');
+      }
+      if (c_.peek() == '/') {
+        c_.advance(1);
+        ni = c_.read_int("normal index");
+      }
+    }
+    const long long v = vi > 0 ? vi - 1 : nv + vi;
+    if (vi == 0 || v < 0 || v >= nv)
+      c_.fail("vertex index " + std::to_string(vi) + " out of range (" + std::to_string(nv) +
+              " vertices defined so far)");
+    int n = -1;
+    if (ni != 0) {
+      const long long nn_idx = ni > 0 ? ni - 1 : nn + ni;
+      if (nn_idx < 0 || nn_idx >= nn)
+        c_.fail("normal index " + std::to_string(ni) + " out of range (" + std::to_string(nn) +
+                " normals defined so far)");
+      n = static_cast<int>(nn_idx);
+    }
+    return {static_cast<int>(v), n};
+  }
+  // A face, fanned into triangles of the current kind.
+  void read_face() {
+    corners_.clear();
+    const long long nv = static_cast<long long>(V_.size() / 3);
+    const long long nn = static_cast<long long>(N_.size() / 3);
+    for (;;) {
+      c_.skip_blanks();
+      if (c_.at_eol()) break;
+      corners_.push_back(read_corner(nv, nn));
+    }
+    if (corners_.size() < 3)
+      c_.fail("face with " + std::to_string(corners_.size()) + " vertices (need at least 3)");
+    for (size_t i = 1; i + 1 < corners_.size(); ++i) {
+      for (size_t k : {size_t(0), i, i + 1}) {
+        F_.push_back(corners_[k].first);
+        FN_.push_back(corners_[k].second);
+        all_corners_have_normals_ &= corners_[k].second >= 0;
+      }
+      if (current_kind_ >= 0) face_kind_.push_back(current_kind_);
+    }
+  }
+  int kind_id(const std::string& name) {
+    const auto [it, added] = kind_of_name_.emplace(name, static_cast<int>(kinds_.size()));
+    if (added) kinds_.push_back(name);
+    return it->second;
+  }
+  // Kinds (element_kinds.h): a face's kind is its material (usemtl), else its group (g or o);
+  // faces before the first name take the default kind once one is named.
+  void update_kind() {
+    const std::string& name = material_.empty() ? group_ : material_;
+    if (name.empty() && current_kind_ < 0) return;
+    if (current_kind_ < 0) face_kind_.assign(F_.size() / 3, kind_id(kDefaultKind));
+    current_kind_ = kind_id(sanitized_kind(name));
   }
   // Per-vertex normals only when each vertex is always paired with the same normal.
-  if (!N.empty() && all_corners_have_normals) {
-    std::vector<int> vertex_normal(V.size() / 3, -1);
+  void attach_vertex_normals(TriMesh& m) const {
+    if (N_.empty() || !all_corners_have_normals_) return;
+    std::vector<int> vertex_normal(V_.size() / 3, -1);
     bool consistent = true;
-    for (size_t i = 0; i < F.size() && consistent; ++i) {
-      int& slot = vertex_normal[static_cast<size_t>(F[i])];
-      if (slot < 0) slot = FN[i];
-      consistent = slot == FN[i];
+    for (size_t i = 0; i < F_.size() && consistent; ++i) {
+      int& slot = vertex_normal[static_cast<size_t>(F_[i])];
+      if (slot < 0) slot = FN_[i];
+      consistent = slot == FN_[i];
     }
     consistent &= std::find(vertex_normal.begin(), vertex_normal.end(), -1) == vertex_normal.end();
-    if (consistent) {
-      m.N.resize(m.V.rows(), 3);
-      for (Eigen::Index v = 0; v < m.V.rows(); ++v)
-        for (int k = 0; k < 3; ++k)
-          m.N(v, k) = N[3 * static_cast<size_t>(vertex_normal[static_cast<size_t>(v)]) + k];
-    }
+    if (!consistent) return;
+    m.N.resize(m.V.rows(), 3);
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v)
+      for (int k = 0; k < 3; ++k)
+        m.N(v, k) = N_[3 * static_cast<size_t>(vertex_normal[static_cast<size_t>(v)]) + k];
   }
-  return m;
+
+  TextCursor& c_;
+  std::vector<double> V_, N_;
+  std::vector<int> F_, FN_;  // FN: normal index per triangle corner, -1 when absent
+  std::vector<std::pair<int, int>> corners_;
+  bool all_corners_have_normals_ = true;
+  std::string material_, group_;
+  std::vector<std::string> kinds_;
+  std::unordered_map<std::string, int> kind_of_name_;
+  std::vector<int> face_kind_;
+  int current_kind_ = -1;  // -1: no name seen yet
+};
+
+TriMesh read_obj(const std::string& path, const std::string& data) {
+  TextCursor c(path, data.data(), data.data() + data.size());
+  ObjParser parser(c, data.size());
+  parser.parse();
+  return parser.mesh();
 }
 
 // ---------------------------------------------------------------------------------------------
