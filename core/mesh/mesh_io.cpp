@@ -960,6 +960,57 @@ void append_rows(AtomicOutputFile& out, Eigen::Index n, size_t max_row, const Fo
 // characters (to_chars of a double) or three "i//j" indices of at most 24 + 2 + 24.
 constexpr size_t kMaxObjLine = 4 + 3 * (1 + 2 * 24 + 2) + 1;
 
+// The faces in output order: grouped by element or by kind (stable), so each group is one run.
+std::vector<int> obj_face_order(const TriMesh& m, const ElementLabels* labels,
+                                ElementGroups groups) {
+  std::vector<int> order(static_cast<size_t>(m.F.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  if (labels && groups != ElementGroups::None) {
+    const auto key = [&](int f) {
+      const int e = labels->face_element[static_cast<size_t>(f)];
+      return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
+    };
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  }
+  return order;
+}
+
+// The group lines before row i of the face block when face order[i] starts a new group (an
+// "o" line by element or kind, and a "usemtl" line naming its kind), decided by the face
+// before it, so each chunk needs nothing but i.
+char* put_obj_group_lines(char* p, Eigen::Index i, const std::vector<int>& order,
+                          const ElementLabels& labels, ElementGroups groups, int width) {
+  const auto element_of = [&](Eigen::Index r) {
+    return r < 0 ? -1 : labels.face_element[static_cast<size_t>(order[static_cast<size_t>(r)])];
+  };
+  const int e = element_of(i), last_element = element_of(i - 1);
+  const int k = labels.element_kind[static_cast<size_t>(e)];
+  const int last_kind =
+      last_element < 0 ? -1 : labels.element_kind[static_cast<size_t>(last_element)];
+  const std::string& kind = labels.kinds[static_cast<size_t>(k)];
+  const auto put = [&](std::string_view text) {
+    std::memcpy(p, text.data(), text.size());
+    p += text.size();
+  };
+  if (groups == ElementGroups::Element && e != last_element) {
+    put("o ");
+    put(kind);
+    put("_");
+    put(padded(e, width));
+    put("\n");
+  } else if (groups == ElementGroups::Kind && k != last_kind) {
+    put("o ");
+    put(kind);
+    put("\n");
+  }
+  if (k != last_kind || (groups == ElementGroups::Element && e != last_element)) {
+    put("usemtl ");
+    put(kind);
+    put("\n");
+  }
+  return p;
+}
+
 void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normals, int precision,
                const ElementLabels* labels, ElementGroups groups, const std::string& mtl_name) {
   if (labels) {
@@ -982,16 +1033,7 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
       *p++ = '\n';
       return p;
     });
-  // Faces grouped by element or by kind (stable), so each group is one run.
-  std::vector<int> order(static_cast<size_t>(m.F.rows()));
-  std::iota(order.begin(), order.end(), 0);
-  if (labels && groups != ElementGroups::None) {
-    const auto key = [&](int f) {
-      const int e = labels->face_element[static_cast<size_t>(f)];
-      return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
-    };
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  }
+  const std::vector<int> order = obj_face_order(m, labels, groups);
   const int width =
       labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size()) : 0;
   // A face line may follow an "o" and a "usemtl" line naming its kind.
@@ -1000,41 +1042,9 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
     for (const std::string& kind : labels->kinds)
       longest_kind = std::max(longest_kind, kind.size());
   const size_t max_row = kMaxObjLine + 2 * (longest_kind + static_cast<size_t>(width) + 16);
-  // Row i of the face block: the group lines when face order[i] starts a new group (decided by
-  // the face before it, so each chunk needs nothing but i), then the face.
   append_rows(out, static_cast<Eigen::Index>(order.size()), max_row, [&](Eigen::Index i, char* p) {
     const int f = order[static_cast<size_t>(i)];
-    if (labels) {
-      const auto element_of = [&](Eigen::Index r) {
-        return r < 0 ? -1
-                     : labels->face_element[static_cast<size_t>(order[static_cast<size_t>(r)])];
-      };
-      const int e = element_of(i), last_element = element_of(i - 1);
-      const int k = labels->element_kind[static_cast<size_t>(e)];
-      const int last_kind =
-          last_element < 0 ? -1 : labels->element_kind[static_cast<size_t>(last_element)];
-      const std::string& kind = labels->kinds[static_cast<size_t>(k)];
-      const auto put = [&](std::string_view text) {
-        std::memcpy(p, text.data(), text.size());
-        p += text.size();
-      };
-      if (groups == ElementGroups::Element && e != last_element) {
-        put("o ");
-        put(kind);
-        put("_");
-        put(padded(e, width));
-        put("\n");
-      } else if (groups == ElementGroups::Kind && k != last_kind) {
-        put("o ");
-        put(kind);
-        put("\n");
-      }
-      if (k != last_kind || (groups == ElementGroups::Element && e != last_element)) {
-        put("usemtl ");
-        put(kind);
-        put("\n");
-      }
-    }
+    if (labels) p = put_obj_group_lines(p, i, order, *labels, groups, width);
     *p++ = 'f';
     for (int k = 0; k < 3; ++k) {
       *p++ = ' ';
