@@ -51,14 +51,7 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
   write_file_atomically(path, j.str());
 }
 
-}  // namespace
-
-int run_plane(int argc, char** argv, int first) {
-  CommandLine cl(
-      "plane", "--swatch FILE --size L W -o OUT [options]",
-      "Grows a swatch (any mesh file; its smallest bounding-box side is the layer's\n"
-      "thickness) into a seamless L x W layer in the swatch's units, by mesh quilting\n"
-      "(seed finding, geometry matching, element correspondences, deformation, merging).");
+void declare_plane_options(CommandLine& cl) {
   cl.option("swatch", "FILE", "input swatch mesh (OBJ, PLY or OFF)");
   cl.option("size", "L W", "output extent along the swatch's two long axes", "", 2);
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
@@ -72,6 +65,44 @@ int run_plane(int argc, char** argv, int first) {
   cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
   add_output_options(cl);
   add_run_options(cl);
+}
+
+// The quilting options the command line gives (each value checked against its range).
+PlanarQuiltingOptions plane_options(const CommandLine& cl) {
+  PlanarQuiltingOptions options;
+  options.length = cl.get_double("size", 0, 1e-300, 1e300);
+  options.width = cl.get_double("size", 1, 1e-300, 1e300);
+  options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
+  if (cl.has("cell")) options.cell_size = cl.get_double("cell", 0, 1e-300, 1e300);
+  options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
+  options.subpatch_fraction = cl.get_double("subpatch", 0, 0.01, 1.0);
+  options.deform = !cl.has("no-deform");
+  options.trim_border = cl.has("trim");
+  options.max_faces = face_limit(cl);
+  return options;
+}
+
+// The two lines a run prints unless --quiet (the structure follows with --stats).
+void print_plane_summary(const std::string& out_path, const PlanarQuiltingStats& stats, double wall,
+                         const std::string& device, int threads) {
+  std::printf("wrote %s: %d faces, %d vertices, %d elements\n", out_path.c_str(), stats.faces,
+              stats.vertices, stats.elements);
+  std::printf(
+      "%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+      "%d added, %d matched, %d removed\n",
+      stats.iterations, wall, device.c_str(), threads, stats.counts.stitched, stats.counts.replaced,
+      stats.counts.added, stats.counts.matched, stats.removed_post);
+}
+
+}  // namespace
+
+int run_plane(int argc, char** argv, int first) {
+  CommandLine cl(
+      "plane", "--swatch FILE --size L W -o OUT [options]",
+      "Grows a swatch (any mesh file; its smallest bounding-box side is the layer's\n"
+      "thickness) into a seamless L x W layer in the swatch's units, by mesh quilting\n"
+      "(seed finding, geometry matching, element correspondences, deformation, merging).");
+  declare_plane_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
   if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
   if (!cl.has("size")) throw UsageError("--size L W is required");
@@ -83,16 +114,7 @@ int run_plane(int argc, char** argv, int first) {
   outputs.push_back(cl.get("stats"));
   check_paths(outputs, {cl.get("swatch")});
 
-  PlanarQuiltingOptions options;
-  options.length = cl.get_double("size", 0, 1e-300, 1e300);
-  options.width = cl.get_double("size", 1, 1e-300, 1e300);
-  options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
-  if (cl.has("cell")) options.cell_size = cl.get_double("cell", 0, 1e-300, 1e300);
-  options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
-  options.subpatch_fraction = cl.get_double("subpatch", 0, 0.01, 1.0);
-  options.deform = !cl.has("no-deform");
-  options.trim_border = cl.has("trim");
-  options.max_faces = face_limit(cl);
+  const PlanarQuiltingOptions options = plane_options(cl);
   const Device device = parse_device(cl.get("device"));
 
   RunContext run(cl);
@@ -123,13 +145,7 @@ int run_plane(int argc, char** argv, int first) {
                 options.length, options.width, structure);
   }
   if (!run.quiet()) {
-    std::printf("wrote %s: %d faces, %d vertices, %d elements\n", out_path.c_str(), stats.faces,
-                stats.vertices, stats.elements);
-    std::printf(
-        "%d iterations in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-        "%d added, %d matched, %d removed\n",
-        stats.iterations, wall, evaluator->name().c_str(), run.threads(), stats.counts.stitched,
-        stats.counts.replaced, stats.counts.added, stats.counts.matched, stats.removed_post);
+    print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);
   }

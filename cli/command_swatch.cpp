@@ -1,5 +1,9 @@
 // meshquilt swatch KIND -o FILE: the sample swatches artists start from.
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -11,15 +15,9 @@
 
 namespace mq::cli {
 
-int run_swatch(int argc, char** argv, int first) {
-  CommandLine cl("swatch", "KIND -o FILE [options]",
-                 "Generates a flat, thin sample swatch. KIND is one of:\n"
-                 "  chainmail         European 4-in-1 chain mail sheet of closed rings\n"
-                 "  chainmail-square  square 4-in-1: flat rings on a square grid, each linked to\n"
-                 "                    4 upright connector rings (kinds ring and connector)\n"
-                 "  weave             plain weave of interlaced threads\n"
-                 "  apples            a layer of apple-like blobs of varied size\n"
-                 "  ivy               a vine section with leaves");
+namespace {
+
+void declare_swatch_options(CommandLine& cl) {
   cl.positional("KIND", "chainmail | chainmail-square | weave | apples | ivy");
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("rows", "N", "chainmail(-square): ring rows; weave: threads along x", "6");
@@ -34,97 +32,142 @@ int run_swatch(int argc, char** argv, int first) {
             "refuse a swatch estimated to have more faces (also bounded by the machine's memory)",
             "2e7");
   add_output_options(cl);
-  if (!cl.parse(argc, argv, first)) return 0;
-  if (!cl.has("output")) throw UsageError("-o FILE is required");
-  const std::string kind = cl.positional_value("KIND");
-  const std::string out = cl.get("output");
-  mesh_format_from_path(out);
-  const WriteOptions write_options = output_options(cl);
-  check_paths(output_files(out, write_options), {});
-  const double scale = cl.get_double("scale", 0, 1e-6, 1e6);
-  const int detail = static_cast<int>(cl.get_int("detail", 0, 256));
-  const auto seed = static_cast<uint64_t>(cl.get_int("seed", 0, 1LL << 62));
-  const double limit = face_limit(cl);
+}
+
+// The options every kind shares, and the size check each makes before the real swatch.
+struct SwatchRequest {
+  std::string kind;
+  double scale = 1;
+  int detail = 0;
+  uint64_t seed = 1;
+  double limit = 0;
   // The size is estimated from a small swatch of the same kind and detail before the real one
   // is made (issue 14: 200 x 200 rings at --detail 256 would need ~54 GB).
-  const auto check_size = [&](double faces) {
+  void check_size(double faces) const {
     MQ_CHECK(faces <= limit, InvalidInput, "this ", kind, " swatch would have about ", faces,
              " faces, more than the limit of ", limit,
              " (--max-faces); use fewer elements or a "
              "lower --detail");
-  };
-  TriMesh mesh;
-  if (kind == "chainmail") {
-    ChainMailOptions o;
-    o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
-    o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
-    o.ring_radius *= scale;
-    o.wire_radius *= scale;
-    if (detail) o.ring_segments = std::max(8, detail), o.wire_segments = std::max(4, detail / 4);
-    ChainMailOptions one = o;
-    one.rows = one.cols = 1;
-    check_size(static_cast<double>(chainmail_4in1(one).num_faces()) * o.rows * o.cols);
-    mesh = chainmail_4in1(o);
-  } else if (kind == "chainmail-square") {
-    SquareMailOptions o;
-    o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
-    o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
-    o.ring_radius *= scale;
-    o.wire_radius *= scale;
-    if (detail) o.ring_segments = std::max(8, detail), o.wire_segments = std::max(4, detail / 4);
-    SquareMailOptions one = o;
-    one.rows = one.cols = 1;
-    // A flat ring per cell and up to two connectors of as many faces.
-    check_size(static_cast<double>(chainmail_square(one).num_faces()) *
-               (3.0 * o.rows * o.cols - o.rows - o.cols));
-    mesh = chainmail_square(o);
-  } else if (kind == "weave") {
-    WeaveOptions o;
-    o.threads_x = static_cast<int>(cl.get_int("rows", 1, 200));
-    o.threads_y = static_cast<int>(cl.get_int("cols", 1, 200));
-    o.spacing *= scale;
-    o.thread_radius *= scale;
-    if (detail) o.tube_segments = std::max(4, detail);
-    WeaveOptions small = o;
-    small.threads_x = small.threads_y = 2;
-    check_size(static_cast<double>(plain_weave(small).num_faces()) * o.threads_x * o.threads_y /
-               4.0);
-    mesh = plain_weave(o);
-  } else if (kind == "apples") {
-    AppleOptions o;
-    o.count = static_cast<int>(cl.get_int("count", 1, 10000));
-    o.mean_radius *= scale;
-    o.seed = seed;
-    if (detail) o.resolution = std::max(6, detail);
-    AppleOptions one = o;
-    one.count = 1;
-    check_size(static_cast<double>(apple_layer(one).num_faces()) * o.count);
-    mesh = apple_layer(o);
-  } else if (kind == "ivy") {
-    IvyOptions o;
-    o.leaves = cl.has("count") ? static_cast<int>(cl.get_int("count", 0, 10000)) : o.leaves;
-    o.length = cl.get_double("length", 0, 1e-3, 1e6) * scale;
-    o.leaf_size *= scale;
-    o.seed = seed;
-    IvyOptions bare = o;  // the vine per unit length, then one leaf
-    bare.leaves = 0;
-    bare.length = std::min(o.length, 10 * scale);
-    const double vine = ivy_section(bare).num_faces();
-    IvyOptions leafy = bare;
-    leafy.leaves = 1;
-    const double leaf = std::max(0, ivy_section(leafy).num_faces() - static_cast<int>(vine));
-    check_size(vine * o.length / bare.length + leaf * o.leaves);
-    mesh = ivy_section(o);
-  } else {
-    throw UsageError("unknown swatch kind '" + kind +
-                     "' (chainmail, chainmail-square, weave, apples or ivy)");
   }
+};
+
+TriMesh make_chainmail(const CommandLine& cl, const SwatchRequest& q) {
+  ChainMailOptions o;
+  o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
+  o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
+  o.ring_radius *= q.scale;
+  o.wire_radius *= q.scale;
+  if (q.detail)
+    o.ring_segments = std::max(8, q.detail), o.wire_segments = std::max(4, q.detail / 4);
+  ChainMailOptions one = o;
+  one.rows = one.cols = 1;
+  q.check_size(static_cast<double>(chainmail_4in1(one).num_faces()) * o.rows * o.cols);
+  return chainmail_4in1(o);
+}
+
+TriMesh make_square_mail(const CommandLine& cl, const SwatchRequest& q) {
+  SquareMailOptions o;
+  o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
+  o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
+  o.ring_radius *= q.scale;
+  o.wire_radius *= q.scale;
+  if (q.detail)
+    o.ring_segments = std::max(8, q.detail), o.wire_segments = std::max(4, q.detail / 4);
+  SquareMailOptions one = o;
+  one.rows = one.cols = 1;
+  // A flat ring per cell and up to two connectors of as many faces.
+  q.check_size(static_cast<double>(chainmail_square(one).num_faces()) *
+               (3.0 * o.rows * o.cols - o.rows - o.cols));
+  return chainmail_square(o);
+}
+
+TriMesh make_weave(const CommandLine& cl, const SwatchRequest& q) {
+  WeaveOptions o;
+  o.threads_x = static_cast<int>(cl.get_int("rows", 1, 200));
+  o.threads_y = static_cast<int>(cl.get_int("cols", 1, 200));
+  o.spacing *= q.scale;
+  o.thread_radius *= q.scale;
+  if (q.detail) o.tube_segments = std::max(4, q.detail);
+  WeaveOptions small = o;
+  small.threads_x = small.threads_y = 2;
+  q.check_size(static_cast<double>(plain_weave(small).num_faces()) * o.threads_x * o.threads_y /
+               4.0);
+  return plain_weave(o);
+}
+
+TriMesh make_apples(const CommandLine& cl, const SwatchRequest& q) {
+  AppleOptions o;
+  o.count = static_cast<int>(cl.get_int("count", 1, 10000));
+  o.mean_radius *= q.scale;
+  o.seed = q.seed;
+  if (q.detail) o.resolution = std::max(6, q.detail);
+  AppleOptions one = o;
+  one.count = 1;
+  q.check_size(static_cast<double>(apple_layer(one).num_faces()) * o.count);
+  return apple_layer(o);
+}
+
+TriMesh make_ivy(const CommandLine& cl, const SwatchRequest& q) {
+  IvyOptions o;
+  o.leaves = cl.has("count") ? static_cast<int>(cl.get_int("count", 0, 10000)) : o.leaves;
+  o.length = cl.get_double("length", 0, 1e-3, 1e6) * q.scale;
+  o.leaf_size *= q.scale;
+  o.seed = q.seed;
+  IvyOptions bare = o;  // the vine per unit length, then one leaf
+  bare.leaves = 0;
+  bare.length = std::min(o.length, 10 * q.scale);
+  const double vine = ivy_section(bare).num_faces();
+  IvyOptions leafy = bare;
+  leafy.leaves = 1;
+  const double leaf = std::max(0, ivy_section(leafy).num_faces() - static_cast<int>(vine));
+  q.check_size(vine * o.length / bare.length + leaf * o.leaves);
+  return ivy_section(o);
+}
+
+}  // namespace
+
+int run_swatch(int argc, char** argv, int first) {
+  CommandLine cl("swatch", "KIND -o FILE [options]",
+                 "Generates a flat, thin sample swatch. KIND is one of:\n"
+                 "  chainmail         European 4-in-1 chain mail sheet of closed rings\n"
+                 "  chainmail-square  square 4-in-1: flat rings on a square grid, each linked to\n"
+                 "                    4 upright connector rings (kinds ring and connector)\n"
+                 "  weave             plain weave of interlaced threads\n"
+                 "  apples            a layer of apple-like blobs of varied size\n"
+                 "  ivy               a vine section with leaves");
+  declare_swatch_options(cl);
+  if (!cl.parse(argc, argv, first)) return 0;
+  if (!cl.has("output")) throw UsageError("-o FILE is required");
+  SwatchRequest q;
+  q.kind = cl.positional_value("KIND");
+  const std::string out = cl.get("output");
+  mesh_format_from_path(out);
+  const WriteOptions write_options = output_options(cl);
+  check_paths(output_files(out, write_options), {});
+  q.scale = cl.get_double("scale", 0, 1e-6, 1e6);
+  q.detail = static_cast<int>(cl.get_int("detail", 0, 256));
+  q.seed = static_cast<uint64_t>(cl.get_int("seed", 0, 1LL << 62));
+  q.limit = face_limit(cl);
+  TriMesh mesh;
+  if (q.kind == "chainmail")
+    mesh = make_chainmail(cl, q);
+  else if (q.kind == "chainmail-square")
+    mesh = make_square_mail(cl, q);
+  else if (q.kind == "weave")
+    mesh = make_weave(cl, q);
+  else if (q.kind == "apples")
+    mesh = make_apples(cl, q);
+  else if (q.kind == "ivy")
+    mesh = make_ivy(cl, q);
+  else
+    throw UsageError("unknown swatch kind '" + q.kind +
+                     "' (chainmail, chainmail-square, weave, apples or ivy)");
   write_output(out, mesh, write_options);
   if (!cl.has("quiet")) {
     std::vector<int> fc;
     const int elements = connected_components(mesh.F, mesh.num_vertices(), fc);
     std::printf("wrote %s: %s swatch, %d faces, %d vertices, %d elements\n", out.c_str(),
-                kind.c_str(), mesh.num_faces(), mesh.num_vertices(), elements);
+                q.kind.c_str(), mesh.num_faces(), mesh.num_vertices(), elements);
   }
   return 0;
 }

@@ -174,125 +174,155 @@ TriMesh make_mesh(const std::vector<double>& V, const std::vector<int>& F) {
 // ---------------------------------------------------------------------------------------------
 // OBJ
 
-TriMesh read_obj(const std::string& path, const std::string& data) {
-  TextCursor c(path, data.data(), data.data() + data.size());
-  std::vector<double> V, N;
-  std::vector<int> F, FN;  // FN: normal index per triangle corner, -1 when absent
-  std::vector<std::pair<int, int>> corners;
-  V.reserve(data.size() / 16);
-  F.reserve(data.size() / 8);
-  bool all_corners_have_normals = true;
-  // Kinds (element_kinds.h): a face's kind is its material (usemtl), else its group (g or o).
-  std::string material, group;
-  std::vector<std::string> kinds;
-  std::unordered_map<std::string, int> kind_of_name;
-  std::vector<int> face_kind;
-  int current_kind = -1;  // -1: no name seen yet
-  const auto kind_id = [&](const std::string& name) {
-    const auto [it, added] = kind_of_name.emplace(name, static_cast<int>(kinds.size()));
-    if (added) kinds.push_back(name);
-    return it->second;
-  };
-  const auto update_kind = [&] {
-    const std::string& name = material.empty() ? group : material;
-    if (name.empty() && current_kind < 0) return;
-    if (current_kind < 0) face_kind.assign(F.size() / 3, kind_id(kDefaultKind));
-    current_kind = kind_id(sanitized_kind(name));
-  };
-
-  while (!c.eof()) {
-    c.skip_blanks();
-    const char c0 = c.peek(), c1 = c.peek(1);
-    if (c0 == 'v' && is_blank(c1)) {
-      c.advance(1);
-      for (int k = 0; k < 3; ++k) V.push_back(c.read_double("vertex coordinate"));
-    } else if (c0 == 'v' && c1 == 'n' && is_blank(c.peek(2))) {
-      c.advance(2);
-      for (int k = 0; k < 3; ++k) N.push_back(c.read_double("normal coordinate"));
-    } else if (c0 == 'f' && is_blank(c1)) {
-      c.advance(1);
-      corners.clear();
-      const long long nv = static_cast<long long>(V.size() / 3);
-      const long long nn = static_cast<long long>(N.size() / 3);
-      for (;;) {
-        c.skip_blanks();
-        if (c.at_eol()) break;
-        const long long vi = c.read_int("vertex index", '/');
-        long long ni = 0;
-        if (c.peek() == '/') {
-          c.advance(1);
-          if (c.peek() != '/') {
-            if (!is_space(c.peek()) && c.peek() != '\0') c.read_int("texture index", '/');
-          }
-          if (c.peek() == '/') {
-            c.advance(1);
-            ni = c.read_int("normal index");
-          }
-        }
-        const long long v = vi > 0 ? vi - 1 : nv + vi;
-        if (vi == 0 || v < 0 || v >= nv)
-          c.fail("vertex index " + std::to_string(vi) + " out of range (" + std::to_string(nv) +
-                 " vertices defined so far)");
-        int n = -1;
-        if (ni != 0) {
-          const long long nn_idx = ni > 0 ? ni - 1 : nn + ni;
-          if (nn_idx < 0 || nn_idx >= nn)
-            c.fail("normal index " + std::to_string(ni) + " out of range (" + std::to_string(nn) +
-                   " normals defined so far)");
-          n = static_cast<int>(nn_idx);
-        }
-        corners.emplace_back(static_cast<int>(v), n);
-      }
-      if (corners.size() < 3)
-        c.fail("face with " + std::to_string(corners.size()) + " vertices (need at least 3)");
-      for (size_t i = 1; i + 1 < corners.size(); ++i) {
-        for (size_t k : {size_t(0), i, i + 1}) {
-          F.push_back(corners[k].first);
-          FN.push_back(corners[k].second);
-          all_corners_have_normals &= corners[k].second >= 0;
-        }
-        if (current_kind >= 0) face_kind.push_back(current_kind);
-      }
-    } else if ((c0 == 'g' || c0 == 'o') && is_blank(c1)) {
-      c.advance(1);
-      group = c.rest_of_line();
-      update_kind();
-    } else if (c.remaining() > 7 && std::memcmp(c.pos(), "usemtl", 6) == 0 && is_blank(c.peek(6))) {
-      c.advance(6);
-      material = c.rest_of_line();
-      if (material == "(null)") material.clear();  // what some exporters write for "none"
-      update_kind();
-    }
-    // Everything else (vt, s, mtllib, l, comments) and trailing values such as
-    // the optional w or vertex colours are ignored.
-    c.skip_line();
+// The OBJ lines a mesh needs (v, vn, f, g, o, usemtl), read line by line; everything else
+// (vt, s, mtllib, l, comments) and trailing values such as the optional w or vertex colours
+// are ignored.
+class ObjParser {
+ public:
+  ObjParser(TextCursor& c, size_t bytes) : c_(c) {
+    V_.reserve(bytes / 16);
+    F_.reserve(bytes / 8);
   }
-  if (F.empty()) c.fail("no faces");
 
-  TriMesh m = make_mesh(V, F);
-  if (current_kind >= 0) {
-    m.kinds = std::move(kinds);
-    m.face_kind = std::move(face_kind);
-    remove_unused_kinds(m);
+  void parse() {
+    while (!c_.eof()) {
+      c_.skip_blanks();
+      const char c0 = c_.peek(), c1 = c_.peek(1);
+      if (c0 == 'v' && is_blank(c1)) {
+        c_.advance(1);
+        for (int k = 0; k < 3; ++k) V_.push_back(c_.read_double("vertex coordinate"));
+      } else if (c0 == 'v' && c1 == 'n' && is_blank(c_.peek(2))) {
+        c_.advance(2);
+        for (int k = 0; k < 3; ++k) N_.push_back(c_.read_double("normal coordinate"));
+      } else if (c0 == 'f' && is_blank(c1)) {
+        c_.advance(1);
+        read_face();
+      } else if ((c0 == 'g' || c0 == 'o') && is_blank(c1)) {
+        c_.advance(1);
+        group_ = c_.rest_of_line();
+        update_kind();
+      } else if (c_.remaining() > 7 && std::memcmp(c_.pos(), "usemtl", 6) == 0 &&
+                 is_blank(c_.peek(6))) {
+        c_.advance(6);
+        material_ = c_.rest_of_line();
+        if (material_ == "(null)") material_.clear();  // what some exporters write for "none"
+        update_kind();
+      }
+      c_.skip_line();
+    }
+    if (F_.empty()) c_.fail("no faces");
+  }
+
+  TriMesh mesh() {
+    TriMesh m = make_mesh(V_, F_);
+    if (current_kind_ >= 0) {
+      m.kinds = std::move(kinds_);
+      m.face_kind = std::move(face_kind_);
+      remove_unused_kinds(m);
+    }
+    attach_vertex_normals(m);
+    return m;
+  }
+
+ private:
+  // One corner "v", "v/t", "v//n" or "v/t/n" (indices from 1, or negative from the end):
+  // its vertex and normal (-1: none).
+  std::pair<int, int> read_corner(long long nv, long long nn) {
+    const long long vi = c_.read_int("vertex index", '/');
+    long long ni = 0;
+    if (c_.peek() == '/') {
+      c_.advance(1);
+      if (c_.peek() != '/') {
+        if (!is_space(c_.peek()) && c_.peek() != '\0') c_.read_int("texture index", '/');
+      }
+      if (c_.peek() == '/') {
+        c_.advance(1);
+        ni = c_.read_int("normal index");
+      }
+    }
+    const long long v = vi > 0 ? vi - 1 : nv + vi;
+    if (vi == 0 || v < 0 || v >= nv)
+      c_.fail("vertex index " + std::to_string(vi) + " out of range (" + std::to_string(nv) +
+              " vertices defined so far)");
+    int n = -1;
+    if (ni != 0) {
+      const long long nn_idx = ni > 0 ? ni - 1 : nn + ni;
+      if (nn_idx < 0 || nn_idx >= nn)
+        c_.fail("normal index " + std::to_string(ni) + " out of range (" + std::to_string(nn) +
+                " normals defined so far)");
+      n = static_cast<int>(nn_idx);
+    }
+    return {static_cast<int>(v), n};
+  }
+  // A face, fanned into triangles of the current kind.
+  void read_face() {
+    corners_.clear();
+    const long long nv = static_cast<long long>(V_.size() / 3);
+    const long long nn = static_cast<long long>(N_.size() / 3);
+    for (;;) {
+      c_.skip_blanks();
+      if (c_.at_eol()) break;
+      corners_.push_back(read_corner(nv, nn));
+    }
+    if (corners_.size() < 3)
+      c_.fail("face with " + std::to_string(corners_.size()) + " vertices (need at least 3)");
+    for (size_t i = 1; i + 1 < corners_.size(); ++i) {
+      for (size_t k : {size_t(0), i, i + 1}) {
+        F_.push_back(corners_[k].first);
+        FN_.push_back(corners_[k].second);
+        all_corners_have_normals_ &= corners_[k].second >= 0;
+      }
+      if (current_kind_ >= 0) face_kind_.push_back(current_kind_);
+    }
+  }
+  int kind_id(const std::string& name) {
+    const auto [it, added] = kind_of_name_.emplace(name, static_cast<int>(kinds_.size()));
+    if (added) kinds_.push_back(name);
+    return it->second;
+  }
+  // Kinds (element_kinds.h): a face's kind is its material (usemtl), else its group (g or o);
+  // faces before the first name take the default kind once one is named.
+  void update_kind() {
+    const std::string& name = material_.empty() ? group_ : material_;
+    if (name.empty() && current_kind_ < 0) return;
+    if (current_kind_ < 0) face_kind_.assign(F_.size() / 3, kind_id(kDefaultKind));
+    current_kind_ = kind_id(sanitized_kind(name));
   }
   // Per-vertex normals only when each vertex is always paired with the same normal.
-  if (!N.empty() && all_corners_have_normals) {
-    std::vector<int> vertex_normal(V.size() / 3, -1);
+  void attach_vertex_normals(TriMesh& m) const {
+    if (N_.empty() || !all_corners_have_normals_) return;
+    std::vector<int> vertex_normal(V_.size() / 3, -1);
     bool consistent = true;
-    for (size_t i = 0; i < F.size() && consistent; ++i) {
-      int& slot = vertex_normal[static_cast<size_t>(F[i])];
-      if (slot < 0) slot = FN[i];
-      consistent = slot == FN[i];
+    for (size_t i = 0; i < F_.size() && consistent; ++i) {
+      int& slot = vertex_normal[static_cast<size_t>(F_[i])];
+      if (slot < 0) slot = FN_[i];
+      consistent = slot == FN_[i];
     }
     consistent &= std::find(vertex_normal.begin(), vertex_normal.end(), -1) == vertex_normal.end();
-    if (consistent) {
-      m.N.resize(m.V.rows(), 3);
-      for (Eigen::Index v = 0; v < m.V.rows(); ++v)
-        for (int k = 0; k < 3; ++k)
-          m.N(v, k) = N[3 * static_cast<size_t>(vertex_normal[static_cast<size_t>(v)]) + k];
-    }
+    if (!consistent) return;
+    m.N.resize(m.V.rows(), 3);
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v)
+      for (int k = 0; k < 3; ++k)
+        m.N(v, k) = N_[3 * static_cast<size_t>(vertex_normal[static_cast<size_t>(v)]) + k];
   }
-  return m;
+
+  TextCursor& c_;
+  std::vector<double> V_, N_;
+  std::vector<int> F_, FN_;  // FN: normal index per triangle corner, -1 when absent
+  std::vector<std::pair<int, int>> corners_;
+  bool all_corners_have_normals_ = true;
+  std::string material_, group_;
+  std::vector<std::string> kinds_;
+  std::unordered_map<std::string, int> kind_of_name_;
+  std::vector<int> face_kind_;
+  int current_kind_ = -1;  // -1: no name seen yet
+};
+
+TriMesh read_obj(const std::string& path, const std::string& data) {
+  TextCursor c(path, data.data(), data.data() + data.size());
+  ObjParser parser(c, data.size());
+  parser.parse();
+  return parser.mesh();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -589,14 +619,37 @@ class PlyValueSource {
   long long index_ = 0;
 };
 
-TriMesh read_ply(const std::string& path, const std::string& data) {
-  TextCursor c(path, data.data(), data.data() + data.size());
-  if (c.word() != "ply") c.fail("missing 'ply' magic");
-  c.skip_line();
+// A PLY header, up to end_header.
+struct PlyHeader {
   PlyEncoding encoding = PlyEncoding::Ascii;
-  bool have_format = false;
   std::vector<PlyElement> elements;
   std::vector<std::pair<long long, std::string>> kind_names;  // "comment kind K NAME" lines
+};
+
+// A "property" line after its keyword: a scalar or a list, of the last element.
+void read_ply_property(TextCursor& c, std::vector<PlyElement>& elements) {
+  if (elements.empty()) c.fail("property before any element");
+  PlyProperty prop;
+  std::string type = c.word();
+  if (type == "list") {
+    prop.is_list = true;
+    const std::string count_type = c.word();
+    if (!parse_ply_type(count_type, prop.count_type) || !ply_is_integer(prop.count_type))
+      c.fail("unsupported PLY list count type '" + count_type + "'");
+    type = c.word();
+  }
+  if (!parse_ply_type(type, prop.type)) c.fail("unsupported PLY property type '" + type + "'");
+  prop.name = c.word();
+  if (prop.name.empty()) c.fail("property without a name");
+  elements.back().properties.push_back(prop);
+}
+
+// The header's lines up to end_header; the cursor is left at the body.
+PlyHeader read_ply_header(TextCursor& c) {
+  if (c.word() != "ply") c.fail("missing 'ply' magic");
+  c.skip_line();
+  PlyHeader h;
+  bool have_format = false;
   for (;;) {
     if (c.eof()) c.fail("unexpected end of file in header (no end_header)");
     const std::string key = c.word();
@@ -606,11 +659,11 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
     } else if (key == "format") {
       const std::string f = c.word();
       if (f == "ascii")
-        encoding = PlyEncoding::Ascii;
+        h.encoding = PlyEncoding::Ascii;
       else if (f == "binary_little_endian")
-        encoding = PlyEncoding::BinaryLittle;
+        h.encoding = PlyEncoding::BinaryLittle;
       else if (f == "binary_big_endian")
-        encoding = PlyEncoding::BinaryBig;
+        h.encoding = PlyEncoding::BinaryBig;
       else
         c.fail("unsupported PLY format '" + f + "'");
       have_format = true;
@@ -621,46 +674,45 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
       e.count = c.read_int("element count");
       if (e.count < 0 || e.count > std::numeric_limits<int>::max())
         c.fail("invalid element count " + std::to_string(e.count));
-      elements.push_back(e);
+      h.elements.push_back(e);
     } else if (key == "property") {
-      if (elements.empty()) c.fail("property before any element");
-      PlyProperty prop;
-      std::string type = c.word();
-      if (type == "list") {
-        prop.is_list = true;
-        const std::string count_type = c.word();
-        if (!parse_ply_type(count_type, prop.count_type) || !ply_is_integer(prop.count_type))
-          c.fail("unsupported PLY list count type '" + count_type + "'");
-        type = c.word();
-      }
-      if (!parse_ply_type(type, prop.type)) c.fail("unsupported PLY property type '" + type + "'");
-      prop.name = c.word();
-      if (prop.name.empty()) c.fail("property without a name");
-      elements.back().properties.push_back(prop);
+      read_ply_property(c, h.elements);
     } else if (key == "comment") {
-      if (c.word() == "kind" && kind_names.size() < (1 << 16)) {
+      if (c.word() == "kind" && h.kind_names.size() < (1 << 16)) {
         c.skip_blanks();
         if (std::isdigit(static_cast<unsigned char>(c.peek()))) {
           const long long k = c.read_int("kind number");
-          kind_names.emplace_back(k, sanitized_kind(c.rest_of_line()));
+          h.kind_names.emplace_back(k, sanitized_kind(c.rest_of_line()));
         }
       }
     } else if (key != "obj_info" && !key.empty()) {
       c.fail("unexpected PLY header keyword '" + key + "'");
     }
-    if (key != "end_header") c.skip_line();
+    c.skip_line();
   }
   if (!have_format) c.fail("PLY header lacks a format line");
+  return h;
+}
 
-  // Locate the vertex coordinates, normals and face index list.
-  const PlyElement* vertex_el = nullptr;
-  const PlyElement* face_el = nullptr;
+// Where the mesh lies in a PLY file's elements: the (first) vertex and face elements, what
+// each vertex property holds, the kind property and the face index list.
+struct PlyLayout {
+  const PlyElement* vertex = nullptr;
+  const PlyElement* face = nullptr;
+  std::vector<int> vslot;  // per vertex property: 0..2 position, 3..5 normal, -1 skipped
+  bool has_normals = false;
+  int kind_prop = -1;   // the vertex property `kind`, or -1
+  int index_prop = -1;  // the face property vertex_indices (or vertex_index)
+};
+
+PlyLayout locate_ply_mesh(TextCursor& c, const std::vector<PlyElement>& elements) {
+  PlyLayout l;
   for (const auto& e : elements) {
-    if (e.name == "vertex" && !vertex_el) vertex_el = &e;
-    if (e.name == "face" && !face_el) face_el = &e;
+    if (e.name == "vertex" && !l.vertex) l.vertex = &e;
+    if (e.name == "face" && !l.face) l.face = &e;
   }
-  if (!vertex_el) c.fail("PLY header has no vertex element");
-  if (!face_el || face_el->count == 0) c.fail("no faces");
+  if (!l.vertex) c.fail("PLY header has no vertex element");
+  if (!l.face || l.face->count == 0) c.fail("no faces");
   auto find_scalar = [&](const PlyElement& e, const char* name) {
     for (size_t i = 0; i < e.properties.size(); ++i)
       if (e.properties[i].name == name) {
@@ -669,43 +721,44 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
       }
     return -1;
   };
-  // slot[i]: 0..2 position, 3..5 normal, -1 skipped
-  std::vector<int> vslot(vertex_el->properties.size(), -1);
+  l.vslot.assign(l.vertex->properties.size(), -1);
   const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
   int found[6];
-  for (int k = 0; k < 6; ++k) found[k] = find_scalar(*vertex_el, names[k]);
+  for (int k = 0; k < 6; ++k) found[k] = find_scalar(*l.vertex, names[k]);
   if (found[0] < 0 || found[1] < 0 || found[2] < 0)
     c.fail("PLY vertex element lacks an x, y or z property");
-  const bool has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
-  for (int k = 0; k < (has_normals ? 6 : 3); ++k) vslot[static_cast<size_t>(found[k])] = k;
+  l.has_normals = found[3] >= 0 && found[4] >= 0 && found[5] >= 0;
+  for (int k = 0; k < (l.has_normals ? 6 : 3); ++k) l.vslot[static_cast<size_t>(found[k])] = k;
   // Kinds (element_kinds.h): an integer vertex property `kind`; a face takes its first vertex's.
-  const int kind_prop = find_scalar(*vertex_el, "kind");
-  if (kind_prop >= 0 && !ply_is_integer(vertex_el->properties[static_cast<size_t>(kind_prop)].type))
+  l.kind_prop = find_scalar(*l.vertex, "kind");
+  if (l.kind_prop >= 0 && !ply_is_integer(l.vertex->properties[size_t(l.kind_prop)].type))
     c.fail("vertex property 'kind' is not an integer");
-  int index_prop = -1;
-  for (size_t i = 0; i < face_el->properties.size(); ++i) {
-    const PlyProperty& p = face_el->properties[i];
+  for (size_t i = 0; i < l.face->properties.size(); ++i) {
+    const PlyProperty& p = l.face->properties[i];
     if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
       if (!ply_is_integer(p.type)) c.fail("face index list has non-integer type");
-      index_prop = static_cast<int>(i);
+      l.index_prop = static_cast<int>(i);
       break;
     }
   }
-  if (index_prop < 0) c.fail("PLY face element lacks a vertex_indices list");
+  if (l.index_prop < 0) c.fail("PLY face element lacks a vertex_indices list");
+  return l;
+}
 
-  // Declared counts are checked against the bytes left before anything is allocated: every
-  // item takes at least its scalars' and list counts' sizes in binary, 2 bytes (a digit and a
-  // separator) per value in ASCII. An element with no properties takes no bytes at all: it is
-  // not iterated (its count is meaningless).
+// Declared counts are checked against the bytes left before anything is allocated: every
+// item takes at least its scalars' and list counts' sizes in binary, 2 bytes (a digit and a
+// separator) per value in ASCII. An element with no properties takes no bytes at all: it is
+// not iterated (its count is meaningless).
+void check_ply_counts(TextCursor& c, const PlyHeader& h, const PlyLayout& l) {
+  const bool ascii = h.encoding == PlyEncoding::Ascii;
   long long needed = 0;
-  for (const PlyElement& e : elements) {
+  for (const PlyElement& e : h.elements) {
     long long per_item = 0;
     for (const PlyProperty& p : e.properties)
-      per_item += encoding == PlyEncoding::Ascii ? 2 : ply_size(p.is_list ? p.count_type : p.type);
-    if (&e == face_el && per_item > 0)  // at least 3 indices per face
-      per_item += 3 * (encoding == PlyEncoding::Ascii
-                           ? 2
-                           : ply_size(face_el->properties[static_cast<size_t>(index_prop)].type));
+      per_item += ascii ? 2 : ply_size(p.is_list ? p.count_type : p.type);
+    if (&e == l.face && per_item > 0)  // at least 3 indices per face
+      per_item +=
+          3 * (ascii ? 2 : ply_size(l.face->properties[static_cast<size_t>(l.index_prop)].type));
     needed += per_item * e.count;  // <= 2^31 * (8 + 24) * #properties: no overflow
     // Small counts go on to the parse, whose messages say where the data end.
     if (e.count > (1 << 16) && needed > c.remaining() + 1)
@@ -713,76 +766,112 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
              " needs more data than the file's " + std::to_string(c.remaining()) +
              " remaining bytes");
   }
+}
 
-  const long long nv = vertex_el->count;
-  std::vector<double> V(static_cast<size_t>(3 * nv)), N;
-  std::vector<int> vertex_kind(kind_prop >= 0 ? static_cast<size_t>(nv) : 0);
-  if (has_normals) N.resize(static_cast<size_t>(3 * nv));
+// What a PLY body holds of the mesh: positions, normals, vertex kinds (#V each, when present)
+// and the faces, polygons fanned into triangles.
+struct PlyBody {
+  std::vector<double> V, N;
+  std::vector<int> vertex_kind;
   std::vector<int> F;
-  F.reserve(static_cast<size_t>(3 * face_el->count));
-  std::vector<int> poly;
+  std::vector<int> poly;  // scratch: the face being read
+};
 
-  const bool swap = encoding != PlyEncoding::Ascii &&
-                    (encoding == PlyEncoding::BinaryLittle) != host_is_little_endian();
-  PlyBinaryReader binary(path, c.pos(), data.data() + data.size(), swap);
-  for (const PlyElement& e : elements) {
-    PlyValueSource src(&c, encoding == PlyEncoding::Ascii ? nullptr : &binary, &e.name);
-    const bool is_vertex = &e == vertex_el, is_face = &e == face_el;
-    if (e.properties.empty()) continue;  // no bytes to read
-    for (long long i = 0; i < e.count; ++i) {
-      src.begin_item(i);
-      for (size_t pi = 0; pi < e.properties.size(); ++pi) {
-        const PlyProperty& p = e.properties[pi];
-        if (is_vertex && vslot[pi] >= 0) {
-          const int k = vslot[pi];
-          const double v = src.read_double(p.type, k < 3 ? "vertex coordinate" : "normal");
-          (k < 3 ? V : N)[static_cast<size_t>(3 * i + k % 3)] = v;
-        } else if (is_vertex && static_cast<int>(pi) == kind_prop) {
-          const long long k = src.read_integer(p.type, "kind");
-          if (k < 0 || k >= (1 << 16)) src.fail("kind " + std::to_string(k) + " out of range");
-          vertex_kind[static_cast<size_t>(i)] = static_cast<int>(k);
-        } else if (is_face && static_cast<int>(pi) == index_prop) {
-          const long long n = src.read_integer(p.count_type, "face vertex count");
-          if (n < 3) src.fail("face with " + std::to_string(n) + " vertices (need at least 3)");
-          poly.clear();
-          for (long long j = 0; j < n; ++j) {
-            const long long v = src.read_integer(p.type, "vertex index");
-            if (v < 0 || v >= nv)
-              src.fail("vertex index " + std::to_string(v) + " out of range (" +
-                       std::to_string(nv) + " vertices)");
-            poly.push_back(static_cast<int>(v));
-          }
-          for (size_t j = 1; j + 1 < poly.size(); ++j) {
-            F.push_back(poly[0]);
-            F.push_back(poly[j]);
-            F.push_back(poly[j + 1]);
-          }
-        } else if (p.is_list) {
-          const long long n = src.read_integer(p.count_type, "list count");
-          if (n < 0) src.fail("negative list count");
-          src.skip(p.type, n);
-        } else {
-          src.skip(p.type);
-        }
-      }
+// One face's index list, fanned into triangles.
+void read_ply_face(PlyValueSource& src, const PlyProperty& p, long long nv, PlyBody& body) {
+  const long long n = src.read_integer(p.count_type, "face vertex count");
+  if (n < 3) src.fail("face with " + std::to_string(n) + " vertices (need at least 3)");
+  std::vector<int>& poly = body.poly;
+  poly.clear();
+  for (long long j = 0; j < n; ++j) {
+    const long long v = src.read_integer(p.type, "vertex index");
+    if (v < 0 || v >= nv)
+      src.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) +
+               " vertices)");
+    poly.push_back(static_cast<int>(v));
+  }
+  for (size_t j = 1; j + 1 < poly.size(); ++j) {
+    body.F.push_back(poly[0]);
+    body.F.push_back(poly[j]);
+    body.F.push_back(poly[j + 1]);
+  }
+}
+
+// Item i of element e: the values the mesh needs into `body`, the others skipped.
+void read_ply_item(PlyValueSource& src, const PlyElement& e, long long i, const PlyLayout& l,
+                   PlyBody& body) {
+  const bool is_vertex = &e == l.vertex, is_face = &e == l.face;
+  src.begin_item(i);
+  for (size_t pi = 0; pi < e.properties.size(); ++pi) {
+    const PlyProperty& p = e.properties[pi];
+    if (is_vertex && l.vslot[pi] >= 0) {
+      const int k = l.vslot[pi];
+      const double v = src.read_double(p.type, k < 3 ? "vertex coordinate" : "normal");
+      (k < 3 ? body.V : body.N)[static_cast<size_t>(3 * i + k % 3)] = v;
+    } else if (is_vertex && static_cast<int>(pi) == l.kind_prop) {
+      const long long k = src.read_integer(p.type, "kind");
+      if (k < 0 || k >= (1 << 16)) src.fail("kind " + std::to_string(k) + " out of range");
+      body.vertex_kind[static_cast<size_t>(i)] = static_cast<int>(k);
+    } else if (is_face && static_cast<int>(pi) == l.index_prop) {
+      read_ply_face(src, p, l.vertex->count, body);
+    } else if (p.is_list) {
+      const long long n = src.read_integer(p.count_type, "list count");
+      if (n < 0) src.fail("negative list count");
+      src.skip(p.type, n);
+    } else {
+      src.skip(p.type);
     }
   }
-  TriMesh m = make_mesh(V, F);
-  if (has_normals) m.N = Eigen::Map<const MatrixX3d>(N.data(), m.V.rows(), 3);
-  if (kind_prop >= 0) {
-    int top = 0;
-    for (const int k : vertex_kind) top = std::max(top, k);
-    m.kinds.resize(static_cast<size_t>(top) + 1);
-    for (const auto& [k, name] : kind_names)
-      if (k <= top) m.kinds[static_cast<size_t>(k)] = name;
-    for (size_t k = 0; k < m.kinds.size(); ++k)
-      if (m.kinds[k].empty()) m.kinds[k] = "kind_" + std::to_string(k);
-    m.face_kind.resize(static_cast<size_t>(m.F.rows()));
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-      m.face_kind[static_cast<size_t>(f)] = vertex_kind[static_cast<size_t>(m.F(f, 0))];
-    remove_unused_kinds(m);
+}
+
+// Every element's items in file order, in either encoding.
+PlyBody read_ply_body(TextCursor& c, const PlyHeader& h, const PlyLayout& l,
+                      const std::string& path, const std::string& data) {
+  const long long nv = l.vertex->count;
+  PlyBody body;
+  body.V.resize(static_cast<size_t>(3 * nv));
+  body.vertex_kind.resize(l.kind_prop >= 0 ? static_cast<size_t>(nv) : 0);
+  if (l.has_normals) body.N.resize(static_cast<size_t>(3 * nv));
+  body.F.reserve(static_cast<size_t>(3 * l.face->count));
+  const bool swap = h.encoding != PlyEncoding::Ascii &&
+                    (h.encoding == PlyEncoding::BinaryLittle) != host_is_little_endian();
+  PlyBinaryReader binary(path, c.pos(), data.data() + data.size(), swap);
+  for (const PlyElement& e : h.elements) {
+    PlyValueSource src(&c, h.encoding == PlyEncoding::Ascii ? nullptr : &binary, &e.name);
+    if (e.properties.empty()) continue;  // no bytes to read
+    for (long long i = 0; i < e.count; ++i) read_ply_item(src, e, i, l, body);
   }
+  return body;
+}
+
+// The mesh of a PLY body; with vertex kinds, each face takes its first vertex's, named by the
+// header's "comment kind" lines (kind_K where none names it).
+TriMesh ply_mesh(const PlyBody& body, const PlyLayout& l,
+                 const std::vector<std::pair<long long, std::string>>& kind_names) {
+  TriMesh m = make_mesh(body.V, body.F);
+  if (l.has_normals) m.N = Eigen::Map<const MatrixX3d>(body.N.data(), m.V.rows(), 3);
+  if (l.kind_prop < 0) return m;
+  int top = 0;
+  for (const int k : body.vertex_kind) top = std::max(top, k);
+  m.kinds.resize(static_cast<size_t>(top) + 1);
+  for (const auto& [k, name] : kind_names)
+    if (k <= top) m.kinds[static_cast<size_t>(k)] = name;
+  for (size_t k = 0; k < m.kinds.size(); ++k)
+    if (m.kinds[k].empty()) m.kinds[k] = "kind_" + std::to_string(k);
+  m.face_kind.resize(static_cast<size_t>(m.F.rows()));
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    m.face_kind[static_cast<size_t>(f)] = body.vertex_kind[static_cast<size_t>(m.F(f, 0))];
+  remove_unused_kinds(m);
   return m;
+}
+
+TriMesh read_ply(const std::string& path, const std::string& data) {
+  TextCursor c(path, data.data(), data.data() + data.size());
+  const PlyHeader header = read_ply_header(c);
+  const PlyLayout layout = locate_ply_mesh(c, header.elements);
+  check_ply_counts(c, header, layout);
+  const PlyBody body = read_ply_body(c, header, layout, path, data);
+  return ply_mesh(body, layout, header.kind_names);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -871,6 +960,57 @@ void append_rows(AtomicOutputFile& out, Eigen::Index n, size_t max_row, const Fo
 // characters (to_chars of a double) or three "i//j" indices of at most 24 + 2 + 24.
 constexpr size_t kMaxObjLine = 4 + 3 * (1 + 2 * 24 + 2) + 1;
 
+// The faces in output order: grouped by element or by kind (stable), so each group is one run.
+std::vector<int> obj_face_order(const TriMesh& m, const ElementLabels* labels,
+                                ElementGroups groups) {
+  std::vector<int> order(static_cast<size_t>(m.F.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  if (labels && groups != ElementGroups::None) {
+    const auto key = [&](int f) {
+      const int e = labels->face_element[static_cast<size_t>(f)];
+      return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
+    };
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  }
+  return order;
+}
+
+// The group lines before row i of the face block when face order[i] starts a new group (an
+// "o" line by element or kind, and a "usemtl" line naming its kind), decided by the face
+// before it, so each chunk needs nothing but i.
+char* put_obj_group_lines(char* p, Eigen::Index i, const std::vector<int>& order,
+                          const ElementLabels& labels, ElementGroups groups, int width) {
+  const auto element_of = [&](Eigen::Index r) {
+    return r < 0 ? -1 : labels.face_element[static_cast<size_t>(order[static_cast<size_t>(r)])];
+  };
+  const int e = element_of(i), last_element = element_of(i - 1);
+  const int k = labels.element_kind[static_cast<size_t>(e)];
+  const int last_kind =
+      last_element < 0 ? -1 : labels.element_kind[static_cast<size_t>(last_element)];
+  const std::string& kind = labels.kinds[static_cast<size_t>(k)];
+  const auto put = [&](std::string_view text) {
+    std::memcpy(p, text.data(), text.size());
+    p += text.size();
+  };
+  if (groups == ElementGroups::Element && e != last_element) {
+    put("o ");
+    put(kind);
+    put("_");
+    put(padded(e, width));
+    put("\n");
+  } else if (groups == ElementGroups::Kind && k != last_kind) {
+    put("o ");
+    put(kind);
+    put("\n");
+  }
+  if (k != last_kind || (groups == ElementGroups::Element && e != last_element)) {
+    put("usemtl ");
+    put(kind);
+    put("\n");
+  }
+  return p;
+}
+
 void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normals, int precision,
                const ElementLabels* labels, ElementGroups groups, const std::string& mtl_name) {
   if (labels) {
@@ -893,16 +1033,7 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
       *p++ = '\n';
       return p;
     });
-  // Faces grouped by element or by kind (stable), so each group is one run.
-  std::vector<int> order(static_cast<size_t>(m.F.rows()));
-  std::iota(order.begin(), order.end(), 0);
-  if (labels && groups != ElementGroups::None) {
-    const auto key = [&](int f) {
-      const int e = labels->face_element[static_cast<size_t>(f)];
-      return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
-    };
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  }
+  const std::vector<int> order = obj_face_order(m, labels, groups);
   const int width =
       labels ? static_cast<int>(std::to_string(std::max(0, labels->count - 1)).size()) : 0;
   // A face line may follow an "o" and a "usemtl" line naming its kind.
@@ -911,41 +1042,9 @@ void write_obj(AtomicOutputFile& out, const TriMesh& m, const ObjNormals& normal
     for (const std::string& kind : labels->kinds)
       longest_kind = std::max(longest_kind, kind.size());
   const size_t max_row = kMaxObjLine + 2 * (longest_kind + static_cast<size_t>(width) + 16);
-  // Row i of the face block: the group lines when face order[i] starts a new group (decided by
-  // the face before it, so each chunk needs nothing but i), then the face.
   append_rows(out, static_cast<Eigen::Index>(order.size()), max_row, [&](Eigen::Index i, char* p) {
     const int f = order[static_cast<size_t>(i)];
-    if (labels) {
-      const auto element_of = [&](Eigen::Index r) {
-        return r < 0 ? -1
-                     : labels->face_element[static_cast<size_t>(order[static_cast<size_t>(r)])];
-      };
-      const int e = element_of(i), last_element = element_of(i - 1);
-      const int k = labels->element_kind[static_cast<size_t>(e)];
-      const int last_kind =
-          last_element < 0 ? -1 : labels->element_kind[static_cast<size_t>(last_element)];
-      const std::string& kind = labels->kinds[static_cast<size_t>(k)];
-      const auto put = [&](std::string_view text) {
-        std::memcpy(p, text.data(), text.size());
-        p += text.size();
-      };
-      if (groups == ElementGroups::Element && e != last_element) {
-        put("o ");
-        put(kind);
-        put("_");
-        put(padded(e, width));
-        put("\n");
-      } else if (groups == ElementGroups::Kind && k != last_kind) {
-        put("o ");
-        put(kind);
-        put("\n");
-      }
-      if (k != last_kind || (groups == ElementGroups::Element && e != last_element)) {
-        put("usemtl ");
-        put(kind);
-        put("\n");
-      }
-    }
+    if (labels) p = put_obj_group_lines(p, i, order, *labels, groups, width);
     *p++ = 'f';
     for (int k = 0; k < 3; ++k) {
       *p++ = ' ';

@@ -28,6 +28,9 @@ struct QuadricSimplificationOptions {
   // 1 equilateral, 0 degenerate) than this, unless the face was already worse (then none worse
   // than it was). In [0, 1].
   double min_quality = 0.3;
+
+  // Throws InvalidInput for a value outside its range (above).
+  void validate() const;
 };
 
 struct QuadricSimplification {
@@ -46,7 +49,7 @@ struct QuadricSimplification {
 // they are found within that: deterministic, O(F) work for the queue.
 //   mesh  #V by 3, #F by 3, consistently oriented
 // Throws InvalidInput for out-of-range indices, non-finite coordinates or options outside their
-// ranges.
+// ranges (options.validate()).
 QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
                                            const QuadricSimplificationOptions& options);
 

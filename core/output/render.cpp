@@ -78,23 +78,12 @@ Vector3d element_albedo(int c, bool color_elements) {
   return rgb.unaryExpr([](double x) { return srgb_to_linear(x); });
 }
 
-void check_input(const TriMesh& mesh, const RenderOptions& o) {
+void check_mesh(const TriMesh& mesh) {
   MQ_CHECK(!mesh.empty(), InvalidInput, "render: the mesh has no faces");
   MQ_CHECK(mesh.V.allFinite(), InvalidInput,
            "render: the mesh has a non-finite (NaN or infinite) vertex coordinate");
   MQ_CHECK(mesh.F.minCoeff() >= 0 && mesh.F.maxCoeff() < mesh.num_vertices(), InvalidInput,
            "render: a face index is outside [0, ", mesh.num_vertices(), ")");
-  MQ_CHECK(o.width >= 16 && o.width <= 8192 && o.height >= 16 && o.height <= 8192, InvalidInput,
-           "render: image size ", o.width, "x", o.height, " is outside [16, 8192]");
-  MQ_CHECK(o.samples_per_pixel >= 1 && o.samples_per_pixel <= 64, InvalidInput,
-           "render: samples per pixel ", o.samples_per_pixel, " is outside [1, 64]");
-  MQ_CHECK(o.fov_deg > 0 && o.fov_deg < 170, InvalidInput, "render: field of view ", o.fov_deg,
-           " degrees is outside (0, 170)");
-  MQ_CHECK(o.elevation_deg > -90 && o.elevation_deg < 90, InvalidInput, "render: elevation ",
-           o.elevation_deg, " degrees is outside (-90, 90)");
-  MQ_CHECK(std::isfinite(o.azimuth_deg), InvalidInput, "render: azimuth is not finite");
-  MQ_CHECK(o.up_axis >= 0 && o.up_axis <= 2, InvalidInput, "render: up axis ", o.up_axis,
-           " is not 0, 1 or 2");
 }
 
 // Per component: true when every manifold edge is used in opposite directions by its two faces
@@ -210,150 +199,193 @@ RTCRay make_ray(const Vector3d& org, const Vector3d& dir, float tnear) {
   return ray;
 }
 
-}  // namespace
+// The mesh in a frame centred on its bounding box, so that Embree's floats keep their
+// precision, with the vertices its faces use and the radius of the box.
+struct CentredMesh {
+  MatrixX3d P;
+  std::vector<char> referenced;
+  double radius = 1;
+};
 
-Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
-  check_input(mesh, o);
-  const MatrixX3i& F = mesh.F;
-  const int nv = mesh.num_vertices(), nf = mesh.num_faces();
-
-  // Work in a frame centred on the bounding box so Embree's floats keep their precision.
-  const BoundingBox box = bounding_box(mesh.V, F);
+CentredMesh centred_mesh(const TriMesh& mesh) {
+  CentredMesh c;
+  const BoundingBox box = bounding_box(mesh.V, mesh.F);
   const Vector3d center = box.center();
-  const MatrixX3d P = mesh.V.rowwise() - center.transpose();
-  double radius = 0.5 * box.extent().norm();
-  if (!(radius > 0)) radius = 1;  // every vertex coincides: nothing will be hit
-  std::vector<char> referenced(nv, 0);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) referenced[F(f, k)] = 1;
+  c.P = mesh.V.rowwise() - center.transpose();
+  c.radius = 0.5 * box.extent().norm();
+  if (!(c.radius > 0)) c.radius = 1;  // every vertex coincides: nothing will be hit
+  c.referenced.assign(mesh.num_vertices(), 0);
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) c.referenced[mesh.F(f, k)] = 1;
+  return c;
+}
 
-  std::vector<int> face_component;
-  const int num_components = connected_components(F, nv, face_component);
-  const std::vector<char> smooth = coherently_oriented(F, nv, face_component, num_components);
-  const MatrixX3d NF = face_normals(P, F);
-  const MatrixX3d CN = corner_normals(P, F, NF, face_component, smooth);
-  std::vector<Vector3d> albedo(num_components);
+// The linear albedo of each component: its hue (or the clay colour), a given colour, or clay
+// from neutral_from on.
+std::vector<Vector3d> element_albedos(int num_components, const RenderOptions& o) {
   MQ_CHECK(o.element_colors.empty() ||
                static_cast<int>(o.element_colors.size()) == num_components ||
                (o.neutral_from >= 0 && static_cast<int>(o.element_colors.size()) == o.neutral_from),
            InvalidInput, "render: ", o.element_colors.size(), " element colours for ",
            num_components, " elements");
+  std::vector<Vector3d> albedo(num_components);
   for (int c = 0; c < num_components; ++c) {
     albedo[c] = element_albedo(c, o.color_elements);
     if (!o.element_colors.empty() && c < static_cast<int>(o.element_colors.size()))
       for (int k = 0; k < 3; ++k) albedo[c](k) = srgb_to_linear(o.element_colors[c][k] / 255.0);
     if (o.neutral_from >= 0 && c >= o.neutral_from) albedo[c] = element_albedo(c, false);
   }
+  return albedo;
+}
 
-  // Embree scene.
-  DevicePtr device(rtcNewDevice("verbose=0"));
-  MQ_CHECK(device, InternalError, "render: cannot create the Embree device (error ",
+// An Embree device and its committed scene of one triangle geometry.
+struct EmbreeScene {
+  DevicePtr device;
+  ScenePtr scene;
+};
+
+EmbreeScene build_scene(const MatrixX3d& P, const MatrixX3i& F) {
+  const int nv = static_cast<int>(P.rows()), nf = static_cast<int>(F.rows());
+  EmbreeScene s;
+  s.device.reset(rtcNewDevice("verbose=0"));
+  MQ_CHECK(s.device, InternalError, "render: cannot create the Embree device (error ",
            static_cast<int>(rtcGetDeviceError(nullptr)), ")");
-  ScenePtr scene(rtcNewScene(device.get()));
-  rtcSetSceneFlags(scene.get(), RTC_SCENE_FLAG_ROBUST);
-  {
-    RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nf));
-    if (vb && ib) {
-      for (int i = 0; i < nv; ++i)
-        for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(P(i, k));
-      for (int f = 0; f < nf; ++f)
-        for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(F(f, k));
-      rtcCommitGeometry(geom);
-      rtcAttachGeometry(scene.get(), geom);
-    }
-    rtcReleaseGeometry(geom);
-    MQ_CHECK(vb && ib, InternalError, "render: Embree could not allocate the mesh buffers");
+  s.scene.reset(rtcNewScene(s.device.get()));
+  rtcSetSceneFlags(s.scene.get(), RTC_SCENE_FLAG_ROBUST);
+  RTCGeometry geom = rtcNewGeometry(s.device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                         RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+  auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nf));
+  if (vb && ib) {
+    for (int i = 0; i < nv; ++i)
+      for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(P(i, k));
+    for (int f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(F(f, k));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(s.scene.get(), geom);
   }
-  rtcCommitScene(scene.get());
-  const RTCError err = rtcGetDeviceError(device.get());
+  rtcReleaseGeometry(geom);
+  MQ_CHECK(vb && ib, InternalError, "render: Embree could not allocate the mesh buffers");
+  rtcCommitScene(s.scene.get());
+  const RTCError err = rtcGetDeviceError(s.device.get());
   MQ_CHECK(err == RTC_ERROR_NONE, InternalError, "render: Embree failed to build the scene (error ",
            static_cast<int>(err), ")");
+  return s;
+}
 
-  const Camera cam = frame_camera(P, referenced, o, radius);
-  const Vector3d key = (-0.65 * cam.right + 0.7 * cam.up - 0.3 * cam.forward).normalized();
-  const Vector3d head = -cam.forward;
-  const Vector3d bg_lin(srgb_to_linear(o.background[0] / 255.0),
-                        srgb_to_linear(o.background[1] / 255.0),
-                        srgb_to_linear(o.background[2] / 255.0));
-  const Vector3d up_w = Vector3d::Unit(o.up_axis);
-  double ground_h = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < nv; ++i)
-    if (referenced[i]) ground_h = std::min(ground_h, up_w.dot(P.row(i)));
-  const float eps = static_cast<float>(1e-4 * radius);
-  const std::vector<Eigen::Vector2d> pattern = sample_pattern(o.samples_per_pixel);
-
-  RTCScene sc = scene.get();
-  // True when the key light is blocked seen from p (offset along n to leave the surface).
-  auto in_shadow = [&](const Vector3d& p, const Vector3d& n) {
-    if (!o.shadows) return false;
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay ray = make_ray(p + 4 * eps * n, key, 0.0f);
-    rtcOccluded1(sc, &ctx, &ray);
-    return ray.tfar < 0;
-  };
+// Shading of camera rays: Lambert from a key light and a headlight, a little ambient and a
+// soft rim, hard shadows from the key light, and the optional shadow-catching floor.
+class Shader {
+ public:
+  Shader(RTCScene scene, const CentredMesh& m, const MatrixX3i& F, const MatrixX3d& NF,
+         const MatrixX3d& CN, const std::vector<int>& face_component,
+         const std::vector<Vector3d>& albedo, const Camera& cam, const RenderOptions& o)
+      : scene_(scene),
+        m_(m),
+        F_(F),
+        NF_(NF),
+        CN_(CN),
+        face_component_(face_component),
+        albedo_(albedo),
+        cam_(cam),
+        o_(o),
+        key_((-0.65 * cam.right + 0.7 * cam.up - 0.3 * cam.forward).normalized()),
+        head_(-cam.forward),
+        bg_lin_(srgb_to_linear(o.background[0] / 255.0), srgb_to_linear(o.background[1] / 255.0),
+                srgb_to_linear(o.background[2] / 255.0)),
+        up_w_(Vector3d::Unit(o.up_axis)),
+        eps_(static_cast<float>(1e-4 * m.radius)) {
+    for (int i = 0; i < m.P.rows(); ++i)
+      if (m.referenced[i]) ground_h_ = std::min(ground_h_, up_w_.dot(m.P.row(i)));
+  }
 
   // Linear radiance along one camera ray.
-  auto shade = [&](const Vector3d& dir) -> Vector3d {
+  Vector3d shade(const Vector3d& dir) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    rh.ray = make_ray(cam.eye, dir, 0.0f);
+    rh.ray = make_ray(cam_.eye, dir, 0.0f);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(sc, &ctx, &rh);
+    rtcIntersect1(scene_, &ctx, &rh);
     const bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-
-    if (!hit || o.ground_plane) {
+    if (!hit || o_.ground_plane) {
       // Shadow-catching floor touching the object from below, fading into the background.
-      const double dz = dir.dot(up_w), oz = cam.eye.dot(up_w);
-      const double t = dz < 0 && oz > ground_h ? (ground_h - oz) / dz : -1;
-      if (o.ground_plane && t > 0 && (!hit || t < rh.ray.tfar)) {
-        const Vector3d p = cam.eye + t * dir;
-        const Vector3d horizontal = p - up_w.dot(p) * up_w;
-        const double fade = std::exp(-horizontal.squaredNorm() / (6.25 * radius * radius));
-        const double shadow = key.dot(up_w) > 0 && in_shadow(p, up_w) ? 0.45 : 1.0;
-        return bg_lin * (1 - fade * (1 - 0.88 * shadow));
-      }
-      if (!hit) return bg_lin;
+      const double dz = dir.dot(up_w_), oz = cam_.eye.dot(up_w_);
+      const double t = dz < 0 && oz > ground_h_ ? (ground_h_ - oz) / dz : -1;
+      if (o_.ground_plane && t > 0 && (!hit || t < rh.ray.tfar)) return floor_at(t, dir);
+      if (!hit) return bg_lin_;
     }
+    return surface_at(static_cast<int>(rh.hit.primID), rh.hit.u, rh.hit.v, dir);
+  }
 
-    const int f = static_cast<int>(rh.hit.primID);
-    const double u = rh.hit.u, v = rh.hit.v;
-    const Vector3d p = (1 - u - v) * P.row(F(f, 0)) + u * P.row(F(f, 1)) + v * P.row(F(f, 2));
-    Vector3d ng = NF.row(f);
+ private:
+  // True when the key light is blocked seen from p (offset along n to leave the surface).
+  bool in_shadow(const Vector3d& p, const Vector3d& n) const {
+    if (!o_.shadows) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray = make_ray(p + 4 * eps_ * n, key_, 0.0f);
+    rtcOccluded1(scene_, &ctx, &ray);
+    return ray.tfar < 0;
+  }
+  Vector3d floor_at(double t, const Vector3d& dir) const {
+    const Vector3d p = cam_.eye + t * dir;
+    const Vector3d horizontal = p - up_w_.dot(p) * up_w_;
+    const double fade = std::exp(-horizontal.squaredNorm() / (6.25 * m_.radius * m_.radius));
+    const double shadow = key_.dot(up_w_) > 0 && in_shadow(p, up_w_) ? 0.45 : 1.0;
+    return bg_lin_ * (1 - fade * (1 - 0.88 * shadow));
+  }
+  // Face f hit at barycentric (u, v), seen along dir.
+  Vector3d surface_at(int f, double u, double v, const Vector3d& dir) const {
+    const MatrixX3d& P = m_.P;
+    const Vector3d p = (1 - u - v) * P.row(F_(f, 0)) + u * P.row(F_(f, 1)) + v * P.row(F_(f, 2));
+    Vector3d ng = NF_.row(f);
     if (ng.squaredNorm() == 0) ng = -dir;
-    Vector3d n = (1 - u - v) * CN.row(3 * f) + u * CN.row(3 * f + 1) + v * CN.row(3 * f + 2);
+    Vector3d n = (1 - u - v) * CN_.row(3 * f) + u * CN_.row(3 * f + 1) + v * CN_.row(3 * f + 2);
     n = n.squaredNorm() > 1e-12 ? Vector3d(n.normalized()) : ng;
     const double side = ng.dot(dir) > 0 ? -1.0 : 1.0;  // back face: shade the side we see
     ng *= side;
     n *= side;
-    const double key_dot = std::max(0.0, n.dot(key));
+    const double key_dot = std::max(0.0, n.dot(key_));
     // Shadow rays start from p lifted onto the smooth surface the corner normals describe
     // (Hanika 2021, "Hacking the shadow terminator"), so the facets of a curved surface do not
     // shadow each other near the terminator. Where the true surface faces away from the light
     // the smooth normal fades the light out by itself, so occlusion is tested only where the
     // light can reach the geometry.
     double key_vis = 1;
-    if (key_dot > 0 && ng.dot(key) > 0) {
+    if (key_dot > 0 && ng.dot(key_) > 0) {
       Vector3d origin = p;
       const double b[3] = {1 - u - v, u, v};
       for (int k = 0; k < 3; ++k) {
-        const Vector3d nk = side * CN.row(3 * f + k);
-        origin -= b[k] * std::min(0.0, (p - P.row(F(f, k)).transpose()).dot(nk)) * nk;
+        const Vector3d nk = side * CN_.row(3 * f + k);
+        origin -= b[k] * std::min(0.0, (p - P.row(F_(f, k)).transpose()).dot(nk)) * nk;
       }
       key_vis = in_shadow(origin, ng) ? 0.0 : 1.0;
     }
-    const double head_dot = std::max(0.0, n.dot(head));
+    const double head_dot = std::max(0.0, n.dot(head_));
     const double rim = 0.12 * std::pow(1 - std::max(0.0, n.dot(-dir)), 3);
-    const Vector3d& a = albedo[face_component[f]];
+    const Vector3d& a = albedo_[face_component_[f]];
     return a * (0.05 + 0.85 * key_dot * key_vis + 0.22 * head_dot) + Vector3d::Constant(rim);
-  };
+  }
 
+  RTCScene scene_;
+  const CentredMesh& m_;
+  const MatrixX3i& F_;
+  const MatrixX3d &NF_, &CN_;
+  const std::vector<int>& face_component_;
+  const std::vector<Vector3d>& albedo_;
+  const Camera& cam_;
+  const RenderOptions& o_;
+  const Vector3d key_, head_, bg_lin_, up_w_;
+  const float eps_;
+  double ground_h_ = std::numeric_limits<double>::infinity();
+};
+
+// Every pixel the mean of its sub-pixel samples, rows in parallel.
+Image trace_image(const Shader& shader, const Camera& cam, const RenderOptions& o) {
+  const std::vector<Eigen::Vector2d> pattern = sample_pattern(o.samples_per_pixel);
   Image image;
   image.width = o.width;
   image.height = o.height;
@@ -365,7 +397,7 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
         for (const Eigen::Vector2d& s : pattern) {
           const double x = (2 * (px + s.x()) / o.width - 1) * cam.tan_half_w;
           const double y = (1 - 2 * (py + s.y()) / o.height) * cam.tan_half_h;
-          sum += shade((cam.forward + x * cam.right + y * cam.up).normalized());
+          sum += shader.shade((cam.forward + x * cam.right + y * cam.up).normalized());
         }
         sum /= static_cast<double>(pattern.size());
         unsigned char* out = &image.rgb[3 * (static_cast<size_t>(py) * o.width + px)];
@@ -373,6 +405,40 @@ Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
       }
   });
   return image;
+}
+
+}  // namespace
+
+void RenderOptions::validate() const {
+  MQ_CHECK(width >= 16 && width <= 8192 && height >= 16 && height <= 8192, InvalidInput,
+           "render: image size ", width, "x", height, " is outside [16, 8192]");
+  MQ_CHECK(samples_per_pixel >= 1 && samples_per_pixel <= 64, InvalidInput,
+           "render: samples per pixel ", samples_per_pixel, " is outside [1, 64]");
+  MQ_CHECK(fov_deg > 0 && fov_deg < 170, InvalidInput, "render: field of view ", fov_deg,
+           " degrees is outside (0, 170)");
+  MQ_CHECK(elevation_deg > -90 && elevation_deg < 90, InvalidInput, "render: elevation ",
+           elevation_deg, " degrees is outside (-90, 90)");
+  MQ_CHECK(std::isfinite(azimuth_deg), InvalidInput, "render: azimuth is not finite");
+  MQ_CHECK(up_axis >= 0 && up_axis <= 2, InvalidInput, "render: up axis ", up_axis,
+           " is not 0, 1 or 2");
+}
+
+Image render_mesh(const TriMesh& mesh, const RenderOptions& o) {
+  check_mesh(mesh);
+  o.validate();
+  const MatrixX3i& F = mesh.F;
+  const CentredMesh m = centred_mesh(mesh);
+  std::vector<int> face_component;
+  const int num_components = connected_components(F, mesh.num_vertices(), face_component);
+  const std::vector<char> smooth =
+      coherently_oriented(F, mesh.num_vertices(), face_component, num_components);
+  const MatrixX3d NF = face_normals(m.P, F);
+  const MatrixX3d CN = corner_normals(m.P, F, NF, face_component, smooth);
+  const std::vector<Vector3d> albedo = element_albedos(num_components, o);
+  const EmbreeScene scene = build_scene(m.P, F);
+  const Camera cam = frame_camera(m.P, m.referenced, o, m.radius);
+  const Shader shader(scene.scene.get(), m, F, NF, CN, face_component, albedo, cam, o);
+  return trace_image(shader, cam, o);
 }
 
 void write_png(const std::string& path, const Image& image) {

@@ -32,6 +32,9 @@ struct RenderOptions {
   int samples_per_pixel = 4;  // fixed sub-pixel pattern, in [1, 64]
   bool shadows = true;        // hard shadows from the key light
   bool ground_plane = false;  // shadow-catching floor under the object
+
+  // Throws InvalidInput for a size, sample count, angle or axis outside its range (above).
+  void validate() const;
 };
 
 // An 8-bit RGB image, rows top to bottom, rgb.size() == 3 * width * height.
@@ -47,9 +50,9 @@ struct Image {
 // 75 degrees; other elements are flat shaded. Rows are rendered in parallel (TBB); the bytes
 // are identical whatever the thread count.
 //   mesh  V #V by 3, F #F by 3 (N is ignored)
-// Throws InvalidInput for an empty mesh, a non-finite coordinate, an out-of-range index or an
-// option outside its documented range or element_colors of the wrong size; InternalError if Embree
-// cannot be initialised.
+// Throws InvalidInput for an empty mesh, a non-finite coordinate, an out-of-range index, an
+// option outside its documented range (options.validate()) or element_colors of the wrong size;
+// InternalError if Embree cannot be initialised.
 Image render_mesh(const TriMesh& mesh, const RenderOptions& options = {});
 
 // Writes an 8-bit RGB PNG atomically: to a temporary file beside path, then renamed over it.

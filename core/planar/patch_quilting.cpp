@@ -1,8 +1,11 @@
 #include "core/planar/patch_quilting.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <optional>
 
+#include "core/common/errors.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/planar/laplacian_deformation.h"
 
@@ -32,7 +35,245 @@ bool inside(const Element& e, const OverlapRegion& region) {
   return true;
 }
 
+// One patch in flight: the swatch's elements moved by t, the output elements near the patch
+// (frame, by local index; near: their output ids) and what steps 3 and 4 found between them.
+struct Patch {
+  std::vector<Element> moved;  // per swatch element
+  std::vector<Element> frame;  // per local index
+  std::vector<int> near;       // per local index
+  Correspondences corr;
+  std::vector<std::vector<int>> partners;  // per swatch element: local indices
+  std::vector<char> frame_inside;          // per local index: wholly in the overlap
+  std::vector<char> deform_in, deform_out;
+  std::map<int, Element> deformed_out;  // local index -> deformed copy
+};
+
+// Step 3 (section 2.5): the swatch moved by t and its correspondences with the output elements
+// near the patch.
+Patch find_patch_correspondences(const PatchOutput& output, const PreparedSwatch& swatch,
+                                 const SwatchQueries& queries, const Vector3d& t,
+                                 const OverlapRegion& region, const CorrespondenceOptions& options,
+                                 PatchCounts& counts) {
+  Patch patch;
+  patch.moved.resize(swatch.elements.size());
+  for (size_t i = 0; i < patch.moved.size(); ++i) {
+    patch.moved[i] = swatch.elements[i];
+    patch.moved[i].translate(t);
+  }
+  patch.near = output.elements_near(region.patch_lo(), region.patch_hi());
+  patch.frame.reserve(patch.near.size());
+  std::vector<int> local(patch.near.size());
+  for (size_t k = 0; k < patch.near.size(); ++k) {
+    patch.frame.push_back(output.element(patch.near[k]));
+    local[k] = static_cast<int>(k);
+  }
+  patch.corr = find_correspondences(patch.frame, local, region, swatch, queries.faces, t, options);
+  counts.pairs += static_cast<long long>(patch.corr.pairs.size());
+  counts.relations += static_cast<long long>(patch.corr.relations.size());
+  return patch;
+}
+
+// Partners of each swatch element. Relations carried by only a few pairs next to a strong one
+// come from elements that merely touch it (crossing threads of a weave, neighbouring rings):
+// they are not the same element and are ignored. A partner must also pair with at least
+// partner_share of the output element's vertices in the overlap region: the same element
+// placed again, not a neighbour it touches (a linked ring, a crossing thread).
+void find_partners(Patch& patch, const OverlapRegion& region, double partner_share) {
+  std::map<std::pair<int, int>, int> pair_count;
+  for (const VertexFacePair& p : patch.corr.pairs) ++pair_count[{p.out_element, p.in_element}];
+  std::vector<int> strongest(patch.moved.size(), 0);
+  for (const auto& [rel, n] : pair_count)
+    strongest[rel.second] = std::max(strongest[rel.second], n);
+  std::vector<int> region_vertices(patch.frame.size(), 0);
+  for (size_t k = 0; k < patch.frame.size(); ++k)
+    for (int v = 0; v < patch.frame[k].V.rows(); ++v)
+      region_vertices[k] += region.contains(patch.frame[k].V.row(v).transpose());
+  patch.partners.assign(patch.moved.size(), {});
+  for (const auto& [k, i] : patch.corr.relations)
+    if (4 * pair_count[{k, i}] >= strongest[i] &&
+        pair_count[{k, i}] >= partner_share * region_vertices[k])
+      patch.partners[i].push_back(k);
+}
+
+// Only elements that step 5 may merge need deforming: a swatch element with a live partner that
+// is not inside the overlap (inside ones are dropped), and an output element that is the one
+// crossing partner of such a swatch element (a stitch candidate). On chain mail most related
+// elements are dropped or kept, and deforming them all took as long as everything else. Also
+// marks which output elements lie wholly in the overlap (used here and by step 5).
+void choose_deformed(Patch& patch, const PatchOutput& output, const OverlapRegion& region) {
+  patch.frame_inside.resize(patch.frame.size());
+  for (size_t k = 0; k < patch.frame.size(); ++k)
+    patch.frame_inside[k] = inside(patch.frame[k], region);
+  patch.deform_in.assign(patch.moved.size(), 0);
+  patch.deform_out.assign(patch.frame.size(), 0);
+  for (size_t i = 0; i < patch.moved.size(); ++i) {
+    std::vector<int> crossing;
+    bool any = false;
+    for (const int k : patch.partners[i]) {
+      if (!output.alive(patch.near[k])) continue;
+      any = true;
+      if (!patch.frame_inside[k]) crossing.push_back(k);
+    }
+    if (!any || inside(patch.moved[i], region)) continue;
+    patch.deform_in[i] = 1;
+    if (crossing.size() == 1) patch.deform_out[crossing[0]] = 1;
+  }
+}
+
+// Step 4 (section 2.6): deforms both sides of every relation towards the averaged points. The
+// swatch elements are deformed in place, the output ones into patch.deformed_out.
+void deform_related(Patch& patch, const PreparedSwatch& swatch, const SwatchQueries& queries,
+                    const PatchQuiltingOptions& options) {
+  std::map<int, std::vector<LinearConstraint>> out_constraints, in_constraints;
+  for (const VertexFacePair& p : patch.corr.pairs) {
+    if (!patch.deform_out[p.out_element] && !patch.deform_in[p.in_element]) continue;
+    const Vector3d v = patch.frame[p.out_element].V.row(p.out_vertex).transpose();
+    const Vector3d target = 0.5 * (v + p.closest);
+    if (patch.deform_out[p.out_element])
+      out_constraints[p.out_element].push_back(LinearConstraint::point(p.out_vertex, target));
+    const auto& f = swatch.elements[p.in_element].F.row(p.in_face);
+    if (patch.deform_in[p.in_element])
+      in_constraints[p.in_element].push_back(
+          LinearConstraint::barycentric(f(0), f(1), f(2), p.barycentric, target));
+  }
+  if (!options.deform) return;
+  // Section 2.6 aligns elements where they correspond; the rest of a long element (a thread
+  // running far out of the overlap) is anchored so it does not swing.
+  auto anchored = [&](const Element& e, std::vector<LinearConstraint> cs) {
+    const auto anchors = anchor_far_vertices(e.V, e.F, cs, options.merging.deformation_rings);
+    cs.insert(cs.end(), anchors.begin(), anchors.end());
+    return cs;
+  };
+  std::vector<DeformationJob> jobs;
+  std::vector<std::pair<bool, int>> owners;  // (is output, index)
+  for (auto& [k, cs] : out_constraints) {
+    jobs.push_back({&patch.frame[k].V, &patch.frame[k].F, anchored(patch.frame[k], std::move(cs))});
+    owners.emplace_back(true, k);
+  }
+  for (auto& [i, cs] : in_constraints) {
+    jobs.push_back({&patch.moved[i].V, &patch.moved[i].F, anchored(patch.moved[i], std::move(cs))});
+    owners.emplace_back(false, i);
+  }
+  DeformationOptions d;
+  d.mu = options.merging.mu;
+  std::vector<MatrixX3d> solved = deform_elements(jobs, d, &queries.laplacians);
+  for (size_t j = 0; j < solved.size(); ++j) {
+    const auto [is_out, k] = owners[j];
+    Element& e = is_out ? patch.deformed_out[k] : patch.moved[k];
+    if (is_out) {
+      e.F = patch.frame[k].F;
+      e.kind = patch.frame[k].kind;
+    }
+    e.V = std::move(solved[j]);
+    e.update();
+  }
+}
+
+// Step 5 (section 2.7) for one patch: each admissible swatch element is added (no partner),
+// dropped (inside the overlap: the output has it), put in place of the partners wholly inside
+// the overlap, kept as its one crossing partner (the same element placed twice) or
+// cut-and-stitched with it; never so that two elements intersect.
+class PatchMerger {
+ public:
+  PatchMerger(PatchOutput& output, const Patch& patch, const OverlapRegion& region,
+              const SwatchQueries& queries, const MergeOptions& options, double mean_edge,
+              PatchCounts& counts)
+      : output_(output),
+        patch_(patch),
+        region_(region),
+        queries_(queries),
+        options_(options),
+        mean_edge_(mean_edge),
+        counts_(counts),
+        busy_(patch.frame.size(), 0) {}
+
+  // Merges swatch element i; false when it could not enter as it would intersect the output.
+  bool merge(size_t i) {
+    const Element& in = patch_.moved[i];
+    std::vector<int> related;  // local indices
+    for (const int k : patch_.partners[i])
+      if (output_.alive(patch_.near[k])) related.push_back(k);
+    if (related.empty()) return replace(in, {});  // no partner: added as it is, if it fits
+    if (inside(in, region_)) {
+      ++counts_.dropped;  // the output already has this element
+      return true;
+    }
+    std::vector<int> replaced, crossing;
+    for (const int k : related)
+      (patch_.frame_inside[k] && !busy_[k] ? replaced : crossing).push_back(k);
+    std::vector<int> replaced_ids;
+    for (const int k : replaced) replaced_ids.push_back(patch_.near[k]);
+    if (crossing.empty()) return replace(in, replaced_ids);
+    if (crossing.size() != 1 || busy_[crossing[0]]) {
+      ++counts_.dropped;
+      return true;
+    }
+    stitch(in, crossing[0], replaced_ids);
+    return true;
+  }
+
+ private:
+  // Adds `in` in place of the output elements `ids` (none: a plain addition) if it fits.
+  bool replace(const Element& in, const std::vector<int>& ids) {
+    if (!fits(output_, in, ids)) {
+      ++counts_.rejected_intersecting;
+      return false;
+    }
+    for (const int id : ids) output_.remove(id);
+    output_.add(in);
+    if (ids.empty())
+      ++counts_.added;
+    else
+      counts_.replaced += static_cast<int>(ids.size());
+    return true;
+  }
+  // Joins `in` with its crossing partner k (local index), whose place it takes with the
+  // partners in `replaced_ids`; or keeps the output's element.
+  void stitch(const Element& in, int k, const std::vector<int>& replaced_ids) {
+    // Output elements take their deformed shape once they are merged with a partner.
+    const auto it = patch_.deformed_out.find(k);
+    const Element& base = it == patch_.deformed_out.end() ? patch_.frame[k] : it->second;
+    // The same element placed twice (nearly identical, or mostly the same footprint, as for two
+    // apples slightly apart): keep the output one rather than stitching two halves.
+    if (elements_coincide(base, in, options_.coincidence_tolerance * mean_edge_,
+                          &queries_.embree) ||
+        footprint_overlap(base, in, mean_edge_) >= options_.same_element_overlap) {
+      ++counts_.matched;
+      busy_[k] = 1;
+      return;
+    }
+    StitchFailure why = StitchFailure::None;
+    std::optional<Element> joined =
+        cut_and_stitch(base, in, region_, mean_edge_, options_, &why, &queries_.embree);
+    std::vector<int> ignore = replaced_ids;
+    ignore.push_back(patch_.near[k]);
+    if (joined && fits(output_, *joined, ignore)) {
+      for (const int id : replaced_ids) output_.remove(id);
+      output_.replace(patch_.near[k], std::move(*joined));
+      busy_[k] = 1;
+      ++counts_.stitched;
+    } else {
+      ++counts_.stitch_fallbacks;
+      ++counts_.stitch_failures[static_cast<int>(joined ? StitchFailure::None : why)];
+    }
+  }
+
+  PatchOutput& output_;
+  const Patch& patch_;
+  const OverlapRegion& region_;
+  const SwatchQueries& queries_;
+  const MergeOptions& options_;
+  const double mean_edge_;
+  PatchCounts& counts_;
+  std::vector<char> busy_;  // per local index: already merged with a swatch element
+};
+
 }  // namespace
+
+void PatchQuiltingOptions::validate() const {
+  MQ_CHECK(std::isfinite(partner_share) && partner_share >= 0 && partner_share <= 1, InvalidInput,
+           "patch quilting: partner_share must lie in [0, 1], got ", partner_share);
+}
 
 void accumulate(PatchCounts& a, const PatchCounts& b) {
   a.pairs += b.pairs;
@@ -58,200 +299,26 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
                  const std::function<bool(const Element&)>& admissible,
                  const PatchQuiltingOptions& options, PatchCounts& counts, StageTimes& times,
                  std::vector<int>* rejected) {
+  options.validate();
   if (rejected) rejected->clear();
-  const double mean_edge = swatch.mean_edge_length;
-  // Step 3 (section 2.5): correspondences in the overlapping region.
-  Correspondences corr;
-  std::vector<Element> moved(swatch.elements.size());
-  std::vector<Element> frame;  // output elements near the patch, indexed like `near`
-  std::vector<int> near;
+  Patch patch;
   {
     ScopedStageTimer timer(times, "correspondence");
-    for (size_t i = 0; i < moved.size(); ++i) {
-      moved[i] = swatch.elements[i];
-      moved[i].translate(t);
-    }
-    near = output.elements_near(region.patch_lo(), region.patch_hi());
-    frame.reserve(near.size());
-    std::vector<int> local(near.size());
-    for (size_t k = 0; k < near.size(); ++k) {
-      frame.push_back(output.element(near[k]));
-      local[k] = static_cast<int>(k);
-    }
-    corr = find_correspondences(frame, local, region, swatch, queries.faces, t,
-                                options.correspondence);
-    counts.pairs += static_cast<long long>(corr.pairs.size());
-    counts.relations += static_cast<long long>(corr.relations.size());
+    patch = find_patch_correspondences(output, swatch, queries, t, region, options.correspondence,
+                                       counts);
   }
-
-  // Partners of each swatch element. Relations carried by only a few pairs next to a strong one
-  // come from elements that merely touch it (crossing threads of a weave, neighbouring rings):
-  // they are not the same element and are ignored.
-  std::map<std::pair<int, int>, int> pair_count;
-  for (const VertexFacePair& p : corr.pairs) ++pair_count[{p.out_element, p.in_element}];
-  std::vector<int> strongest(moved.size(), 0);
-  for (const auto& [rel, n] : pair_count)
-    strongest[rel.second] = std::max(strongest[rel.second], n);
-  // A partner must also pair with at least partner_share of the output element's vertices in
-  // the overlap region: the same element placed again, not a neighbour it touches (a linked
-  // ring, a crossing thread).
-  std::vector<int> region_vertices(frame.size(), 0);
-  for (size_t k = 0; k < frame.size(); ++k)
-    for (int v = 0; v < frame[k].V.rows(); ++v)
-      region_vertices[k] += region.contains(frame[k].V.row(v).transpose());
-  std::vector<std::vector<int>> partners(moved.size());
-  for (const auto& [k, i] : corr.relations)
-    if (4 * pair_count[{k, i}] >= strongest[i] &&
-        pair_count[{k, i}] >= options.partner_share * region_vertices[k])
-      partners[i].push_back(k);
-
-  // Only elements that step 5 may merge need deforming: a swatch element with a live partner that
-  // is not inside the overlap (inside ones are dropped), and an output element that is the one
-  // crossing partner of such a swatch element (a stitch candidate). On chain mail most related
-  // elements are dropped or kept, and deforming them all took as long as everything else.
-  // Which output elements lie wholly in the overlap (used here and by step 5).
-  std::vector<char> frame_inside(frame.size());
-  for (size_t k = 0; k < frame.size(); ++k) frame_inside[k] = inside(frame[k], region);
-  std::vector<char> deform_in(moved.size(), 0), deform_out(frame.size(), 0);
-  for (size_t i = 0; i < moved.size(); ++i) {
-    std::vector<int> crossing;
-    bool any = false;
-    for (const int k : partners[i]) {
-      if (!output.alive(near[k])) continue;
-      any = true;
-      if (!frame_inside[k]) crossing.push_back(k);
-    }
-    if (!any || inside(moved[i], region)) continue;
-    deform_in[i] = 1;
-    if (crossing.size() == 1) deform_out[crossing[0]] = 1;
-  }
-
-  // Step 4 (section 2.6): deform both sides of every relation towards the averaged points.
-  std::map<int, Element> deformed_out;  // local index -> deformed copy
+  find_partners(patch, region, options.partner_share);
+  choose_deformed(patch, output, region);
   {
     ScopedStageTimer timer(times, "deformation");
-    std::map<int, std::vector<LinearConstraint>> out_constraints, in_constraints;
-    for (const VertexFacePair& p : corr.pairs) {
-      if (!deform_out[p.out_element] && !deform_in[p.in_element]) continue;
-      const Vector3d v = frame[p.out_element].V.row(p.out_vertex).transpose();
-      const Vector3d target = 0.5 * (v + p.closest);
-      if (deform_out[p.out_element])
-        out_constraints[p.out_element].push_back(LinearConstraint::point(p.out_vertex, target));
-      const auto& f = swatch.elements[p.in_element].F.row(p.in_face);
-      if (deform_in[p.in_element])
-        in_constraints[p.in_element].push_back(
-            LinearConstraint::barycentric(f(0), f(1), f(2), p.barycentric, target));
-    }
-    if (options.deform) {
-      // Section 2.6 aligns elements where they correspond; the rest of a long element (a thread
-      // running far out of the overlap) is anchored so it does not swing.
-      auto anchored = [&](const Element& e, std::vector<LinearConstraint> cs) {
-        const auto anchors = anchor_far_vertices(e.V, e.F, cs, options.merging.deformation_rings);
-        cs.insert(cs.end(), anchors.begin(), anchors.end());
-        return cs;
-      };
-      std::vector<DeformationJob> jobs;
-      std::vector<std::pair<bool, int>> owners;  // (is output, index)
-      for (auto& [k, cs] : out_constraints) {
-        jobs.push_back({&frame[k].V, &frame[k].F, anchored(frame[k], std::move(cs))});
-        owners.emplace_back(true, k);
-      }
-      for (auto& [i, cs] : in_constraints) {
-        jobs.push_back({&moved[i].V, &moved[i].F, anchored(moved[i], std::move(cs))});
-        owners.emplace_back(false, i);
-      }
-      DeformationOptions d;
-      d.mu = options.merging.mu;
-      std::vector<MatrixX3d> solved = deform_elements(jobs, d, &queries.laplacians);
-      for (size_t j = 0; j < solved.size(); ++j) {
-        const auto [is_out, k] = owners[j];
-        Element& e = is_out ? deformed_out[k] : moved[k];
-        if (is_out) {
-          e.F = frame[k].F;
-          e.kind = frame[k].kind;
-        }
-        e.V = std::move(solved[j]);
-        e.update();
-      }
-    }
+    deform_related(patch, swatch, queries, options);
   }
-
-  // Step 5 (section 2.7): merge.
   ScopedStageTimer timer(times, "merging");
-  // Output elements take their deformed shape once they are merged with a partner.
-  auto current = [&](int k) -> const Element& {
-    auto it = deformed_out.find(k);
-    return it == deformed_out.end() ? frame[k] : it->second;
-  };
-  std::vector<char> busy(frame.size(), 0);
-  for (size_t i = 0; i < moved.size(); ++i) {
-    const Element& in = moved[i];
-    if (!admissible(in)) {
-      if (rejected) rejected->push_back(static_cast<int>(i));
-      continue;
-    }
-    std::vector<int> related;  // local indices
-    for (const int k : partners[i])
-      if (output.alive(near[k])) related.push_back(k);
-    if (related.empty()) {
-      // No partner: added as it is (if it fits among the existing elements).
-      if (fits(output, in, {})) {
-        output.add(in);
-        ++counts.added;
-      } else {
-        ++counts.rejected_intersecting;
-        if (rejected) rejected->push_back(static_cast<int>(i));
-      }
-      continue;
-    }
-    if (inside(in, region)) {
-      ++counts.dropped;  // the output already has this element
-      continue;
-    }
-    std::vector<int> replaced, crossing;
-    for (const int k : related) (frame_inside[k] && !busy[k] ? replaced : crossing).push_back(k);
-    std::vector<int> replaced_ids;
-    for (const int k : replaced) replaced_ids.push_back(near[k]);
-    if (crossing.empty()) {
-      if (fits(output, in, replaced_ids)) {
-        for (const int id : replaced_ids) output.remove(id);
-        output.add(in);
-        counts.replaced += static_cast<int>(replaced.size());
-      } else {
-        ++counts.rejected_intersecting;
-        if (rejected) rejected->push_back(static_cast<int>(i));
-      }
-      continue;
-    }
-    if (crossing.size() != 1 || busy[crossing[0]]) {
-      ++counts.dropped;
-      continue;
-    }
-    const int k = crossing[0];
-    const Element& base = current(k);
-    // The same element placed twice (nearly identical, or mostly the same footprint, as for two
-    // apples slightly apart): keep the output one rather than stitching two halves.
-    if (elements_coincide(base, in, options.merging.coincidence_tolerance * mean_edge,
-                          &queries.embree) ||
-        footprint_overlap(base, in, mean_edge) >= options.merging.same_element_overlap) {
-      ++counts.matched;
-      busy[k] = 1;
-      continue;
-    }
-    StitchFailure why = StitchFailure::None;
-    std::optional<Element> joined =
-        cut_and_stitch(base, in, region, mean_edge, options.merging, &why, &queries.embree);
-    std::vector<int> ignore = replaced_ids;
-    ignore.push_back(near[k]);
-    if (joined && fits(output, *joined, ignore)) {
-      for (const int id : replaced_ids) output.remove(id);
-      output.replace(near[k], std::move(*joined));
-      busy[k] = 1;
-      ++counts.stitched;
-    } else {
-      ++counts.stitch_fallbacks;
-      ++counts.stitch_failures[static_cast<int>(joined ? StitchFailure::None : why)];
-    }
+  PatchMerger merger(output, patch, region, queries, options.merging, swatch.mean_edge_length,
+                     counts);
+  for (size_t i = 0; i < patch.moved.size(); ++i) {
+    const bool entered = admissible(patch.moved[i]) && merger.merge(i);
+    if (!entered && rejected) rejected->push_back(static_cast<int>(i));
   }
 }
 

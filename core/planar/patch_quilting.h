@@ -41,6 +41,9 @@ struct PatchQuiltingOptions {
   // --detail 16 3x3 3% at 0, 83% at 0.3, 100% at 0.5 and 0.7; plain weave 26 x 26 unchanged
   // (97 threads at 0 and 0.5, 101 at 0.7).
   double partner_share = 0.5;
+
+  // Throws InvalidInput unless partner_share lies in [0, 1].
+  void validate() const;
 };
 
 // What one patch did, added to running totals by the caller.
@@ -72,6 +75,8 @@ LaplacianTopologyCache swatch_topologies(const PreparedSwatch& swatch);
 // only ever added or changed so that no two of them intersect. Times go to the stages
 // "correspondence", "deformation" and "merging". `rejected`, when given, receives the indices
 // of the swatch elements that could not enter: not admissible, or intersecting the output.
+// Throws InvalidInput when options.validate() does, and what the deformation throws
+// (deform_elements: InvalidInput, SolverFailure).
 void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const SwatchQueries& queries,
                  const Vector3d& t, const OverlapRegion& region,
                  const std::function<bool(const Element&)>& admissible,

@@ -83,14 +83,9 @@ class OutputStore final : public PatchOutput {
   std::vector<std::vector<int>> cells_;
 };
 
-void validate(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
-  MQ_CHECK(std::isfinite(o.length) && std::isfinite(o.width) && o.length > 0 && o.width > 0,
-           InvalidInput, "the output size must be positive and finite, got ", o.length, " x ",
-           o.width);
-  MQ_CHECK(o.cell_size == 0 || (std::isfinite(o.cell_size) && o.cell_size > 0), InvalidInput,
-           "the cell size must be positive, got ", o.cell_size);
-  MQ_CHECK(o.subpatch_fraction > 0 && o.subpatch_fraction <= 1, InvalidInput,
-           "the sub-patch fraction must lie in (0, 1], got ", o.subpatch_fraction);
+// The checks of the options against the swatch: some element fits the domain, and the output
+// is not estimated too large to make.
+void check_against_swatch(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
   double smallest = std::numeric_limits<double>::infinity();
   for (const Element& e : s.elements)
     smallest = std::min(smallest, std::max(e.hi.x() - e.lo.x(), e.hi.y() - e.lo.y()));
@@ -104,7 +99,212 @@ void validate(const PreparedSwatch& s, const PlanarQuiltingOptions& o) {
            o.max_faces, " (--max-faces); choose a smaller size");
 }
 
+// The grid cell (section 2.3): given or matching_cell_size's. The grid and the swatch in cells
+// bound the memory of the grid and the offsets each match searches (every swatch cell is a
+// candidate offset): the default cell gives at most a few hundred thousand and a few hundred.
+double grid_cell(const PreparedSwatch& swatch, const PlanarQuiltingOptions& options) {
+  const double cell = options.cell_size > 0 ? options.cell_size : matching_cell_size(swatch);
+  MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ", cell,
+           " is larger than the swatch's footprint");
+  const double cells_estimate = std::ceil(options.length / cell) * std::ceil(options.width / cell);
+  MQ_CHECK(cells_estimate <= double(1 << 24), InvalidInput, "the grid would have ", cells_estimate,
+           " cells of size ", cell, " (at most ", 1 << 24, "); use a larger --cell");
+  const double swatch_cells =
+      std::floor(swatch.size.x() / cell) * std::floor(swatch.size.y() / cell);
+  MQ_CHECK(swatch_cells <= double(1 << 16), InvalidInput, "a cell of ", cell,
+           " divides the swatch into ", swatch_cells, " cells (at most ", 1 << 16,
+           "), too many offsets to match; use a larger --cell");
+  return cell;
+}
+
+// One run of planar quilting (section 2): the grid of cells, the swatch's queries and the
+// growing output, patch by patch from the first at the origin.
+class PlaneQuilter {
+ public:
+  PlaneQuilter(const PreparedSwatch& swatch, const PlanarQuiltingOptions& options, double cell,
+               TranslationCostEvaluator& evaluator, PlanarQuiltingStats& stats)
+      : swatch_(swatch),
+        options_(options),
+        cell_(cell),
+        evaluator_(evaluator),
+        stats_(stats),
+        grid_(Vector2d::Zero(), cell, static_cast<int>(std::ceil(options.length / cell)),
+              static_cast<int>(std::ceil(options.width / cell))),
+        domain_hi_(options.length, options.width),
+        output_(grid_),
+        rng_(options.seed) {
+    stats.cell_size = cell;
+    stats.grid_nx = grid_.nx();
+    stats.grid_ny = grid_.ny();
+    patch_options_.correspondence = options.correspondence;
+    patch_options_.merging = options.merging;
+    patch_options_.deform = options.deform;
+    in_domain_ = [this](const Element& e) {
+      return e.hi.x() > domain_lo_.x() && e.lo.x() < domain_hi_.x() && e.hi.y() > domain_lo_.y() &&
+             e.lo.y() < domain_hi_.y();
+    };
+  }
+
+  SynthesisGrid& grid() { return grid_; }
+
+  // The swatch's face tree and Laplacian topologies, and the side of the matched sub-patch.
+  void prepare_queries() {
+    const int cells_x = static_cast<int>(std::floor(swatch_.size.x() / cell_ + 1e-9));
+    const int cells_y = static_cast<int>(std::floor(swatch_.size.y() / cell_ + 1e-9));
+    window_ = std::max(
+        1, std::min({static_cast<int>(options_.subpatch_fraction * std::min(cells_x, cells_y)),
+                     cells_x, cells_y}));
+    ScopedStageTimer timer(stats_.times, "prepare");
+    swatch_tree_ = std::make_unique<SwatchFaceTree>(swatch_.mesh.V, swatch_.mesh.F);
+    laplacians_ = swatch_topologies(swatch_);
+    // The swatch must be able to shift by a period of its texture and still cover the
+    // sub-patch, or no placement continues a lattice: the range of offsets (swatch cells minus
+    // window) is kept at least a period along each axis. Half the 3 x 3 chain mail sheet left
+    // 2.37 of its 2.5 period along x: a 20 x 20 plane had 93% of interior rings with their 4
+    // links, 100% with this bound.
+    const Vector2d period = axis_periods(swatch_, *swatch_tree_, cell_);
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!(period(axis) > 0)) continue;
+      const int cells = axis == 0 ? cells_x : cells_y;
+      window_ = std::max(
+          1, std::min(window_, cells - static_cast<int>(std::ceil(period(axis) / cell_ - 1e-9))));
+    }
+    stats_.window_cells = window_;
+  }
+
+  // First patch: the swatch as it is, at the origin.
+  void place_first_patch() {
+    ScopedStageTimer timer(stats_.times, "merging");
+    for (const Element& e : swatch_.elements)
+      if (in_domain_(e)) {
+        output_.add(e);
+        ++stats_.counts.added;
+      }
+    mark_patch(Vector2d::Zero(), swatch_.size.head<2>());
+    stats_.iterations = 1;
+  }
+
+  // One patch at a seed cell: step 2 (section 2.4) places the swatch, steps 3-5 (sections
+  // 2.5-2.7) merge it.
+  void quilt_at(const Cell& seed) {
+    ++stats_.iterations;
+    const Vector3d t = match_at(seed);
+    const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch_.size.head<2>();
+    const OverlapRegion region(patch_lo, patch_hi, grid_.processed_snapshot());
+    const SwatchQueries queries{*swatch_tree_, embree_, laplacians_};
+    quilt_patch(output_, swatch_, queries, t, region, in_domain_, patch_options_, stats_.counts,
+                stats_.times);
+    mark_patch(patch_lo, patch_hi);
+    grid_.set_processed(seed);  // progress is guaranteed even if the patch is clipped
+  }
+
+  // Post-processing: elements outside the domain go; border elements stay whole unless
+  // trimmed (into `trimmed`, which the result points into).
+  std::vector<const Element*> keep_in_domain(std::vector<Element>& trimmed) {
+    ScopedStageTimer timer(stats_.times, "post-processing");
+    std::vector<const Element*> kept;
+    trimmed.reserve(output_.size());
+    for (int id = 0; id < output_.size(); ++id) {
+      if (!output_.alive(id)) continue;
+      const Element& e = output_[id];
+      if (!in_domain_(e)) {
+        ++stats_.removed_post;
+        continue;
+      }
+      const bool crosses = e.lo.x() < domain_lo_.x() || e.lo.y() < domain_lo_.y() ||
+                           e.hi.x() > domain_hi_.x() || e.hi.y() > domain_hi_.y();
+      if (options_.trim_border && crosses) {
+        trimmed.push_back(trimmed_to_domain(e));
+        ++stats_.trimmed;
+        continue;
+      }
+      kept.push_back(&e);
+    }
+    for (const Element& e : trimmed) kept.push_back(&e);
+    return kept;
+  }
+
+ private:
+  // Step 2 (section 2.4): the sub-patch around the seed, the admissible offsets and the one
+  // chosen among the cheapest.
+  Vector3d match_at(const Cell& seed) {
+    const int half = window_ / 2;
+    const int px0 = std::max(0, std::min(seed.x - half, grid_.nx() - window_));
+    const int py0 = std::max(0, std::min(seed.y - half, grid_.ny() - window_));
+    const int px1 = std::min(grid_.nx(), px0 + window_) - 1,
+              py1 = std::min(grid_.ny(), py0 + window_) - 1;
+    const Vector2d sub_lo(px0 * cell_, py0 * cell_), sub_hi((px1 + 1) * cell_, (py1 + 1) * cell_);
+    const Vector2d t_min = sub_hi - swatch_.size.head<2>(), t_max = sub_lo;
+    ScopedStageTimer timer(stats_.times, "matching");
+    std::vector<const Element*> near;
+    for (const int id : output_.query(sub_lo, sub_hi)) near.push_back(&output_[id]);
+    MatrixX3d P, NP;
+    gather_subpatch(near, sub_lo, sub_hi, options_.match_points, P, NP);
+    const MatrixX3d T = whole_cell_offsets(t_min, t_max, cell_);
+    MatchingOptions matching = options_.matching;
+    matching.lambda = options_.matching.lambda / cell_;  // distances in cells (scale invariant)
+    const OffsetChoice choice =
+        choose_offset(*swatch_tree_, evaluator_, P, NP, T, t_min, t_max, cell_, matching, rng_);
+    stats_.matched_point_offsets += choice.point_offsets;
+    return choice.offset;
+  }
+
+  // Marks the cells lying entirely inside the patch footprint [lo, hi].
+  void mark_patch(const Vector2d& lo, const Vector2d& hi) {
+    const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x() / cell_ - 1e-9)));
+    const int y0 = std::max(0, static_cast<int>(std::ceil(lo.y() / cell_ - 1e-9)));
+    const int x1 = std::min(grid_.nx(), static_cast<int>(std::floor(hi.x() / cell_ + 1e-9)));
+    const int y1 = std::min(grid_.ny(), static_cast<int>(std::floor(hi.y() / cell_ + 1e-9)));
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) grid_.set_processed({x, y});
+  }
+
+  // The faces of e whose centroids lie in the domain, as an element of its own.
+  Element trimmed_to_domain(const Element& e) const {
+    std::vector<int> faces;
+    for (int f = 0; f < e.F.rows(); ++f) {
+      const Vector3d c =
+          (e.V.row(e.F(f, 0)) + e.V.row(e.F(f, 1)) + e.V.row(e.F(f, 2))).transpose() / 3.0;
+      if (c.x() >= domain_lo_.x() && c.y() >= domain_lo_.y() && c.x() <= domain_hi_.x() &&
+          c.y() <= domain_hi_.y())
+        faces.push_back(f);
+    }
+    const TriMesh part = extract_faces(e.mesh(), faces);
+    Element t;
+    t.V = part.V;
+    t.F = part.F;
+    t.kind = e.kind;
+    t.update();
+    return t;
+  }
+
+  const PreparedSwatch& swatch_;
+  const PlanarQuiltingOptions& options_;
+  const double cell_;
+  TranslationCostEvaluator& evaluator_;
+  PlanarQuiltingStats& stats_;
+  SynthesisGrid grid_;
+  const Vector2d domain_lo_ = Vector2d::Zero(), domain_hi_;
+  int window_ = 1;  // side of the matched sub-patch, in cells
+  std::unique_ptr<SwatchFaceTree> swatch_tree_;
+  const EmbreeDevice embree_;  // for the merging's temporary BVHs
+  LaplacianTopologyCache laplacians_;
+  OutputStore output_;
+  std::mt19937_64 rng_;
+  PatchQuiltingOptions patch_options_;
+  std::function<bool(const Element&)> in_domain_;
+};
+
 }  // namespace
+
+void PlanarQuiltingOptions::validate() const {
+  MQ_CHECK(std::isfinite(length) && std::isfinite(width) && length > 0 && width > 0, InvalidInput,
+           "the output size must be positive and finite, got ", length, " x ", width);
+  MQ_CHECK(cell_size == 0 || (std::isfinite(cell_size) && cell_size > 0), InvalidInput,
+           "the cell size must be positive, got ", cell_size);
+  MQ_CHECK(subpatch_fraction > 0 && subpatch_fraction <= 1, InvalidInput,
+           "the sub-patch fraction must lie in (0, 1], got ", subpatch_fraction);
+}
 
 double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width) {
   const double sx = swatch.size.x(), sy = swatch.size.y();
@@ -123,168 +323,26 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
                     TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats_out,
                     ProgressSink* progress) {
   PlanarQuiltingStats stats;
-  StageTimes& times = stats.times;
   PreparedSwatch swatch;
   {
-    ScopedStageTimer timer(times, "prepare");
+    ScopedStageTimer timer(stats.times, "prepare");
     swatch = prepare_swatch(swatch_mesh);
-    validate(swatch, options);
+    // After the swatch, so that a bad swatch is what a job with both wrong is refused for.
+    options.validate();
+    check_against_swatch(swatch, options);
   }
-  const double cell = options.cell_size > 0 ? options.cell_size : matching_cell_size(swatch);
-  MQ_CHECK(cell <= std::min(swatch.size.x(), swatch.size.y()), InvalidInput, "the cell size ", cell,
-           " is larger than the swatch's footprint");
-  // The grid and the swatch in cells bound the memory of the grid and the offsets each match
-  // searches (every swatch cell is a candidate offset): the default cell gives at most a few
-  // hundred thousand and a few hundred.
-  const double cells_estimate = std::ceil(options.length / cell) * std::ceil(options.width / cell);
-  MQ_CHECK(cells_estimate <= double(1 << 24), InvalidInput, "the grid would have ", cells_estimate,
-           " cells of size ", cell, " (at most ", 1 << 24, "); use a larger --cell");
-  const double swatch_cells =
-      std::floor(swatch.size.x() / cell) * std::floor(swatch.size.y() / cell);
-  MQ_CHECK(swatch_cells <= double(1 << 16), InvalidInput, "a cell of ", cell,
-           " divides the swatch into ", swatch_cells, " cells (at most ", 1 << 16,
-           "), too many offsets to match; use a larger --cell");
-  SynthesisGrid grid(Vector2d::Zero(), cell, static_cast<int>(std::ceil(options.length / cell)),
-                     static_cast<int>(std::ceil(options.width / cell)));
-  stats.cell_size = cell;
-  stats.grid_nx = grid.nx();
-  stats.grid_ny = grid.ny();
-  const int swatch_cells_x = static_cast<int>(std::floor(swatch.size.x() / cell + 1e-9));
-  const int swatch_cells_y = static_cast<int>(std::floor(swatch.size.y() / cell + 1e-9));
-  // The swatch must be able to shift by a period of its texture and still cover the
-  // sub-patch, or no placement continues a lattice: the range of offsets (swatch cells minus
-  // window) is kept at least a period along each axis. Half the 3 x 3 chain mail sheet left
-  // 2.37 of its 2.5 period along x: a 20 x 20 plane had 93% of interior rings with their 4
-  // links, 100% with this bound.
-  int window = std::max(1, std::min({static_cast<int>(options.subpatch_fraction *
-                                                      std::min(swatch_cells_x, swatch_cells_y)),
-                                     swatch_cells_x, swatch_cells_y}));
-  const Vector2d domain_lo(0, 0), domain_hi(options.length, options.width);
-
-  std::unique_ptr<SwatchFaceTree> swatch_tree;
-  const EmbreeDevice embree;  // for the merging's temporary BVHs
-  LaplacianTopologyCache laplacians;
-  {
-    ScopedStageTimer timer(times, "prepare");
-    swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
-    laplacians = swatch_topologies(swatch);
-    const Vector2d period = axis_periods(swatch, *swatch_tree, cell);
-    for (int axis = 0; axis < 2; ++axis) {
-      if (!(period(axis) > 0)) continue;
-      const int cells = axis == 0 ? swatch_cells_x : swatch_cells_y;
-      window = std::max(
-          1, std::min(window, cells - static_cast<int>(std::ceil(period(axis) / cell - 1e-9))));
-    }
-    stats.window_cells = window;
-  }
-  const SwatchQueries queries{*swatch_tree, embree, laplacians};
-  OutputStore output(grid);
-  std::mt19937_64 rng(options.seed);
-
-  const std::function<bool(const Element&)> in_domain = [&](const Element& e) {
-    return e.hi.x() > domain_lo.x() && e.lo.x() < domain_hi.x() && e.hi.y() > domain_lo.y() &&
-           e.lo.y() < domain_hi.y();
-  };
-  PatchQuiltingOptions patch_options;
-  patch_options.correspondence = options.correspondence;
-  patch_options.merging = options.merging;
-  patch_options.deform = options.deform;
-  // Marks the cells lying entirely inside the patch footprint [lo, hi].
-  auto mark_patch = [&](const Vector2d& lo, const Vector2d& hi) {
-    const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x() / cell - 1e-9)));
-    const int y0 = std::max(0, static_cast<int>(std::ceil(lo.y() / cell - 1e-9)));
-    const int x1 = std::min(grid.nx(), static_cast<int>(std::floor(hi.x() / cell + 1e-9)));
-    const int y1 = std::min(grid.ny(), static_cast<int>(std::floor(hi.y() / cell + 1e-9)));
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) grid.set_processed({x, y});
-  };
-
-  // First patch: the swatch as it is, at the origin.
-  {
-    ScopedStageTimer timer(times, "merging");
-    for (const Element& e : swatch.elements)
-      if (in_domain(e)) {
-        output.add(e);
-        ++stats.counts.added;
-      }
-    mark_patch(Vector2d::Zero(), swatch.size.head<2>());
-    stats.iterations = 1;
-  }
+  PlaneQuilter quilter(swatch, options, grid_cell(swatch, options), evaluator, stats);
+  quilter.prepare_queries();
+  quilter.place_first_patch();
+  SynthesisGrid& grid = quilter.grid();
   report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
-
   Cell seed;
   while (grid.next_seed(seed)) {
-    ++stats.iterations;
-    // Step 2 (section 2.4): the sub-patch around the seed and the admissible offsets.
-    const int half = window / 2;
-    const int px0 = std::max(0, std::min(seed.x - half, grid.nx() - window));
-    const int py0 = std::max(0, std::min(seed.y - half, grid.ny() - window));
-    const int px1 = std::min(grid.nx(), px0 + window) - 1,
-              py1 = std::min(grid.ny(), py0 + window) - 1;
-    const Vector2d sub_lo(px0 * cell, py0 * cell), sub_hi((px1 + 1) * cell, (py1 + 1) * cell);
-    const Vector2d t_min = sub_hi - swatch.size.head<2>(), t_max = sub_lo;
-    OffsetChoice choice;
-    {
-      ScopedStageTimer timer(times, "matching");
-      std::vector<const Element*> near;
-      for (const int id : output.query(sub_lo, sub_hi)) near.push_back(&output[id]);
-      MatrixX3d P, NP;
-      gather_subpatch(near, sub_lo, sub_hi, options.match_points, P, NP);
-      const MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
-      MatchingOptions matching = options.matching;
-      matching.lambda = options.matching.lambda / cell;  // distances in cells (scale invariant)
-      choice = choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
-      stats.matched_point_offsets += choice.point_offsets;
-    }
-    const Vector3d t = choice.offset;
-    const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
-    const OverlapRegion region(patch_lo, patch_hi, grid.processed_snapshot());
-
-    // Steps 3-5 (sections 2.5-2.7): correspondences, deformation, merging.
-    quilt_patch(output, swatch, queries, t, region, in_domain, patch_options, stats.counts, times);
-    mark_patch(patch_lo, patch_hi);
-    grid.set_processed(seed);  // progress is guaranteed even if the patch is clipped
+    quilter.quilt_at(seed);
     report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
   }
-
-  // Post-processing: elements outside the domain go; border elements stay whole unless trimmed.
-  std::vector<const Element*> kept;
   std::vector<Element> trimmed;
-  {
-    ScopedStageTimer timer(times, "post-processing");
-    trimmed.reserve(output.size());
-    for (int id = 0; id < output.size(); ++id) {
-      if (!output.alive(id)) continue;
-      const Element& e = output[id];
-      if (!in_domain(e)) {
-        ++stats.removed_post;
-        continue;
-      }
-      const bool crosses = e.lo.x() < domain_lo.x() || e.lo.y() < domain_lo.y() ||
-                           e.hi.x() > domain_hi.x() || e.hi.y() > domain_hi.y();
-      if (options.trim_border && crosses) {
-        std::vector<int> faces;
-        for (int f = 0; f < e.F.rows(); ++f) {
-          const Vector3d c =
-              (e.V.row(e.F(f, 0)) + e.V.row(e.F(f, 1)) + e.V.row(e.F(f, 2))).transpose() / 3.0;
-          if (c.x() >= domain_lo.x() && c.y() >= domain_lo.y() && c.x() <= domain_hi.x() &&
-              c.y() <= domain_hi.y())
-            faces.push_back(f);
-        }
-        const TriMesh part = extract_faces(e.mesh(), faces);
-        Element t;
-        t.V = part.V;
-        t.F = part.F;
-        t.kind = e.kind;
-        t.update();
-        trimmed.push_back(std::move(t));
-        ++stats.trimmed;
-        continue;
-      }
-      kept.push_back(&e);
-    }
-    for (const Element& e : trimmed) kept.push_back(&e);
-  }
+  const std::vector<const Element*> kept = quilter.keep_in_domain(trimmed);
   TriMesh result = merge_elements(kept);
   result.kinds = swatch.kinds;
   // Back to the swatch's own axes (the thickness axis returns to where it was).

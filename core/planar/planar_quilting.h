@@ -34,6 +34,10 @@ struct PlanarQuiltingOptions {
   // Refuse a job whose output is estimated above this many faces (issue 14: a size that would
   // run for hours or exhaust memory fails at once; about 350 bytes of memory per face).
   double max_faces = 2e7;
+
+  // Throws InvalidInput for a size that is not positive and finite, a negative or non-finite
+  // cell size or a sub-patch fraction outside (0, 1].
+  void validate() const;
 };
 
 // Estimated faces of a length x width layer of the swatch: whole swatch copies, so a strip
@@ -60,8 +64,9 @@ double matching_cell_size(const PreparedSwatch& swatch);
 // Runs planar mesh quilting. The swatch's smallest bounding-box side is its thickness; the
 // output lies in [0, L] x [0, W] x [0, thickness] (whole elements may cross the border unless
 // trim_border). Deterministic for given input, options and evaluator results.
-// Throws InvalidInput for impossible parameters (non-positive or non-finite sizes, a domain
-// smaller than every element of the swatch, an output too large to hold in memory).
+// Throws InvalidInput for impossible parameters (options.validate(), a domain smaller than
+// every element of the swatch, a cell larger than the swatch or making too many cells, an
+// output too large to hold in memory) and for a swatch prepare_swatch rejects.
 TriMesh quilt_plane(const TriMesh& swatch, const PlanarQuiltingOptions& options,
                     TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats = nullptr,
                     ProgressSink* progress = nullptr);

@@ -120,11 +120,7 @@ MatrixX3d smoothed_directions(const MatrixX3d& V, const MatrixX3i& F, int iterat
 
 // The diffusion steps offset_directions takes.
 int diffusion_steps(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options) {
-  MQ_CHECK(options.smoothing_iterations >= 0, InvalidInput,
-           "offset surface: smoothing_iterations must be >= 0, got ", options.smoothing_iterations);
-  MQ_CHECK(std::isfinite(options.smoothing_radius) && options.smoothing_radius >= 0, InvalidInput,
-           "offset surface: smoothing_radius must be finite and >= 0, got ",
-           options.smoothing_radius);
+  options.validate_smoothing();
   int steps = options.smoothing_iterations;
   const double mean_edge = mean_edge_length(V, F);
   if (mean_edge > 0 && std::isfinite(options.height)) {
@@ -135,7 +131,198 @@ int diffusion_steps(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions&
   return steps;
 }
 
+// Whether shell tet t is flat or inverted: its volume at most kMinRelativeVolume times its
+// longest edge cubed.
+bool flat_tet(const MatrixX3d& S, const TetIndices& T, Eigen::Index t) {
+  const Vector3d p[4] = {S.row(T(t, 0)), S.row(T(t, 1)), S.row(T(t, 2)), S.row(T(t, 3))};
+  double l2 = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) l2 = std::max(l2, (p[a] - p[b]).squaredNorm());
+  return !(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2));
+}
+
+// Intersecting pairs of shell boundary faces, kept from round to round. A round re-tests only
+// the pairs with a face that moved (an offset vertex lowered): the others keep last round's
+// answer, so every round sees exactly the pairs a full test would, at the cost of the faces
+// that moved (on a 1.1M-face base the full test every round was most of the shell's cost).
+class ShellPairs {
+ public:
+  // The pairs of the shell S (base then offset vertices, n each) with offset heights `heights`.
+  const std::vector<std::pair<int, int>>& update(const MatrixX3d& S, const MatrixX3i& B, int n,
+                                                 const Eigen::VectorXd& heights) {
+    if (first_) {
+      IntersectionOptions all_pairs;
+      all_pairs.between_components_only = false;
+      pairs_ = intersecting_face_pairs(S, B, all_pairs);
+      first_ = false;
+    } else {
+      std::vector<char> moved(static_cast<size_t>(B.rows()), 0);
+      for (Eigen::Index f = 0; f < B.rows(); ++f)
+        for (int k = 0; k < 3; ++k) {
+          const int v = B(f, k);
+          if (v >= n && heights(v - n) != tested_heights_(v - n)) moved[f] = 1;
+        }
+      std::vector<std::pair<int, int>> kept;
+      for (const auto& [f, g] : pairs_)
+        if (!moved[f] && !moved[g]) kept.emplace_back(f, g);
+      std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
+      pairs_.clear();
+      std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs_));
+    }
+    tested_heights_ = heights;
+    return pairs_;
+  }
+
+ private:
+  bool first_ = true;
+  std::vector<std::pair<int, int>> pairs_;
+  Eigen::VectorXd tested_heights_;
+};
+
+// Per base vertex: a corner of a face whose prism offends, with a flat or inverted tet or a
+// boundary face meeting another (base-base pairs excepted: the base is given).
+std::vector<char> offending_vertices(const MatrixX3d& S, const TetIndices& T, const MatrixX3i& F,
+                                     const MatrixX3i& B,
+                                     const std::vector<std::pair<int, int>>& pairs) {
+  const int n = static_cast<int>(S.rows() / 2);
+  std::vector<char> bad(n, 0);
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    if (flat_tet(S, T, t))
+      for (int k = 0; k < 3; ++k) bad[F(t / 3, k) % n] = 1;
+  for (const auto& [f, g] : pairs) {
+    if (f < F.rows() && g < F.rows()) continue;  // both on the given base
+    for (int k = 0; k < 3; ++k) {
+      bad[B(f, k) % n] = 1;
+      bad[B(g, k) % n] = 1;
+    }
+  }
+  return bad;
+}
+
+// Halves the offending vertices' heights, not below the floor. Returns whether any moved;
+// `stuck` counts those already at the floor.
+bool lower_heights(const std::vector<char>& bad, double floor_h, Eigen::VectorXd& heights,
+                   int& stuck) {
+  bool progress = false;
+  stuck = 0;
+  for (size_t i = 0; i < bad.size(); ++i) {
+    if (!bad[i]) continue;
+    if (heights(i) > floor_h) {
+      heights(i) = std::max(floor_h, 0.5 * heights(i));
+      progress = true;
+    } else {
+      ++stuck;
+    }
+  }
+  return progress;
+}
+
+// Grades the heights: none more than twice its lowest neighbour's, so a lowered region tapers
+// off over a few rings instead of leaving a step; heights only decrease.
+void grade_heights(const Adjacency& vv, Eigen::VectorXd& heights) {
+  const int n = static_cast<int>(heights.size());
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int i = 0; i < n; ++i) {
+      for (const int* j = vv.begin(i); j != vv.end(i); ++j) {
+        if (heights(i) > 2.0 * heights(*j)) {
+          heights(i) = 2.0 * heights(*j);
+          changed = true;
+        }
+      }
+    }
+  }
+}
+
+// The prisms that offend, ascending: those with a flat or inverted tet, and those whose
+// offset or side wall meets another boundary face (a base face only offends through the other
+// face of its pair: the base is given).
+std::vector<int> offending_prisms(const MatrixX3d& S, const TetIndices& T, const MatrixX3i& F,
+                                  const MatrixX3i& B,
+                                  const std::vector<std::pair<int, int>>& pairs) {
+  const int n = static_cast<int>(S.rows() / 2);
+  std::vector<char> prism(static_cast<size_t>(F.rows()), 0);
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    if (flat_tet(S, T, t)) prism[static_cast<size_t>(t / 3)] = 1;
+  const EdgeTopology topo = edge_topology(F, n);
+  std::map<std::pair<int, int>, int> boundary_face;  // boundary edge (a < b) -> its face
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int e = topo.FE(f, k);
+      if (topo.edge_faces.degree(e) == 1)
+        boundary_face[{topo.E(e, 0), topo.E(e, 1)}] = static_cast<int>(f);
+    }
+  const auto prism_of = [&](int row) {
+    if (row < 2 * F.rows()) return row % static_cast<int>(F.rows());
+    // A side wall: the face on its boundary edge (its two base corners, modulo n).
+    int a = -1, b = -1;
+    for (int k = 0; k < 3; ++k) {
+      const int v = B(row, k) % n;
+      if (a < 0)
+        a = v;
+      else if (v != a)
+        b = v;
+    }
+    const auto it = boundary_face.find({std::min(a, b), std::max(a, b)});
+    return it == boundary_face.end() ? -1 : it->second;
+  };
+  for (const auto& [f, g] : pairs) {
+    if (f < F.rows() && g < F.rows()) continue;
+    for (const int row : {f, g})
+      if (row >= F.rows()) {
+        const int q = prism_of(row);
+        if (q >= 0) prism[static_cast<size_t>(q)] = 1;
+      }
+  }
+  std::vector<int> faces;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (prism[static_cast<size_t>(f)]) faces.push_back(static_cast<int>(f));
+  return faces;
+}
+
+// The faces round the fold vertices of a failure, ascending.
+void list_fold_faces(const MatrixX3i& F, int n, OffsetFailure& failure) {
+  failure.fold = true;
+  const Adjacency vf = vertex_faces(F, n);
+  for (const int v : failure.vertices)
+    failure.faces.insert(failure.faces.end(), vf.begin(v), vf.end(v));
+  std::sort(failure.faces.begin(), failure.faces.end());
+  failure.faces.erase(std::unique(failure.faces.begin(), failure.faces.end()), failure.faces.end());
+}
+
+// Every vertex a face uses starts at the full height; the others get no direction.
+void start_heights(const MatrixX3i& F, double height, OffsetSurface& out) {
+  const int n = static_cast<int>(out.directions.rows());
+  std::vector<char> used(n, 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
+  out.heights = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    if (used[i]) {
+      out.heights(i) = height;
+    } else {
+      out.directions.row(i).setZero();
+    }
+  }
+}
+
 }  // namespace
+
+void OffsetOptions::validate_smoothing() const {
+  MQ_CHECK(smoothing_iterations >= 0, InvalidInput,
+           "offset surface: smoothing_iterations must be >= 0, got ", smoothing_iterations);
+  MQ_CHECK(std::isfinite(smoothing_radius) && smoothing_radius >= 0, InvalidInput,
+           "offset surface: smoothing_radius must be finite and >= 0, got ", smoothing_radius);
+}
+
+void OffsetOptions::validate() const {
+  MQ_CHECK(std::isfinite(height) && height > 0.0, InvalidInput,
+           "offset surface: height must be finite and > 0, got ", height);
+  MQ_CHECK(min_fraction > 0.0 && min_fraction <= 1.0, InvalidInput,
+           "offset surface: min_fraction must lie in (0, 1], got ", min_fraction);
+  MQ_CHECK(max_rounds >= 1, InvalidInput, "offset surface: max_rounds must be >= 1");
+  validate_smoothing();
+}
 
 std::vector<int> fold_vertices(const MatrixX3d& V, const MatrixX3i& F) {
   MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
@@ -170,11 +357,7 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
 bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                         OffsetSurface& out, OffsetFailure& failure) {
   failure = OffsetFailure();
-  MQ_CHECK(std::isfinite(options.height) && options.height > 0.0, InvalidInput,
-           "offset surface: height must be finite and > 0, got ", options.height);
-  MQ_CHECK(options.min_fraction > 0.0 && options.min_fraction <= 1.0, InvalidInput,
-           "offset surface: min_fraction must lie in (0, 1], got ", options.min_fraction);
-  MQ_CHECK(options.max_rounds >= 1, InvalidInput, "offset surface: max_rounds must be >= 1");
+  options.validate();
   MQ_CHECK(V.allFinite(), InvalidInput, "offset surface: vertices contain NaN or infinite values");
   MQ_CHECK(F.rows() > 0, InvalidInput, "offset surface: the base has no faces");
   const int n = static_cast<int>(V.rows());
@@ -186,159 +369,34 @@ bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOpti
   out.smoothing_steps = diffusion_steps(V, F, options);
   out.directions = smoothed_directions(V, F, out.smoothing_steps, failure.vertices, failure.reason);
   if (!failure.vertices.empty()) {
-    failure.fold = true;
-    const Adjacency vf = vertex_faces(F, n);
-    for (const int v : failure.vertices)
-      failure.faces.insert(failure.faces.end(), vf.begin(v), vf.end(v));
-    std::sort(failure.faces.begin(), failure.faces.end());
-    failure.faces.erase(std::unique(failure.faces.begin(), failure.faces.end()),
-                        failure.faces.end());
+    list_fold_faces(F, n, failure);
     return false;
   }
-  std::vector<char> used(n, 0);
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
-  out.heights = Eigen::VectorXd::Zero(n);
-  for (int i = 0; i < n; ++i) {
-    if (used[i]) {
-      out.heights(i) = options.height;
-    } else {
-      out.directions.row(i).setZero();
-    }
-  }
+  start_heights(F, options.height, out);
   const double floor_h = options.min_fraction * options.height;
-
-  IntersectionOptions all_pairs;
-  all_pairs.between_components_only = false;
   MatrixX3d S(2 * n, 3);  // shell vertices: base then offset
   S.topRows(n) = V;
-  // Intersecting boundary pairs of the last round. A round re-tests only the pairs with a face
-  // that moved (an offset vertex lowered): the others keep last round's answer, so every round
-  // sees exactly the pairs a full test would, at the cost of the faces that moved (on a 1.1M-
-  // face base the full test every round was most of the shell's cost).
-  std::vector<std::pair<int, int>> pairs;
-  Eigen::VectorXd tested_heights;
+  ShellPairs shell_pairs;
   for (int round = 0;; ++round) {
     out.V = V + out.heights.asDiagonal() * out.directions;
     S.bottomRows(n) = out.V;
-
-    std::vector<char> bad(n, 0);
-    bool any_bad = false;
-    auto mark = [&](int v) {
-      bad[v % n] = 1;
-      any_bad = true;
-    };
-    for (Eigen::Index t = 0; t < T.rows(); ++t) {
-      const Vector3d p[4] = {S.row(T(t, 0)), S.row(T(t, 1)), S.row(T(t, 2)), S.row(T(t, 3))};
-      double l2 = 0.0;
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b) l2 = std::max(l2, (p[a] - p[b]).squaredNorm());
-      if (!(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2)))
-        for (int k = 0; k < 3; ++k) mark(F(t / 3, k));
-    }
-    if (round == 0) {
-      pairs = intersecting_face_pairs(S, B, all_pairs);
-    } else {
-      std::vector<char> moved(static_cast<size_t>(B.rows()), 0);
-      for (Eigen::Index f = 0; f < B.rows(); ++f)
-        for (int k = 0; k < 3; ++k) {
-          const int v = B(f, k);
-          if (v >= n && out.heights(v - n) != tested_heights(v - n)) moved[f] = 1;
-        }
-      std::vector<std::pair<int, int>> kept;
-      for (const auto& [f, g] : pairs)
-        if (!moved[f] && !moved[g]) kept.emplace_back(f, g);
-      std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
-      pairs.clear();
-      std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs));
-    }
-    tested_heights = out.heights;
-    for (const auto& [f, g] : pairs) {
-      if (f < F.rows() && g < F.rows()) continue;  // both on the given base
-      for (int k = 0; k < 3; ++k) {
-        mark(B(f, k));
-        mark(B(g, k));
-      }
-    }
-    if (!any_bad) break;
-
-    bool progress = false;
+    const std::vector<std::pair<int, int>>& pairs = shell_pairs.update(S, B, n, out.heights);
+    const std::vector<char> bad = offending_vertices(S, T, F, B, pairs);
+    if (std::find(bad.begin(), bad.end(), 1) == bad.end()) break;
     int stuck = 0;
-    for (int i = 0; i < n; ++i) {
-      if (!bad[i]) continue;
-      if (out.heights(i) > floor_h) {
-        out.heights(i) = std::max(floor_h, 0.5 * out.heights(i));
-        progress = true;
-      } else {
-        ++stuck;
-      }
-    }
+    const bool progress = lower_heights(bad, floor_h, out.heights, stuck);
     if (!progress || round + 1 >= options.max_rounds) {
       failure.reason = detail::concat("offset surface: cannot make a valid shell (", stuck,
                                       " offending vertices already at the minimum height ", floor_h,
                                       " after ", round + 1, " rounds)");
       // Where it is stuck: the offending vertices at the floor (all of them when the rounds
-      // ran out first), and the prisms that offend: those with a flat or inverted tet, and
-      // those whose offset or side wall meets another boundary face (a base face only offends
-      // through the other face of its pair: the base is given).
+      // ran out first), and the prisms that offend.
       for (int i = 0; i < n; ++i)
         if (bad[i] && (out.heights(i) <= floor_h || progress)) failure.vertices.push_back(i);
-      std::vector<char> prism(static_cast<size_t>(F.rows()), 0);
-      for (Eigen::Index t = 0; t < T.rows(); ++t) {
-        const Vector3d p[4] = {S.row(T(t, 0)), S.row(T(t, 1)), S.row(T(t, 2)), S.row(T(t, 3))};
-        double l2 = 0.0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) l2 = std::max(l2, (p[a] - p[b]).squaredNorm());
-        if (!(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2)))
-          prism[static_cast<size_t>(t / 3)] = 1;
-      }
-      const EdgeTopology topo = edge_topology(F, n);
-      std::map<std::pair<int, int>, int> boundary_face;  // boundary edge (a < b) -> its face
-      for (Eigen::Index f = 0; f < F.rows(); ++f)
-        for (int k = 0; k < 3; ++k) {
-          const int e = topo.FE(f, k);
-          if (topo.edge_faces.degree(e) == 1)
-            boundary_face[{topo.E(e, 0), topo.E(e, 1)}] = static_cast<int>(f);
-        }
-      const auto prism_of = [&](int row) {
-        if (row < 2 * F.rows()) return row % static_cast<int>(F.rows());
-        // A side wall: the face on its boundary edge (its two base corners, modulo n).
-        int a = -1, b = -1;
-        for (int k = 0; k < 3; ++k) {
-          const int v = B(row, k) % n;
-          if (a < 0)
-            a = v;
-          else if (v != a)
-            b = v;
-        }
-        const auto it = boundary_face.find({std::min(a, b), std::max(a, b)});
-        return it == boundary_face.end() ? -1 : it->second;
-      };
-      for (const auto& [f, g] : pairs) {
-        if (f < F.rows() && g < F.rows()) continue;
-        for (const int row : {f, g})
-          if (row >= F.rows()) {
-            const int q = prism_of(row);
-            if (q >= 0) prism[static_cast<size_t>(q)] = 1;
-          }
-      }
-      for (Eigen::Index f = 0; f < F.rows(); ++f)
-        if (prism[static_cast<size_t>(f)]) failure.faces.push_back(static_cast<int>(f));
+      failure.faces = offending_prisms(S, T, F, B, pairs);
       return false;
     }
-    // Grade the heights: none more than twice its lowest neighbour's, so a lowered region
-    // tapers off over a few rings instead of leaving a step; heights only decrease.
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (int i = 0; i < n; ++i) {
-        for (const int* j = vv.begin(i); j != vv.end(i); ++j) {
-          if (out.heights(i) > 2.0 * out.heights(*j)) {
-            out.heights(i) = 2.0 * out.heights(*j);
-            changed = true;
-          }
-        }
-      }
-    }
+    grade_heights(vv, out.heights);
   }
   return true;
 }

@@ -22,6 +22,11 @@ struct OffsetOptions {
   double smoothing_radius = 1.25;
   double min_fraction = 0.1;  // no vertex's height drops below min_fraction * height
   int max_rounds = 64;        // bound on the shrink-and-check rounds (>= 1)
+
+  // Throws InvalidInput for a value outside its range (above).
+  void validate() const;
+  // The same for the smoothing options alone (what offset_directions uses).
+  void validate_smoothing() const;
 };
 
 // The offset vertices W = V + h_i d_i with their directions and heights.
@@ -38,7 +43,8 @@ struct OffsetSurface {
 // The unit directions offset_surface moves the vertices along (its first step, below), and in
 // steps_out (if given) the diffusion steps taken: max(smoothing_iterations,
 // ceil((smoothing_radius * height / mean edge)^2)). #V by 3.
-// Throws InvalidInput for bad smoothing options; TopologyError as offset_surface.
+// Throws InvalidInput for bad smoothing options (OffsetOptions::validate_smoothing);
+// TopologyError as offset_surface.
 MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
                             int* steps_out = nullptr);
 
@@ -62,10 +68,11 @@ MatrixX3d displacement_directions(const MatrixX3d& V, const MatrixX3i& F, double
 // rings. Heights only decrease; convex regions are not lowered, concave ones as far as needed.
 //   V  #V by 3 base vertices (finite), F  #F by 3 faces, counter-clockwise seen from outside
 // Deterministic; the result does not depend on the thread count.
-// Throws InvalidInput for bad options, non-finite coordinates, bad or repeated indices or no
-// faces; TopologyError when a referenced vertex has no normal, when the base folds so that no
-// direction lies above all of a vertex's faces (the message names the vertex), or when the
-// shell stays invalid with every offending vertex at the height floor (or after max_rounds).
+// Throws InvalidInput for bad options (OffsetOptions::validate), non-finite coordinates, bad or
+// repeated indices or no faces; TopologyError when a referenced vertex has no normal, when the base
+// folds so that no direction lies above all of a vertex's faces (the message names the vertex), or
+// when the shell stays invalid with every offending vertex at the height floor (or after
+// max_rounds).
 OffsetSurface offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options);
 
 // The vertices where the base folds for the shell: no normal, or no direction above all their

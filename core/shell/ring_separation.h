@@ -40,6 +40,10 @@ struct RingSeparationOptions {
   // stays its tube's radius above it), a static obstacle like a fixed ring. Without it, rings
   // pushed apart over a concave crease went into the base (armor job: 248 of 294 moved).
   const SignedHeight* ground = nullptr;
+
+  // Throws InvalidInput unless max_iterations, clearance and max_travel are >= 0 and max_step
+  // > 0, all finite.
+  void validate() const;
 };
 
 struct RingSeparationStats {
@@ -64,7 +68,7 @@ struct RingSeparationStats {
 //            loops changes
 //   movable  per element: may move; rings that may not are obstacles
 // Returns per element whether it moved. Deterministic whatever the thread count. Throws
-// InvalidInput when the sizes do not agree.
+// InvalidInput when the sizes do not agree or options.validate() does.
 std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& first,
                                  const std::vector<std::optional<RingBins>>& bins,
                                  const std::vector<std::optional<RingBins>>& link_bins,

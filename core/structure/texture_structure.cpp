@@ -392,22 +392,32 @@ int swatch_kind_for(const SwatchStructure& swatch, const std::string& kind, int 
   return best;
 }
 
-StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& options) {
-  MQ_CHECK(mesh.V.allFinite(), InvalidInput, "the mesh has non-finite vertex coordinates");
-  check_kinds(mesh);
-  StructureReport report;
+void StructureOptions::validate() const {
+  MQ_CHECK(loop_bins >= 8, InvalidInput, "a centre loop needs at least 8 bins, got ", loop_bins);
+  MQ_CHECK(std::isfinite(interior_margin) && interior_margin >= 0 && std::isfinite(end_margin) &&
+               end_margin >= 0 && std::isfinite(area) && area >= 0 && std::isfinite(linear_scale) &&
+               linear_scale >= 0,
+           InvalidInput, "structure options: margins, area and scale must be finite and >= 0");
+}
+
+namespace {
+
+// The figures of every element (a connected component), in parallel; with a swatch, each is
+// matched to its swatch kind (by name, else swatch_kind_for) and a compact one measured
+// against it.
+std::vector<ElementFigures> measure_elements(const TriMesh& mesh, const StructureOptions& options,
+                                             const std::vector<std::string>& kinds) {
   std::vector<int> fc;
   const int n = connected_components(mesh.F, mesh.num_vertices(), fc);
   const std::vector<std::vector<int>> groups = component_faces(fc, n);
   const std::vector<int> element_kind = component_kinds(mesh, fc, n);
-  report.kinds = has_kinds(mesh) ? mesh.kinds : std::vector<std::string>{kDefaultKind};
   const SwatchStructure* swatch = options.swatch;
   // The swatch kind of each of the mesh's kinds by name (-1: matched per element).
-  std::vector<int> by_name(report.kinds.size(), -1);
+  std::vector<int> by_name(kinds.size(), -1);
   if (swatch)
-    for (size_t k = 0; k < report.kinds.size(); ++k)
+    for (size_t k = 0; k < kinds.size(); ++k)
       for (size_t j = 0; j < swatch->kinds.size(); ++j)
-        if (swatch->kinds[j].name == report.kinds[k]) by_name[k] = static_cast<int>(j);
+        if (swatch->kinds[j].name == kinds[k]) by_name[k] = static_cast<int>(j);
 
   std::vector<ElementFigures> figures(static_cast<size_t>(n));
   tbb::parallel_for(0, n, [&](int c) {
@@ -418,221 +428,257 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
     if (!swatch || swatch->kinds.empty()) return;
     int sk = by_name[static_cast<size_t>(f.s.kind)];
     if (sk < 0)
-      sk = swatch_kind_for(*swatch, report.kinds[static_cast<size_t>(f.s.kind)], f.s.vertices,
+      sk = swatch_kind_for(*swatch, kinds[static_cast<size_t>(f.s.kind)], f.s.vertices,
                            f.s.ring_shaped, &part.V);
     f.s.swatch_kind = sk;
     if (sk >= 0 && swatch->kinds[sk].compact) shape_against(part.V, swatch->kinds[sk], f);
   });
+  return figures;
+}
 
-  // Ring kinds: the swatch's, or the mesh's own (most of a kind's elements ring-shaped).
-  std::vector<char> ring_kind(report.kinds.size(), 0);
-  if (!swatch) {
-    std::vector<int> shaped(report.kinds.size(), 0), all(report.kinds.size(), 0);
-    for (const ElementFigures& f : figures) {
-      ++all[static_cast<size_t>(f.s.kind)];
-      shaped[static_cast<size_t>(f.s.kind)] += f.s.ring_shaped ? 1 : 0;
-    }
-    for (size_t k = 0; k < ring_kind.size(); ++k) ring_kind[k] = 2 * shaped[k] > all[k];
+// What each of the mesh's own kinds is, for a mesh measured without a swatch (with one, the
+// swatch kinds decide): a ring kind when most of its elements are ring-shaped, a long kind
+// when most are long (and it is no ring kind); and its wire gauge, the median wire of its
+// ring-shaped elements, which a ring's free hole must pass (RingDefect::NoHole).
+struct KindRoles {
+  std::vector<char> ring, long_kind;
+  std::vector<double> gauge;
+};
+
+KindRoles kind_roles(const std::vector<ElementFigures>& figures, size_t kinds, bool swatch) {
+  KindRoles roles;
+  roles.ring.assign(kinds, 0);
+  roles.long_kind.assign(kinds, 0);
+  roles.gauge.assign(kinds, 0);
+  std::vector<int> shaped(kinds, 0), longs(kinds, 0), all(kinds, 0);
+  std::vector<std::vector<double>> wires(kinds);
+  for (const ElementFigures& f : figures) {
+    const size_t k = static_cast<size_t>(f.s.kind);
+    ++all[k];
+    shaped[k] += f.s.ring_shaped ? 1 : 0;
+    longs[k] += f.s.long_element ? 1 : 0;
+    if (f.s.ring_shaped) wires[k].push_back(f.s.wire);
   }
-  // The wire gauge of each kind: the median wire of its ring-shaped elements.
-  std::vector<double> gauge(report.kinds.size(), 0);
-  {
-    std::vector<std::vector<double>> wires(report.kinds.size());
-    for (const ElementFigures& f : figures)
-      if (f.s.ring_shaped) wires[static_cast<size_t>(f.s.kind)].push_back(f.s.wire);
-    for (size_t k = 0; k < gauge.size(); ++k) gauge[k] = median(wires[k]);
+  for (size_t k = 0; k < kinds; ++k) {
+    roles.gauge[k] = median(wires[k]);
+    if (swatch) continue;
+    roles.ring[k] = 2 * shaped[k] > all[k];
+    roles.long_kind[k] = !roles.ring[k] && 2 * longs[k] > all[k];
   }
-  // Long kinds: the swatch's (neither rings nor compact), or the mesh's own (most of a kind's
-  // elements long). Their closed elements are threads closed on themselves, not rings.
-  std::vector<char> long_kind(report.kinds.size(), 0);
-  if (!swatch) {
-    std::vector<int> longs(report.kinds.size(), 0), all(report.kinds.size(), 0);
-    for (const ElementFigures& f : figures) {
-      ++all[static_cast<size_t>(f.s.kind)];
-      longs[static_cast<size_t>(f.s.kind)] += f.s.long_element ? 1 : 0;
+  return roles;
+}
+
+// Decides what an element is from its shape and its kind's role (sk: its swatch kind, or
+// nullptr to take the mesh's own roles): a thread closed on itself (as long as its loop, no
+// ends), a ring that is not ring-shaped (a torn, merged or melted ring: a miss, not a thread
+// with two ends), or a ring-shaped one judged for a hole and a fold (issue 23).
+void classify_element(ElementFigures& f, const SwatchKind* sk, const KindRoles& roles,
+                      bool judge_folds) {
+  ElementStructure& e = f.s;
+  const size_t kind = static_cast<size_t>(e.kind);
+  const bool of_ring_kind = sk ? sk->ring : roles.ring[kind] != 0;
+  const bool of_long_kind = sk ? !sk->ring && !sk->compact : roles.long_kind[kind] != 0;
+  if (of_long_kind && !of_ring_kind && (e.ring_shaped || (f.closed_genus_one && e.long_element))) {
+    if (e.ring_shaped) {
+      double length = 0;
+      const Loop& loop = *f.loop;
+      for (size_t k = 0; k < loop.size(); ++k)
+        length += (loop[(k + 1) % loop.size()] - loop[k]).norm();
+      e.length = length;
+      e.width = length > 0 ? e.area / (M_PI * length) : 0;
     }
-    for (size_t k = 0; k < long_kind.size(); ++k)
-      long_kind[k] = !ring_kind[k] && 2 * longs[k] > all[k];
+    e.ring = false;
+    e.long_element = e.closed = true;
+    e.wire = e.opening = e.fold = 0;
+  } else if (!e.ring_shaped && of_ring_kind) {
+    e.ring = true;
+    e.defect = RingDefect::NotRing;
+    e.long_element = false;
+  } else if (e.ring_shaped) {
+    const double reference = sk && sk->ring ? sk->fold : 0.0;
+    if (!(e.opening >= std::max(e.wire, roles.gauge[kind])))
+      e.defect = RingDefect::NoHole;
+    else if (judge_folds && e.fold - reference > kFoldLimit)
+      e.defect = RingDefect::Folded;
   }
-  report.elements.resize(static_cast<size_t>(n));
-  std::vector<Vector3d> centres(static_cast<size_t>(n));
-  std::vector<double> sizes(static_cast<size_t>(n)), areas(static_cast<size_t>(n)), widths;
-  for (int c = 0; c < n; ++c) {
-    ElementFigures& f = figures[static_cast<size_t>(c)];
-    ElementStructure& e = f.s;
-    const SwatchKind* sk = swatch && e.swatch_kind >= 0 ? &swatch->kinds[e.swatch_kind] : nullptr;
-    const bool of_ring_kind = sk ? sk->ring : ring_kind[static_cast<size_t>(e.kind)] != 0;
-    const bool of_long_kind =
-        sk ? !sk->ring && !sk->compact : long_kind[static_cast<size_t>(e.kind)] != 0;
-    if (of_long_kind && !of_ring_kind &&
-        (e.ring_shaped || (f.closed_genus_one && e.long_element))) {
-      // A thread closed on itself: as long as its loop, without ends.
-      if (e.ring_shaped) {
-        double length = 0;
-        const Loop& loop = *f.loop;
-        for (size_t k = 0; k < loop.size(); ++k)
-          length += (loop[(k + 1) % loop.size()] - loop[k]).norm();
-        e.length = length;
-        e.width = length > 0 ? e.area / (M_PI * length) : 0;
-      }
-      e.ring = false;
-      e.long_element = e.closed = true;
-      e.wire = e.opening = e.fold = 0;
-    } else if (!e.ring_shaped && of_ring_kind) {
-      // A torn, merged or melted ring: a miss, not a thread with two ends.
-      e.ring = true;
-      e.defect = RingDefect::NotRing;
-      e.long_element = false;
-    } else if (e.ring_shaped) {
-      const double reference = sk && sk->ring ? sk->fold : 0.0;
-      if (!(e.opening >= std::max(e.wire, gauge[static_cast<size_t>(e.kind)])))
-        e.defect = RingDefect::NoHole;
-      else if (options.judge_folds && e.fold - reference > kFoldLimit)
-        e.defect = RingDefect::Folded;
-    }
+}
+
+// Classifies every element into report.elements and takes the medians of their sizes, areas
+// and long elements' lengths and widths.
+void classify_elements(std::vector<ElementFigures>& figures, const StructureOptions& options,
+                       StructureReport& report) {
+  const SwatchStructure* swatch = options.swatch;
+  const KindRoles roles = kind_roles(figures, report.kinds.size(), swatch != nullptr);
+  const size_t n = figures.size();
+  report.elements.resize(n);
+  std::vector<double> sizes(n), areas(n), widths, lengths;
+  for (size_t c = 0; c < n; ++c) {
+    ElementFigures& f = figures[c];
+    const int sk = f.s.swatch_kind;
+    classify_element(f, swatch && sk >= 0 ? &swatch->kinds[sk] : nullptr, roles,
+                     options.judge_folds);
+    const ElementStructure& e = f.s;
     report.elements[c] = e;
-    centres[c] = e.centre;
     sizes[c] = e.size;
     areas[c] = e.area;
-    if (e.long_element) widths.push_back(e.width);
+    if (e.long_element) {
+      widths.push_back(e.width);
+      lengths.push_back(e.length);
+    }
   }
   report.median_size = median(sizes);
   report.median_area = median(areas);
-  {
-    std::vector<double> lengths;
-    for (const ElementStructure& e : report.elements)
-      if (e.long_element) lengths.push_back(e.length);
-    report.median_long_length = median(lengths);
-    report.median_long_width = median(widths);
-  }
-  if (n == 0) return report;
+  report.median_long_length = median(lengths);
+  report.median_long_width = median(widths);
+}
 
-  // Shapes at the output's scale.
-  if (swatch) {
-    double scale = options.linear_scale;
-    const bool long_swatch =
-        2 * swatch->report.long_elements > static_cast<int>(swatch->report.elements.size());
-    if (!(scale > 0) && long_swatch && report.median_long_width > 0 &&
-        swatch->report.median_long_width > 0)
-      scale = report.median_long_width / swatch->report.median_long_width;
-    if (!(scale > 0) && swatch->report.median_area > 0)
-      scale = std::sqrt(report.median_area / swatch->report.median_area);
-    report.linear_scale = scale > 0 ? scale : 0;
-    for (int c = 0; c < n && scale > 0; ++c) {
-      const ElementFigures& f = figures[static_cast<size_t>(c)];
-      ElementStructure& e = report.elements[c];
-      if (!(f.raw_size > 0)) continue;
-      e.size_ratio = f.raw_size / scale;
-      e.stretch = f.raw_stretch / scale;
-    }
+// The shape figures at the output's scale: the given one, else from the long elements' widths
+// for a swatch mostly of long elements (welded threads' areas follow their lengths), else from
+// the median element areas.
+void scale_shapes(const std::vector<ElementFigures>& figures, const SwatchStructure& swatch,
+                  double given_scale, StructureReport& report) {
+  double scale = given_scale;
+  const bool long_swatch =
+      2 * swatch.report.long_elements > static_cast<int>(swatch.report.elements.size());
+  if (!(scale > 0) && long_swatch && report.median_long_width > 0 &&
+      swatch.report.median_long_width > 0)
+    scale = report.median_long_width / swatch.report.median_long_width;
+  if (!(scale > 0) && swatch.report.median_area > 0)
+    scale = std::sqrt(report.median_area / swatch.report.median_area);
+  report.linear_scale = scale > 0 ? scale : 0;
+  for (size_t c = 0; c < figures.size() && scale > 0; ++c) {
+    const ElementFigures& f = figures[c];
+    ElementStructure& e = report.elements[c];
+    if (!(f.raw_size > 0)) continue;
+    e.size_ratio = f.raw_size / scale;
+    e.stretch = f.raw_stretch / scale;
   }
+}
 
-  // Nearest other centre, searched in the 27 cells of a grid of the median element size.
-  {
-    const double cell = report.median_size > 0 ? report.median_size : 1.0;
-    HashGrid3 grid(cell);
-    for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
-    std::vector<double> nearest(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
-    const Vector3d r = Vector3d::Constant(cell);
-    tbb::parallel_for(0, n, [&](int c) {
-      for (const int d : grid.query_box(centres[c] - r, centres[c] + r))
-        if (d != c) nearest[c] = std::min(nearest[c], (centres[d] - centres[c]).norm());
-    });
-    report.median_spacing = median(nearest);
-  }
+// The median distance from a centre to the nearest other, searched in the 27 cells of a grid
+// of the median element size.
+double median_spacing(const std::vector<Vector3d>& centres, double median_size) {
+  const int n = static_cast<int>(centres.size());
+  const double cell = median_size > 0 ? median_size : 1.0;
+  HashGrid3 grid(cell);
+  for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
+  std::vector<double> nearest(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+  const Vector3d r = Vector3d::Constant(cell);
+  tbb::parallel_for(0, n, [&](int c) {
+    for (const int d : grid.query_box(centres[c] - r, centres[c] + r))
+      if (d != c) nearest[c] = std::min(nearest[c], (centres[d] - centres[c]).norm());
+  });
+  return median(nearest);
+}
 
-  // The border and each element's distance to it.
+// The border options.border gives, or with automatic_border a flat layer's box (centres within
+// half an element size of their plane) or none.
+TextureBorder texture_border(const StructureOptions& options, const CentrePlane& plane,
+                             double median_size) {
   TextureBorder border = options.border;
-  const CentrePlane plane = centre_plane(centres);
   if (options.automatic_border)
-    border.kind = plane.thickness <= 0.5 * report.median_size ? TextureBorder::Kind::FlatBox
-                                                              : TextureBorder::Kind::None;
-  report.border = border.kind;
-  auto border_distance = [&](const Vector3d& p) {
-    switch (border.kind) {
-      case TextureBorder::Kind::None:
-        return std::numeric_limits<double>::infinity();
-      case TextureBorder::Kind::FlatBox: {
-        const Vector3d d = p - plane.origin;
-        const Vector2d q(d.dot(plane.u), d.dot(plane.w));
-        const double m = std::min({q.x() - plane.lo.x(), plane.hi.x() - q.x(), q.y() - plane.lo.y(),
-                                   plane.hi.y() - q.y()});
-        return std::max(0.0, m);
-      }
-      case TextureBorder::Kind::Segments: {
-        double best = std::numeric_limits<double>::infinity();
-        for (const auto& [a, b] : border.segments)
-          best = std::min(best, point_segment_distance(p, a, b));
-        return best;
-      }
+    border.kind = plane.thickness <= 0.5 * median_size ? TextureBorder::Kind::FlatBox
+                                                       : TextureBorder::Kind::None;
+  return border;
+}
+
+// Distance from a point to the border (infinite without one).
+double border_distance(const TextureBorder& border, const CentrePlane& plane, const Vector3d& p) {
+  switch (border.kind) {
+    case TextureBorder::Kind::None:
+      return std::numeric_limits<double>::infinity();
+    case TextureBorder::Kind::FlatBox: {
+      const Vector3d d = p - plane.origin;
+      const Vector2d q(d.dot(plane.u), d.dot(plane.w));
+      const double m = std::min(
+          {q.x() - plane.lo.x(), plane.hi.x() - q.x(), q.y() - plane.lo.y(), plane.hi.y() - q.y()});
+      return std::max(0.0, m);
     }
-    return std::numeric_limits<double>::infinity();
-  };
-  // One element size and one spacing: on a base the outermost elements must lie wholly on it,
-  // so their centres can be a size and a spacing from its edge. The size of the largest kind
-  // (of those holding a tenth of the elements): the square sheet's flat rings lose connectors
-  // that would stand beyond the edge, and its connectors, most of its elements, are smaller.
-  double largest_kind = report.median_size;
-  {
-    std::vector<std::vector<double>> by_kind(report.kinds.size());
-    for (const ElementStructure& e : report.elements)
-      by_kind[static_cast<size_t>(e.kind)].push_back(e.size);
-    for (const std::vector<double>& k : by_kind)
-      if (10 * k.size() >= static_cast<size_t>(n)) largest_kind = std::max(largest_kind, median(k));
+    case TextureBorder::Kind::Segments: {
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& [a, b] : border.segments)
+        best = std::min(best, point_segment_distance(p, a, b));
+      return best;
+    }
   }
-  const double margin =
-      options.interior_margin > 0 ? options.interior_margin : largest_kind + report.median_spacing;
-  const double end_margin = options.end_margin > 0 ? options.end_margin : 5 * median(widths);
+  return std::numeric_limits<double>::infinity();
+}
+
+// The distance from the border beyond which an element is interior: given, else one element
+// size and one spacing (on a base the outermost elements must lie wholly on it, so their
+// centres can be a size and a spacing from its edge). The size of the largest kind (of those
+// holding a tenth of the elements): the square sheet's flat rings lose connectors that would
+// stand beyond the edge, and its connectors, most of its elements, are smaller.
+double interior_margin(const StructureOptions& options, const StructureReport& report) {
+  if (options.interior_margin > 0) return options.interior_margin;
+  double largest_kind = report.median_size;
+  std::vector<std::vector<double>> by_kind(report.kinds.size());
+  for (const ElementStructure& e : report.elements)
+    by_kind[static_cast<size_t>(e.kind)].push_back(e.size);
+  for (const std::vector<double>& k : by_kind)
+    if (10 * k.size() >= report.elements.size()) largest_kind = std::max(largest_kind, median(k));
+  return largest_kind + report.median_spacing;
+}
+
+// Marks the interior elements and counts the long elements' ends away from the border.
+void mark_interior(const std::vector<ElementFigures>& figures, const TextureBorder& border,
+                   const CentrePlane& plane, double margin, double end_margin,
+                   StructureReport& report) {
+  const int n = static_cast<int>(report.elements.size());
   tbb::parallel_for(0, n, [&](int c) {
     ElementStructure& e = report.elements[c];
-    e.interior = border_distance(e.centre) > margin;
+    e.interior = border_distance(border, plane, e.centre) > margin;
     if (e.long_element && !e.closed)
       for (const Vector3d& p : figures[c].end)
-        if (border_distance(p) > end_margin) ++e.interior_ends;
+        if (border_distance(border, plane, p) > end_margin) ++e.interior_ends;
   });
+}
 
-  // Interlinked rings: loops whose boxes overlap (b must cross the cone over a, which lies in
-  // a's convex hull) are tested exactly. A pair counts as a link only when neither ring is
-  // degenerate.
-  {
-    std::vector<int> rings;
-    std::vector<Vector3d> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n));
-    std::vector<double> ring_sizes;
-    for (int c = 0; c < n; ++c) {
-      if (!figures[c].loop || !report.elements[c].ring) continue;
-      rings.push_back(c);
-      lo[c] = hi[c] = figures[c].loop->front();
-      for (const Vector3d& p : *figures[c].loop) {
-        lo[c] = lo[c].cwiseMin(p);
-        hi[c] = hi[c].cwiseMax(p);
-      }
-      ring_sizes.push_back(figures[c].s.size);
+// Interlinked rings: loops whose boxes overlap (b must cross the cone over a, which lies in
+// a's convex hull) are tested exactly. A pair counts as a link only when neither ring is
+// degenerate; loop_links count every interlinked centre loop.
+void link_rings(const std::vector<ElementFigures>& figures, StructureReport& report) {
+  const int n = static_cast<int>(figures.size());
+  std::vector<int> rings;
+  std::vector<Vector3d> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n));
+  std::vector<double> ring_sizes;
+  for (int c = 0; c < n; ++c) {
+    if (!figures[c].loop || !report.elements[c].ring) continue;
+    rings.push_back(c);
+    lo[c] = hi[c] = figures[c].loop->front();
+    for (const Vector3d& p : *figures[c].loop) {
+      lo[c] = lo[c].cwiseMin(p);
+      hi[c] = hi[c].cwiseMax(p);
     }
-    HashGrid3 grid(std::max(median(ring_sizes), 1e-12));
-    for (const int c : rings) grid.insert_box(c, lo[c], hi[c]);
-    std::vector<std::vector<int>> partners(static_cast<size_t>(n));
-    tbb::parallel_for(size_t(0), rings.size(), [&](size_t k) {
-      const int a = rings[k];
-      for (const int b : grid.query_box(lo[a], hi[a])) {
-        if (b <= a) continue;
-        if ((lo[a].array() > hi[b].array()).any() || (lo[b].array() > hi[a].array()).any())
-          continue;
-        if (linking_number(*figures[a].loop, *figures[b].loop) != 0) partners[a].push_back(b);
-      }
-    });
-    for (const int a : rings)
-      for (const int b : partners[a]) {
-        ElementStructure &ea = report.elements[a], &eb = report.elements[b];
-        ++report.loop_linked_pairs;
-        ++ea.loop_links;
-        ++eb.loop_links;
-        if (ea.degenerate() || eb.degenerate()) continue;
-        report.linked_pairs.emplace_back(a, b);
-        ++ea.links;
-        ++eb.links;
-      }
+    ring_sizes.push_back(figures[c].s.size);
   }
+  HashGrid3 grid(std::max(median(ring_sizes), 1e-12));
+  for (const int c : rings) grid.insert_box(c, lo[c], hi[c]);
+  std::vector<std::vector<int>> partners(static_cast<size_t>(n));
+  tbb::parallel_for(size_t(0), rings.size(), [&](size_t k) {
+    const int a = rings[k];
+    for (const int b : grid.query_box(lo[a], hi[a])) {
+      if (b <= a) continue;
+      if ((lo[a].array() > hi[b].array()).any() || (lo[b].array() > hi[a].array()).any()) continue;
+      if (linking_number(*figures[a].loop, *figures[b].loop) != 0) partners[a].push_back(b);
+    }
+  });
+  for (const int a : rings)
+    for (const int b : partners[a]) {
+      ElementStructure &ea = report.elements[a], &eb = report.elements[b];
+      ++report.loop_linked_pairs;
+      ++ea.loop_links;
+      ++eb.loop_links;
+      if (ea.degenerate() || eb.degenerate()) continue;
+      report.linked_pairs.emplace_back(a, b);
+      ++ea.links;
+      ++eb.links;
+    }
+}
 
+// The report's counts: long elements and their ends, compact elements, rings by defect and
+// the link histograms (over all rings and over the interior ones).
+void count_elements(StructureReport& report) {
   int max_links = 0;
   for (const ElementStructure& e : report.elements)
     if (e.ring) max_links = std::max(max_links, e.links);
@@ -660,70 +706,108 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
       if (!e.degenerate()) ++report.interior_link_histogram[e.links];
     }
   }
+}
 
-  // Density from the Voronoi cells of interior elements in their tangent planes.
-  {
-    const double radius =
-        4 * (report.median_spacing > 0 ? report.median_spacing : report.median_size);
-    HashGrid3 grid(radius > 0 ? radius : 1.0);
-    for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
-    std::vector<double> cell_area(static_cast<size_t>(n), 0);
-    tbb::parallel_for(0, n, [&](int c) {
-      if (!report.elements[c].interior || !(radius > 0)) return;
-      const Vector3d r = Vector3d::Constant(radius);
-      std::vector<Vector3d> others;
-      const Vector3d own =
-          options.surface_normal ? options.surface_normal(centres[c]) : Vector3d::Zero();
-      for (const int d : grid.query_box(centres[c] - r, centres[c] + r)) {
-        if (d == c || (centres[d] - centres[c]).norm() > radius) continue;
-        if (options.surface_normal && options.surface_normal(centres[d]).dot(own) < 0.5) continue;
-        others.push_back(centres[d]);
-      }
-      if (others.size() < 3) return;
-      Vector3d normal;
-      if (options.surface_normal) {
-        normal = own;
-      } else {
-        Vector3d mean = centres[c];
-        for (const Vector3d& o : others) mean += o;
-        mean /= static_cast<double>(others.size() + 1);
-        Eigen::Matrix3d cov = (centres[c] - mean) * (centres[c] - mean).transpose();
-        for (const Vector3d& o : others) cov += (o - mean) * (o - mean).transpose();
-        normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
-      }
-      if (!(normal.norm() > 0) || !normal.allFinite()) return;
-      cell_area[c] = voronoi_cell_area(centres[c], others, normal.normalized(), radius);
-    });
-    double total = 0;
-    for (int c = 0; c < n; ++c)
-      if (cell_area[c] > 0) {
-        total += cell_area[c];
-        ++report.density_cells;
-      }
-    report.density = total > 0 ? report.density_cells / total : 0;
-  }
+// The tangent-plane normal at centres[c] among its neighbours `others`: the surface's when
+// given, else the normal of the plane best fitting them all.
+Vector3d tangent_normal(const std::vector<Vector3d>& centres, int c,
+                        const std::vector<Vector3d>& others, const Vector3d& own, bool given) {
+  if (given) return own;
+  Vector3d mean = centres[c];
+  for (const Vector3d& o : others) mean += o;
+  mean /= static_cast<double>(others.size() + 1);
+  Eigen::Matrix3d cov = (centres[c] - mean) * (centres[c] - mean).transpose();
+  for (const Vector3d& o : others) cov += (o - mean) * (o - mean).transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+}
 
-  // Areas: given, or for a flat layer the centres' box grown by one spacing (a lattice of
-  // a x b cells then has exactly its area).
-  double area = options.area, end_area = options.area;
+// Density from the Voronoi cells of interior elements in their tangent planes (neighbours
+// within 4 spacings; with surface normals, those whose surface faces another way are none).
+void measure_density(const std::vector<Vector3d>& centres,
+                     const std::function<Vector3d(const Vector3d&)>& surface_normal,
+                     StructureReport& report) {
+  const int n = static_cast<int>(centres.size());
+  const double radius =
+      4 * (report.median_spacing > 0 ? report.median_spacing : report.median_size);
+  HashGrid3 grid(radius > 0 ? radius : 1.0);
+  for (int c = 0; c < n; ++c) grid.insert_box(c, centres[c], centres[c]);
+  std::vector<double> cell_area(static_cast<size_t>(n), 0);
+  tbb::parallel_for(0, n, [&](int c) {
+    if (!report.elements[c].interior || !(radius > 0)) return;
+    const Vector3d r = Vector3d::Constant(radius);
+    std::vector<Vector3d> others;
+    const Vector3d own = surface_normal ? surface_normal(centres[c]) : Vector3d::Zero();
+    for (const int d : grid.query_box(centres[c] - r, centres[c] + r)) {
+      if (d == c || (centres[d] - centres[c]).norm() > radius) continue;
+      if (surface_normal && surface_normal(centres[d]).dot(own) < 0.5) continue;
+      others.push_back(centres[d]);
+    }
+    if (others.size() < 3) return;
+    const Vector3d normal = tangent_normal(centres, c, others, own, bool(surface_normal));
+    if (!(normal.norm() > 0) || !normal.allFinite()) return;
+    cell_area[c] = voronoi_cell_area(centres[c], others, normal.normalized(), radius);
+  });
+  double total = 0;
+  for (int c = 0; c < n; ++c)
+    if (cell_area[c] > 0) {
+      total += cell_area[c];
+      ++report.density_cells;
+    }
+  report.density = total > 0 ? report.density_cells / total : 0;
+}
+
+// The textured area: given, or for a flat layer the centres' box grown by one spacing (a
+// lattice of a x b cells then has exactly its area); and the interior ends per unit of the
+// area farther than end_margin from the border.
+void measure_area(double given_area, const TextureBorder& border, const CentrePlane& plane,
+                  double end_margin, StructureReport& report) {
+  double area = given_area, end_area = given_area;
   if (!(area > 0) && border.kind == TextureBorder::Kind::FlatBox) {
     const Vector2d ext = plane.hi - plane.lo;
     const double d = report.median_spacing;
     area = (ext.x() + d) * (ext.y() + d);
   }
-  if (area > 0) {
-    end_area = area;
-    if (border.kind == TextureBorder::Kind::FlatBox) {
-      const Vector2d ext = plane.hi - plane.lo;
-      end_area = std::max(0.0, ext.x() - 2 * end_margin) * std::max(0.0, ext.y() - 2 * end_margin);
-    } else if (border.kind == TextureBorder::Kind::Segments) {
-      double perimeter = 0;
-      for (const auto& [a, b] : border.segments) perimeter += (b - a).norm();
-      end_area = std::max(0.0, area - perimeter * end_margin);
-    }
-    report.area = area;
-    report.interior_ends_per_area = end_area > 0 ? report.interior_ends / end_area : 0;
+  if (!(area > 0)) return;
+  end_area = area;
+  if (border.kind == TextureBorder::Kind::FlatBox) {
+    const Vector2d ext = plane.hi - plane.lo;
+    end_area = std::max(0.0, ext.x() - 2 * end_margin) * std::max(0.0, ext.y() - 2 * end_margin);
+  } else if (border.kind == TextureBorder::Kind::Segments) {
+    double perimeter = 0;
+    for (const auto& [a, b] : border.segments) perimeter += (b - a).norm();
+    end_area = std::max(0.0, area - perimeter * end_margin);
   }
+  report.area = area;
+  report.interior_ends_per_area = end_area > 0 ? report.interior_ends / end_area : 0;
+}
+
+}  // namespace
+
+StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& options) {
+  MQ_CHECK(mesh.V.allFinite(), InvalidInput, "the mesh has non-finite vertex coordinates");
+  check_kinds(mesh);
+  options.validate();
+  StructureReport report;
+  report.kinds = has_kinds(mesh) ? mesh.kinds : std::vector<std::string>{kDefaultKind};
+  std::vector<ElementFigures> figures = measure_elements(mesh, options, report.kinds);
+  classify_elements(figures, options, report);
+  if (figures.empty()) return report;
+  if (options.swatch) scale_shapes(figures, *options.swatch, options.linear_scale, report);
+
+  std::vector<Vector3d> centres;
+  for (const ElementStructure& e : report.elements) centres.push_back(e.centre);
+  report.median_spacing = median_spacing(centres, report.median_size);
+  const CentrePlane plane = centre_plane(centres);
+  const TextureBorder border = texture_border(options, plane, report.median_size);
+  report.border = border.kind;
+  // Ends this close to the border are where the texture stops, not breaks.
+  const double end_margin =
+      options.end_margin > 0 ? options.end_margin : 5 * report.median_long_width;
+  mark_interior(figures, border, plane, interior_margin(options, report), end_margin, report);
+  link_rings(figures, report);
+  count_elements(report);
+  measure_density(centres, options.surface_normal, report);
+  measure_area(options.area, border, plane, end_margin, report);
   return report;
 }
 
@@ -740,6 +824,158 @@ int common_count(const std::vector<int>& histogram, int rings) {
 
 }  // namespace
 
+namespace {
+
+// What a swatch kind's elements gather before their medians: the link counts of its rings
+// that are not degenerate, their folds and the elements' principal extents.
+struct KindSamples {
+  std::vector<int> histogram;
+  std::vector<double> folds;
+  std::array<std::vector<double>, 3> extents;
+};
+
+// Adds one swatch element (its figures e and its mesh part) to its kind: counts, samples and,
+// unless a similarity takes one of the kind's shapes of as many vertices onto it, a new shape
+// (the rings of a sheet are one shape; apples of varied sizes and squash are many).
+void add_to_kind(const ElementStructure& e, const TriMesh& part, SwatchKind& kind,
+                 KindSamples& samples) {
+  ++kind.elements;
+  kind.rings += e.ring_shaped ? 1 : 0;
+  kind.long_elements += e.long_element ? 1 : 0;
+  if (e.ring && !e.degenerate()) {
+    if (samples.histogram.size() <= static_cast<size_t>(e.links))
+      samples.histogram.resize(static_cast<size_t>(e.links) + 1, 0);
+    ++samples.histogram[static_cast<size_t>(e.links)];
+  }
+  if (e.ring_shaped) samples.folds.push_back(e.fold);
+  Vector3d s;
+  Eigen::Matrix3d axes;
+  principal_extents(part.V, s, &axes);
+  for (int a = 0; a < 3; ++a) samples.extents[a].push_back(s(a));
+  const MatrixX3d centred = part.V.rowwise() - part.V.colwise().mean();
+  int same_count = 0;
+  bool known = false;
+  for (const SwatchKind::Shape& shape : kind.shapes) {
+    if (shape.V.rows() != centred.rows()) continue;
+    ++same_count;
+    if (similarity_residual(shape.V, centred) < 1e-8) {
+      known = true;
+      break;
+    }
+  }
+  if (!known && same_count < 16) kind.shapes.push_back({centred, axes.leftCols<2>()});
+}
+
+// Per kind: ring-ness, link count, fold, extents and the distinct shapes of its elements.
+std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport& r) {
+  std::vector<int> fc;
+  const int ne = connected_components(mesh.F, mesh.num_vertices(), fc);
+  const std::vector<std::vector<int>> groups = component_faces(fc, ne);
+  std::vector<SwatchKind> kinds(r.kinds.size());
+  std::vector<KindSamples> samples(r.kinds.size());
+  for (size_t k = 0; k < r.kinds.size(); ++k) kinds[k].name = r.kinds[k];
+  for (int c = 0; c < ne; ++c) {
+    const ElementStructure& e = r.elements[static_cast<size_t>(c)];
+    const size_t k = static_cast<size_t>(e.kind);
+    add_to_kind(e, extract_faces(mesh, groups[static_cast<size_t>(c)]), kinds[k], samples[k]);
+  }
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    SwatchKind& kind = kinds[k];
+    kind.ring = 2 * kind.rings > kind.elements;
+    kind.compact = 2 * kind.long_elements <= kind.elements;
+    int judged = 0;
+    for (const int h : samples[k].histogram) judged += h;
+    if (kind.ring) kind.interior_links = common_count(samples[k].histogram, judged);
+    kind.fold = median(samples[k].folds);
+    for (int a = 0; a < 3; ++a) kind.extents(a) = median(samples[k].extents[a]);
+  }
+  return kinds;
+}
+
+// The element centres in the swatch plane (z is the thickness axis after prepare_swatch), with
+// their box and each one's neighbours within four spacings (they bound every cell that closes
+// at all in a sheet).
+class SwatchCentres {
+ public:
+  explicit SwatchCentres(const StructureReport& r)
+      : n_(static_cast<int>(r.elements.size())),
+        c_(static_cast<size_t>(n_)),
+        radius_(4 * (r.median_spacing > 0 ? r.median_spacing : r.median_size)),
+        grid_(std::max(radius_, 1e-12)) {
+    lo_ = Vector2d::Constant(std::numeric_limits<double>::infinity());
+    hi_ = -lo_;
+    for (int i = 0; i < n_; ++i) {
+      c_[i] = r.elements[i].centre.head<2>();
+      lo_ = lo_.cwiseMin(c_[i]);
+      hi_ = hi_.cwiseMax(c_[i]);
+    }
+    for (int i = 0; i < n_; ++i)
+      grid_.insert_box(i, Vector3d(c_[i].x(), c_[i].y(), 0), Vector3d(c_[i].x(), c_[i].y(), 0));
+  }
+  std::vector<int> near(int i) const {
+    const Vector3d p(c_[i].x(), c_[i].y(), 0), d(radius_, radius_, 0);
+    std::vector<int> ids;
+    for (const int j : grid_.query_box(p - d, p + d))
+      if (j != i && (c_[j] - c_[i]).norm() <= radius_) ids.push_back(j);
+    return ids;
+  }
+  // The mean area of the Voronoi cells that close inside the centres' box: elements per unit
+  // area, 0 when no cell closes.
+  double closed_cell_density() const {
+    const double tol = 1e-9 * std::max(1.0, (hi_ - lo_).norm());
+    double closed_area = 0;
+    int closed = 0;
+    for (int i = 0; i < n_ && n_ > 1; ++i) {
+      std::vector<Vector2d> cell = {lo_, Vector2d(hi_.x(), lo_.y()), hi_,
+                                    Vector2d(lo_.x(), hi_.y())};
+      for (const int j : near(i)) {
+        if (cell.empty()) break;
+        cell = clip(cell, 0.5 * (c_[i] + c_[j]), c_[j] - c_[i]);
+      }
+      bool inside = cell.size() >= 3;
+      for (const Vector2d& p : cell)
+        if (p.x() <= lo_.x() + tol || p.y() <= lo_.y() + tol || p.x() >= hi_.x() - tol ||
+            p.y() >= hi_.y() - tol)
+          inside = false;
+      if (!inside) continue;
+      closed_area += polygon_area(cell);
+      ++closed;
+    }
+    return closed > 0 && closed_area > 0 ? closed / closed_area : 0;
+  }
+  // 1 / the median area of the parallelogram of each centre's two nearest independent
+  // neighbours (exact for a lattice); 0 when there is none.
+  double lattice_cell_density() const {
+    std::vector<double> cells;
+    for (int i = 0; i < n_; ++i) {
+      std::vector<std::pair<double, int>> byd;
+      for (const int j : near(i)) byd.emplace_back((c_[j] - c_[i]).norm(), j);
+      std::sort(byd.begin(), byd.end());
+      if (byd.empty()) continue;
+      const Vector2d v1 = c_[byd[0].second] - c_[i];
+      for (size_t k = 1; k < byd.size(); ++k) {
+        const Vector2d v2 = c_[byd[k].second] - c_[i];
+        const double cross = std::abs(v1.x() * v2.y() - v1.y() * v2.x());
+        if (cross > 0.2 * v1.norm() * v2.norm()) {
+          cells.push_back(cross);
+          break;
+        }
+      }
+    }
+    const double m = median(cells);
+    return m > 0 ? 1.0 / m : 0;
+  }
+
+ private:
+  int n_;
+  std::vector<Vector2d> c_;
+  Vector2d lo_, hi_;
+  double radius_;
+  HashGrid3 grid_;
+};
+
+}  // namespace
+
 SwatchStructure measure_swatch_structure(const TriMesh& swatch) {
   SwatchStructure out;
   const PreparedSwatch prepared = prepare_swatch(swatch);
@@ -748,122 +984,12 @@ SwatchStructure measure_swatch_structure(const TriMesh& swatch) {
   out.report = measure_structure(prepared.mesh, own);
   const StructureReport& r = out.report;
   out.interior_links = common_count(r.link_histogram, r.rings - r.degenerate_rings());
-
-  // Per kind: ring-ness, link count, fold, extents and the distinct shapes of its elements.
-  std::vector<int> fc;
-  const int ne = connected_components(prepared.mesh.F, prepared.mesh.num_vertices(), fc);
-  const std::vector<std::vector<int>> groups = component_faces(fc, ne);
-  out.kinds.resize(r.kinds.size());
-  std::vector<std::vector<int>> histograms(r.kinds.size());
-  std::vector<std::vector<double>> folds(r.kinds.size());
-  std::vector<std::array<std::vector<double>, 3>> extents(r.kinds.size());
-  for (size_t k = 0; k < r.kinds.size(); ++k) out.kinds[k].name = r.kinds[k];
-  for (int c = 0; c < ne; ++c) {
-    const ElementStructure& e = r.elements[static_cast<size_t>(c)];
-    const size_t k = static_cast<size_t>(e.kind);
-    SwatchKind& kind = out.kinds[k];
-    ++kind.elements;
-    kind.rings += e.ring_shaped ? 1 : 0;
-    kind.long_elements += e.long_element ? 1 : 0;
-    if (e.ring && !e.degenerate()) {
-      if (histograms[k].size() <= static_cast<size_t>(e.links))
-        histograms[k].resize(static_cast<size_t>(e.links) + 1, 0);
-      ++histograms[k][static_cast<size_t>(e.links)];
-    }
-    if (e.ring_shaped) folds[k].push_back(e.fold);
-    const TriMesh part = extract_faces(prepared.mesh, groups[static_cast<size_t>(c)]);
-    Vector3d s;
-    Eigen::Matrix3d axes;
-    principal_extents(part.V, s, &axes);
-    for (int a = 0; a < 3; ++a) extents[k][a].push_back(s(a));
-    // A new shape unless a similarity takes one of the kind's shapes of as many vertices onto
-    // it (the rings of a sheet are one shape; apples of varied sizes and squash are many).
-    const MatrixX3d centred = part.V.rowwise() - part.V.colwise().mean();
-    int same_count = 0;
-    bool known = false;
-    for (const SwatchKind::Shape& shape : kind.shapes) {
-      if (shape.V.rows() != centred.rows()) continue;
-      ++same_count;
-      if (similarity_residual(shape.V, centred) < 1e-8) {
-        known = true;
-        break;
-      }
-    }
-    if (!known && same_count < 16) kind.shapes.push_back({centred, axes.leftCols<2>()});
-  }
-  for (size_t k = 0; k < out.kinds.size(); ++k) {
-    SwatchKind& kind = out.kinds[k];
-    kind.ring = 2 * kind.rings > kind.elements;
-    kind.compact = 2 * kind.long_elements <= kind.elements;
-    int judged = 0;
-    for (const int h : histograms[k]) judged += h;
-    if (kind.ring) kind.interior_links = common_count(histograms[k], judged);
-    kind.fold = median(folds[k]);
-    for (int a = 0; a < 3; ++a) kind.extents(a) = median(extents[k][a]);
-  }
-
-  // Density from Voronoi cells in the swatch plane (z is the thickness axis after prepare).
-  const int n = static_cast<int>(r.elements.size());
-  std::vector<Vector2d> c(static_cast<size_t>(n));
-  Vector2d lo = Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (int i = 0; i < n; ++i) {
-    c[i] = r.elements[i].centre.head<2>();
-    lo = lo.cwiseMin(c[i]);
-    hi = hi.cwiseMax(c[i]);
-  }
-  const double tol = 1e-9 * std::max(1.0, (hi - lo).norm());
-  // Neighbours within four spacings bound every cell that closes at all in a sheet.
-  const double radius = 4 * (r.median_spacing > 0 ? r.median_spacing : r.median_size);
-  HashGrid3 grid(std::max(radius, 1e-12));
-  for (int i = 0; i < n; ++i)
-    grid.insert_box(i, Vector3d(c[i].x(), c[i].y(), 0), Vector3d(c[i].x(), c[i].y(), 0));
-  auto near = [&](int i) {
-    const Vector3d p(c[i].x(), c[i].y(), 0), d(radius, radius, 0);
-    std::vector<int> ids;
-    for (const int j : grid.query_box(p - d, p + d))
-      if (j != i && (c[j] - c[i]).norm() <= radius) ids.push_back(j);
-    return ids;
-  };
-  double closed_area = 0;
-  int closed = 0;
-  for (int i = 0; i < n && n > 1; ++i) {
-    std::vector<Vector2d> cell = {lo, Vector2d(hi.x(), lo.y()), hi, Vector2d(lo.x(), hi.y())};
-    for (const int j : near(i)) {
-      if (cell.empty()) break;
-      cell = clip(cell, 0.5 * (c[i] + c[j]), c[j] - c[i]);
-    }
-    bool inside = cell.size() >= 3;
-    for (const Vector2d& p : cell)
-      if (p.x() <= lo.x() + tol || p.y() <= lo.y() + tol || p.x() >= hi.x() - tol ||
-          p.y() >= hi.y() - tol)
-        inside = false;
-    if (!inside) continue;
-    closed_area += polygon_area(cell);
-    ++closed;
-  }
-  if (closed > 0 && closed_area > 0) {
-    out.density = closed / closed_area;
-    return out;
-  }
-  // No closed cell: the lattice cell of each centre's two nearest independent neighbours.
-  std::vector<double> cells;
-  for (int i = 0; i < n; ++i) {
-    std::vector<std::pair<double, int>> byd;
-    for (const int j : near(i)) byd.emplace_back((c[j] - c[i]).norm(), j);
-    std::sort(byd.begin(), byd.end());
-    if (byd.empty()) continue;
-    const Vector2d v1 = c[byd[0].second] - c[i];
-    for (size_t k = 1; k < byd.size(); ++k) {
-      const Vector2d v2 = c[byd[k].second] - c[i];
-      const double cross = std::abs(v1.x() * v2.y() - v1.y() * v2.x());
-      if (cross > 0.2 * v1.norm() * v2.norm()) {
-        cells.push_back(cross);
-        break;
-      }
-    }
-  }
-  const double m = median(cells);
-  out.density = m > 0 ? 1.0 / m : 0;
+  out.kinds = swatch_kinds(prepared.mesh, r);
+  // Density from Voronoi cells in the swatch plane; when no cell closes (a sheet two elements
+  // wide), from the lattice cell of each centre's nearest neighbours.
+  const SwatchCentres centres(r);
+  out.density = centres.closed_cell_density();
+  if (!(out.density > 0)) out.density = centres.lattice_cell_density();
   return out;
 }
 

@@ -70,6 +70,10 @@ struct StructureOptions {
   double linear_scale = 0;
   // Rings judged folded (off only for the swatch itself, whose rings are the reference).
   bool judge_folds = true;
+
+  // Throws InvalidInput when loop_bins < 8 or a margin, the area or the scale is negative or
+  // not finite (0 is automatic).
+  void validate() const;
 };
 
 // Why a ring cannot count as linked (issue 23: the measure counted rings squeezed shut or folded
@@ -189,7 +193,8 @@ struct StructureReport {
 // Measures the structure of a mesh whose connected components are the elements. Deterministic
 // whatever the thread count. O(#F log #F) plus, per pair of rings whose loops' boxes overlap,
 // O(#loop^2).
-// Throws InvalidInput for non-finite coordinates, out-of-range indices or invalid kinds.
+// Throws InvalidInput for non-finite coordinates, out-of-range indices, invalid kinds or
+// options that StructureOptions::validate rejects.
 StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& options = {});
 
 // One kind of swatch element, the reference its output elements are judged against.

@@ -21,101 +21,88 @@ int corner_of(const MatrixX3i& F, int f, int v) {
   return -1;
 }
 
-}  // namespace
-
-GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX3i& F,
-                                               const EdgeTopology& topo, const MatrixX3i& TT,
-                                               const DirectionField& field,
-                                               const GlobalParameterizationOptions& options) {
-  const int nf = static_cast<int>(F.rows()), nv = static_cast<int>(V.rows());
-  const int ne = topo.num_edges();
-  MQ_CHECK(field.direction.rows() == nf && static_cast<int>(field.matching.size()) == ne &&
-               static_cast<int>(field.index.size()) == nv,
-           InvalidInput, "global parameterisation: the field does not match the mesh");
-  MQ_CHECK(options.face_scale.size() == 0 || options.face_scale.size() == nf, InvalidInput,
-           "global parameterisation: ", options.face_scale.size(), " face scales for ", nf,
-           " faces");
-  MQ_CHECK(
-      field.N == 1 || field.N == 2, InvalidInput,
-      "global parameterisation: the field must be a vector or a line field, got N = ", field.N);
-  GlobalParameterization gp;
-  gp.field = field;
-  gp.singular.assign(static_cast<size_t>(nv), 0);
-  for (int v = 0; v < nv; ++v)
-    if (field.index[v] != 0) {
-      gp.singular[v] = 1;
-      ++gp.num_singular;
-    }
-
-  // Cut graph: the edges outside a breadth-first dual spanning tree.
-  gp.cut.assign(static_cast<size_t>(ne), 0);
-  gp.sign.assign(static_cast<size_t>(ne), 1);
-  {
-    std::vector<char> tree(static_cast<size_t>(ne), 0), seen(static_cast<size_t>(nf), 0);
-    for (int start = 0; start < nf; ++start) {
-      if (seen[start]) continue;
-      seen[start] = 1;
-      std::queue<int> q;
-      q.push(start);
-      while (!q.empty()) {
-        const int f = q.front();
-        q.pop();
-        for (int k = 0; k < 3; ++k) {
-          const int g = TT(f, k);
-          if (g < 0 || seen[g]) continue;
-          seen[g] = 1;
-          tree[topo.FE(f, k)] = 1;
-          q.push(g);
-        }
+// The edges of a breadth-first dual spanning tree (faces joined across TT).
+std::vector<char> dual_spanning_tree(const EdgeTopology& topo, const MatrixX3i& TT, int nf) {
+  std::vector<char> tree(static_cast<size_t>(topo.num_edges()), 0),
+      seen(static_cast<size_t>(nf), 0);
+  for (int start = 0; start < nf; ++start) {
+    if (seen[start]) continue;
+    seen[start] = 1;
+    std::queue<int> q;
+    q.push(start);
+    while (!q.empty()) {
+      const int f = q.front();
+      q.pop();
+      for (int k = 0; k < 3; ++k) {
+        const int g = TT(f, k);
+        if (g < 0 || seen[g]) continue;
+        seen[g] = 1;
+        tree[topo.FE(f, k)] = 1;
+        q.push(g);
       }
-    }
-    std::vector<int> degree(static_cast<size_t>(nv), 0);
-    std::vector<std::vector<int>> edges_at(static_cast<size_t>(nv));
-    for (int e = 0; e < ne; ++e) {
-      const int a = topo.E(e, 0), b = topo.E(e, 1);
-      if (topo.edge_faces.degree(e) != 2) {
-        // Boundaries (and non-manifold edges, which TT does not cross) anchor the cut graph.
-        degree[a] += 2;
-        degree[b] += 2;
-        continue;
-      }
-      if (tree[e]) continue;
-      gp.cut[e] = 1;
-      ++degree[a];
-      ++degree[b];
-      edges_at[a].push_back(e);
-      edges_at[b].push_back(e);
-    }
-    // Only cones whose transition is not the identity need a cut to end at them.
-    auto keeps = [&](int v) { return field.N > 1 && field.index[v] % field.N != 0; };
-    std::queue<int> leaves;
-    for (int v = 0; v < nv; ++v)
-      if (degree[v] == 1 && !keeps(v)) leaves.push(v);
-    while (!leaves.empty()) {
-      const int v = leaves.front();
-      leaves.pop();
-      if (degree[v] != 1) continue;
-      for (const int e : edges_at[v]) {
-        if (!gp.cut[e]) continue;
-        gp.cut[e] = 0;
-        const int w = topo.E(e, 0) == v ? topo.E(e, 1) : topo.E(e, 0);
-        --degree[v];
-        --degree[w];
-        if (degree[w] == 1 && !keeps(w)) leaves.push(w);
-        break;
-      }
-    }
-    for (int e = 0; e < ne; ++e) {
-      if (gp.cut[e]) ++gp.num_cut_edges;
-      // The half turn of a line field's matching; 0 elsewhere (tree edges by construction,
-      // pruned ones because the turns around a regular vertex cancel).
-      if (gp.cut[e] && field.N == 2 && field.matching[e] == 1) gp.sign[e] = -1;
     }
   }
+  return tree;
+}
 
-  // Corner groups: corners of one vertex joined across edges that are not cut.
-  UnionFind uf(3 * nf);
+// Cut graph: the interior edges outside the dual spanning tree, pruned from their dangling
+// ends (boundaries, and non-manifold edges, which TT does not cross, anchor it; so do cones
+// whose transition is not the identity), and the half-turn sign of each cut edge.
+void cut_graph(const EdgeTopology& topo, const MatrixX3i& TT, const DirectionField& field, int nf,
+               int nv, GlobalParameterization& gp) {
+  const int ne = topo.num_edges();
+  gp.cut.assign(static_cast<size_t>(ne), 0);
+  gp.sign.assign(static_cast<size_t>(ne), 1);
+  const std::vector<char> tree = dual_spanning_tree(topo, TT, nf);
+  std::vector<int> degree(static_cast<size_t>(nv), 0);
+  std::vector<std::vector<int>> edges_at(static_cast<size_t>(nv));
   for (int e = 0; e < ne; ++e) {
+    const int a = topo.E(e, 0), b = topo.E(e, 1);
+    if (topo.edge_faces.degree(e) != 2) {
+      degree[a] += 2;
+      degree[b] += 2;
+      continue;
+    }
+    if (tree[e]) continue;
+    gp.cut[e] = 1;
+    ++degree[a];
+    ++degree[b];
+    edges_at[a].push_back(e);
+    edges_at[b].push_back(e);
+  }
+  // Only cones whose transition is not the identity need a cut to end at them.
+  auto keeps = [&](int v) { return field.N > 1 && field.index[v] % field.N != 0; };
+  std::queue<int> leaves;
+  for (int v = 0; v < nv; ++v)
+    if (degree[v] == 1 && !keeps(v)) leaves.push(v);
+  while (!leaves.empty()) {
+    const int v = leaves.front();
+    leaves.pop();
+    if (degree[v] != 1) continue;
+    for (const int e : edges_at[v]) {
+      if (!gp.cut[e]) continue;
+      gp.cut[e] = 0;
+      const int w = topo.E(e, 0) == v ? topo.E(e, 1) : topo.E(e, 0);
+      --degree[v];
+      --degree[w];
+      if (degree[w] == 1 && !keeps(w)) leaves.push(w);
+      break;
+    }
+  }
+  for (int e = 0; e < ne; ++e) {
+    if (gp.cut[e]) ++gp.num_cut_edges;
+    // The half turn of a line field's matching; 0 elsewhere (tree edges by construction,
+    // pruned ones because the turns around a regular vertex cancel).
+    if (gp.cut[e] && field.N == 2 && field.matching[e] == 1) gp.sign[e] = -1;
+  }
+}
+
+// Corner groups (wedges): corners of one vertex joined across edges that are not cut. Returns
+// the number of wedges.
+int group_corners(const MatrixX3i& F, const EdgeTopology& topo, GlobalParameterization& gp) {
+  const int nf = static_cast<int>(F.rows());
+  UnionFind uf(3 * nf);
+  for (int e = 0; e < topo.num_edges(); ++e) {
     if (topo.edge_faces.degree(e) != 2 || gp.cut[e]) continue;
     const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
     for (int side = 0; side < 2; ++side) {
@@ -132,10 +119,20 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
     if (id[r] < 0) id[r] = nw++;
     gp.corner_wedge(c / 3, c % 3) = id[r];
   }
+  return nw;
+}
 
-  // Dirichlet energy of (u - d, v - n x d) per face, and the cut constraints.
+// The normal equations over the wedges' (u, v), as triplets and two right-hand sides.
+struct WedgeSystem {
   std::vector<Eigen::Triplet<double>> t;
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nw, 2);
+  Eigen::MatrixXd rhs;
+};
+
+// Dirichlet energy of (u - s d, v - s n x d) per face.
+void add_dirichlet(const MatrixX3d& V, const MatrixX3i& F, const DirectionField& field,
+                   const GlobalParameterizationOptions& options, const GlobalParameterization& gp,
+                   WedgeSystem& sys) {
+  const int nf = static_cast<int>(F.rows());
   for (int f = 0; f < nf; ++f) {
     const Vector3d x[3] = {V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2))};
     Vector3d n = (x[1] - x[0]).cross(x[2] - x[0]);
@@ -152,12 +149,17 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
     for (int i = 0; i < 3; ++i) {
       const int wi = gp.corner_wedge(f, i);
       for (int j = 0; j < 3; ++j)
-        t.emplace_back(wi, gp.corner_wedge(f, j), area * grad[i].dot(grad[j]));
-      rhs(wi, 0) += area * grad[i].dot(d);
-      rhs(wi, 1) += area * grad[i].dot(d2);
+        sys.t.emplace_back(wi, gp.corner_wedge(f, j), area * grad[i].dot(grad[j]));
+      sys.rhs(wi, 0) += area * grad[i].dot(d);
+      sys.rhs(wi, 1) += area * grad[i].dot(d2);
     }
   }
-  for (int e = 0; e < ne; ++e) {
+}
+
+// Per cut edge (p, q) between faces f and g: uv_g(p) - uv_g(q) = s (uv_f(p) - uv_f(q)).
+void add_cut_constraints(const MatrixX3i& F, const EdgeTopology& topo, double cut_weight,
+                         const GlobalParameterization& gp, WedgeSystem& sys) {
+  for (int e = 0; e < topo.num_edges(); ++e) {
     if (!gp.cut[e]) continue;
     const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
     const int p = topo.E(e, 0), q = topo.E(e, 1);
@@ -167,8 +169,14 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
     const double s = gp.sign[e];
     const double c[4] = {1, -1, -s, s};
     for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) t.emplace_back(w[i], w[j], options.cut_weight * c[i] * c[j]);
+      for (int j = 0; j < 4; ++j) sys.t.emplace_back(w[i], w[j], cut_weight * c[i] * c[j]);
   }
+}
+
+// The pinned vertices (their first wedge) at their coordinates.
+void add_pins(const MatrixX3i& F, int nv, const GlobalParameterizationOptions& options,
+              const GlobalParameterization& gp, WedgeSystem& sys) {
+  const int nf = static_cast<int>(F.rows());
   std::vector<int> first_wedge(static_cast<size_t>(nv), -1);
   if (!options.pinned.empty())
     for (int f = nf - 1; f >= 0; --f)
@@ -178,42 +186,94 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
              " out of range");
     const int w = first_wedge[v];
     if (w < 0) continue;
-    t.emplace_back(w, w, options.pin_weight);
-    rhs(w, 0) += options.pin_weight * at.x();
-    rhs(w, 1) += options.pin_weight * at.y();
+    sys.t.emplace_back(w, w, options.pin_weight);
+    sys.rhs(w, 0) += options.pin_weight * at.x();
+    sys.rhs(w, 1) += options.pin_weight * at.y();
   }
+}
+
+// The fixed translations of cut edges: weight (uv_g - s uv_f - t)^2 at both ends.
+void add_fixed_translations(const MatrixX3i& F, const EdgeTopology& topo,
+                            const GlobalParameterizationOptions& options,
+                            const GlobalParameterization& gp, WedgeSystem& sys) {
   for (const auto& [e, tr] : options.fixed_translation) {
-    if (e < 0 || e >= ne || !gp.cut[e]) continue;
+    if (e < 0 || e >= topo.num_edges() || !gp.cut[e]) continue;
     const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
     const double s = gp.sign[e];
     for (int side = 0; side < 2; ++side) {
       const int v = topo.E(e, side);
       const int wg = gp.corner_wedge(g, corner_of(F, g, v)),
                 wf = gp.corner_wedge(f, corner_of(F, f, v));
-      // weight (uv_g - s uv_f - t)^2
       const double wt = options.cut_weight;
-      t.emplace_back(wg, wg, wt);
-      t.emplace_back(wf, wf, wt);
-      t.emplace_back(wg, wf, -s * wt);
-      t.emplace_back(wf, wg, -s * wt);
-      rhs(wg, 0) += wt * tr.x();
-      rhs(wg, 1) += wt * tr.y();
-      rhs(wf, 0) -= s * wt * tr.x();
-      rhs(wf, 1) -= s * wt * tr.y();
+      sys.t.emplace_back(wg, wg, wt);
+      sys.t.emplace_back(wf, wf, wt);
+      sys.t.emplace_back(wg, wf, -s * wt);
+      sys.t.emplace_back(wf, wg, -s * wt);
+      sys.rhs(wg, 0) += wt * tr.x();
+      sys.rhs(wg, 1) += wt * tr.y();
+      sys.rhs(wf, 0) -= s * wt * tr.x();
+      sys.rhs(wf, 1) -= s * wt * tr.y();
     }
   }
+}
+
+// One sparse factorisation, two right-hand sides: the wedges' coordinates.
+void solve_wedges(WedgeSystem& sys, int nw, GlobalParameterization& gp) {
   // Translations are free per component: a whisper of regularisation fixes them.
-  for (int i = 0; i < nw; ++i) t.emplace_back(i, i, 1e-9);
+  for (int i = 0; i < nw; ++i) sys.t.emplace_back(i, i, 1e-9);
   Eigen::SparseMatrix<double> M(nw, nw);
-  M.setFromTriplets(t.begin(), t.end());
+  M.setFromTriplets(sys.t.begin(), sys.t.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
   MQ_CHECK(ldlt.info() == Eigen::Success, SolverFailure,
            "global parameterisation: the system could not be factorised");
-  const Eigen::MatrixXd uv = ldlt.solve(rhs);
+  const Eigen::MatrixXd uv = ldlt.solve(sys.rhs);
   MQ_CHECK(ldlt.info() == Eigen::Success && uv.allFinite(), SolverFailure,
            "global parameterisation: the solve failed");
   gp.wedge_uv.resize(nw, 2);
   for (int i = 0; i < nw; ++i) gp.wedge_uv.row(i) << uv(i, 0), uv(i, 1);
+}
+
+}  // namespace
+
+void GlobalParameterizationOptions::validate() const {
+  MQ_CHECK(
+      std::isfinite(cut_weight) && cut_weight > 0 && std::isfinite(pin_weight) && pin_weight > 0,
+      InvalidInput, "global parameterisation: the cut and pin weights must be positive");
+}
+
+GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX3i& F,
+                                               const EdgeTopology& topo, const MatrixX3i& TT,
+                                               const DirectionField& field,
+                                               const GlobalParameterizationOptions& options) {
+  const int nf = static_cast<int>(F.rows()), nv = static_cast<int>(V.rows());
+  MQ_CHECK(field.direction.rows() == nf &&
+               static_cast<int>(field.matching.size()) == topo.num_edges() &&
+               static_cast<int>(field.index.size()) == nv,
+           InvalidInput, "global parameterisation: the field does not match the mesh");
+  MQ_CHECK(options.face_scale.size() == 0 || options.face_scale.size() == nf, InvalidInput,
+           "global parameterisation: ", options.face_scale.size(), " face scales for ", nf,
+           " faces");
+  MQ_CHECK(
+      field.N == 1 || field.N == 2, InvalidInput,
+      "global parameterisation: the field must be a vector or a line field, got N = ", field.N);
+  options.validate();
+  GlobalParameterization gp;
+  gp.field = field;
+  gp.singular.assign(static_cast<size_t>(nv), 0);
+  for (int v = 0; v < nv; ++v)
+    if (field.index[v] != 0) {
+      gp.singular[v] = 1;
+      ++gp.num_singular;
+    }
+  cut_graph(topo, TT, field, nf, nv, gp);
+  const int nw = group_corners(F, topo, gp);
+  WedgeSystem sys;
+  sys.rhs = Eigen::MatrixXd::Zero(nw, 2);
+  add_dirichlet(V, F, field, options, gp, sys);
+  add_cut_constraints(F, topo, options.cut_weight, gp, sys);
+  add_pins(F, nv, options, gp, sys);
+  add_fixed_translations(F, topo, options, gp, sys);
+  solve_wedges(sys, nw, gp);
   return gp;
 }
 

@@ -51,6 +51,9 @@ struct GlobalParameterizationOptions {
   std::vector<std::pair<int, Vector2d>> pinned;
   // Cut edges whose transition translation is fixed: uv_g = s uv_f + t at both ends.
   std::vector<std::pair<int, Vector2d>> fixed_translation;
+
+  // Throws InvalidInput unless both weights are positive and finite.
+  void validate() const;
 };
 
 // A maximal chain of cut edges through regular vertices (cut degree 2, not singular, not on a
@@ -79,7 +82,8 @@ Vector2d edge_translation(const CutPath& path, size_t k, const Vector2d& t);
 // sign), which makes the transition across each cut path one rigid motion.
 //   field  a direction field of N = 1 or 2 (smooth_direction_field)
 // One sparse factorisation, two right-hand sides. Throws InvalidInput for sizes that do not
-// match, SolverFailure when the factorisation fails.
+// match, a pinned vertex out of range or options.validate() failing, SolverFailure when the
+// factorisation or the solve fails.
 GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX3i& F,
                                                const EdgeTopology& topo, const MatrixX3i& TT,
                                                const DirectionField& field,

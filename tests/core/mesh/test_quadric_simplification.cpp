@@ -177,7 +177,9 @@ TEST(QuadricSimplification, BadOptionsAndMeshesAreRefused) {
   o.max_normal_turn_degrees = 45;
   o.min_quality = 1.5;
   EXPECT_THROW(simplify_by_quadrics(grid, o), InvalidInput);
+  EXPECT_THROW(o.validate(), InvalidInput);
   o.min_quality = 0.3;
+  EXPECT_NO_THROW(o.validate());
   TriMesh bad = grid;
   bad.F(0, 0) = 99;
   EXPECT_THROW(simplify_by_quadrics(bad, o), InvalidInput);

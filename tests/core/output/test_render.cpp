@@ -234,5 +234,15 @@ TEST(Render, RealMeshBunny) {
   EXPECT_FALSE(is_background(im, o.width / 2, o.height / 2, o));
 }
 
+TEST(Render, OptionsValidate) {
+  RenderOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.up_axis = 3;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o.up_axis = 1;
+  o.fov_deg = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
+}
+
 }  // namespace
 }  // namespace mq

@@ -11,6 +11,7 @@
 
 #include "core/common/errors.h"
 #include "core/mesh/mesh_io.h"
+#include "core/planar/patch_quilting.h"
 #include "core/planar/planar_quilting.h"
 #include "core/planar/swatch_generators.h"
 #include "core/structure/texture_structure.h"
@@ -278,6 +279,27 @@ TEST(PlanarQuilting, SingleElementLargerThanTheDomainIsInvalidInput) {
   PlanarQuiltingOptions o;
   o.length = o.width = 0.5 * b.extent().minCoeff();
   EXPECT_THROW(quilt_plane(link, o, cpu), InvalidInput);
+}
+
+TEST(PlanarQuilting, PatchOptionsOutOfRangeAreRefused) {
+  PatchQuiltingOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.partner_share = 1.5;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o.partner_share = std::nan("");
+  EXPECT_THROW(o.validate(), InvalidInput);
+}
+
+TEST(PlanarQuilting, OptionsOutOfRangeAreRefused) {
+  PlanarQuiltingOptions o;
+  EXPECT_THROW(o.validate(), InvalidInput);  // no size
+  o.length = o.width = 4;
+  EXPECT_NO_THROW(o.validate());
+  o.cell_size = -1;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o.cell_size = 0;
+  o.subpatch_fraction = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
 }
 
 }  // namespace

@@ -217,5 +217,19 @@ TEST(OffsetSurface, InvalidInputThrows) {
   EXPECT_NO_THROW(offset_surface(s.V, s.F, opt));
 }
 
+TEST(OffsetSurface, OptionsValidate) {
+  OffsetOptions opt;
+  EXPECT_THROW(opt.validate(), InvalidInput);  // height 0
+  EXPECT_NO_THROW(opt.validate_smoothing());   // offset_directions needs no height
+  opt.height = 0.1;
+  EXPECT_NO_THROW(opt.validate());
+  opt.max_rounds = 0;
+  EXPECT_THROW(opt.validate(), InvalidInput);
+  opt.max_rounds = 1;
+  opt.smoothing_radius = -1;
+  EXPECT_THROW(opt.validate_smoothing(), InvalidInput);
+  EXPECT_THROW(opt.validate(), InvalidInput);
+}
+
 }  // namespace
 }  // namespace mq

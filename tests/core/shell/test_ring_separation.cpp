@@ -169,5 +169,18 @@ TEST(RingSeparation, SizesThatDoNotAgreeAreRefused) {
                InvalidInput);
 }
 
+TEST(RingSeparation, OptionsOutOfRangeAreRefused) {
+  RingSeparationOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.max_step = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o = RingSeparationOptions{};
+  o.max_iterations = -1;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o = RingSeparationOptions{};
+  o.clearance = std::nan("");
+  EXPECT_THROW(o.validate(), InvalidInput);
+}
+
 }  // namespace
 }  // namespace mq

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 
+#include "core/common/errors.h"
 #include "core/mesh/element_kinds.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
@@ -576,6 +577,20 @@ TEST(SelfIntersection, FoldedRingIsFoundAndNeighboursAreNot) {
   const std::vector<int> self = self_intersecting_components(folded.V, folded.F);
   ASSERT_EQ(self.size(), 1u);
   EXPECT_EQ(self[0], 1);
+}
+
+TEST(TextureStructure, OptionsValidateRejectsFewBinsAndNegativeFigures) {
+  StructureOptions so;
+  EXPECT_NO_THROW(so.validate());
+  so.loop_bins = 4;
+  EXPECT_THROW(so.validate(), InvalidInput);
+  EXPECT_THROW(measure_structure(chain(2), so), InvalidInput);
+  so = StructureOptions{};
+  so.end_margin = -1;
+  EXPECT_THROW(so.validate(), InvalidInput);
+  so = StructureOptions{};
+  so.linear_scale = std::nan("");
+  EXPECT_THROW(so.validate(), InvalidInput);
 }
 
 }  // namespace

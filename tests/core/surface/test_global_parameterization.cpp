@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/common/errors.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/surface/global_parameterization.h"
 #include "core/surface/line_field.h"
@@ -159,6 +160,16 @@ TEST(GlobalParameterization, LocateWalksAcrossCutsToThePoint) {
       EXPECT_NEAR(b.minCoeff(), 1.0 / 3.0, 1e-3);
     }
   EXPECT_GT(cut_crossings, 0);
+}
+
+TEST(GlobalParameterization, OptionsWithoutPositiveWeightsAreRefused) {
+  GlobalParameterizationOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.cut_weight = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o.cut_weight = 1;
+  o.pin_weight = std::nan("");
+  EXPECT_THROW(o.validate(), InvalidInput);
 }
 
 }  // namespace
