@@ -11,6 +11,9 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # The add-on is installed into a throw-away user scripts directory, not the user's own.
 export BLENDER_USER_SCRIPTS="$work/scripts" BLENDER_USER_CONFIG="$work/config"
+# The add-on keeps the quilts of an unsaved file in the temporary directory: this run's go too.
+mkdir -p "$work/tmp"
+export TMPDIR="$work/tmp"
 blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
   "$engine" "$(realpath build/meshquilt_blender.zip)" "$work/out" 2>&1 |
   grep -E '^\[blender\]|Error|error:|Traceback|File "' || true

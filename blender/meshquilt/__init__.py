@@ -5,6 +5,10 @@ sample kind), the scale, the guidance and the seed; Run quilts in the background
 and time remaining in the status bar (Esc or Cancel stops it), and brings the result in as a new
 object parented to the base, with a material per kind of element and the integer face
 attributes `element_id` and `kind`.
+
+Every run also saves its quilt (follow.py): the result can then follow its base (its evaluated
+mesh, re-placed by the engine without a new synthesis when the frame changes), be baked over the
+scene's frame range into shape keys, and lose the elements selected in it.
 """
 
 bl_info = {
@@ -24,7 +28,7 @@ import tempfile
 import bpy
 import numpy as np
 
-from . import engine, exchange
+from . import engine, exchange, follow
 
 _running = {}  # the one active Run, under key "run", while the modal operator works
 
@@ -76,6 +80,38 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     seed: bpy.props.IntProperty(name="Seed", default=1, min=0)
 
 
+def _follow_changed(self, context):
+    obj = self.id_data
+    if not self.follow:
+        return
+    if self.baked:
+        follow.clear_bake(obj)
+    try:
+        follow.place(obj, context.evaluated_depsgraph_get(), context, force=True)
+    except (engine.EngineError, OSError, ValueError, KeyError) as e:
+        follow.stop_following(obj, str(e))
+
+
+class MeshquiltBinding(bpy.types.PropertyGroup):
+    """A result's tie to its base (Object.meshquilt): its saved quilt and how it follows."""
+    quilt: bpy.props.StringProperty(
+        name="Saved quilt", subtype="FILE_PATH",
+        description="The quilt saved by the run that made this object (meshquilt embed places "
+        "it on the base moved)")
+    base: bpy.props.PointerProperty(name="Base", type=bpy.types.Object,
+                                    description="The object this result was quilted over")
+    base_matrix: bpy.props.FloatVectorProperty(
+        name="Base matrix", size=16, description="The base's world matrix when it was quilted")
+    follow: bpy.props.BoolProperty(
+        name="Follow base", default=False, update=_follow_changed,
+        description="Place the result again on the base's evaluated mesh (modifiers, armature, "
+        "shape keys) whenever the frame changes, without a new synthesis")
+    baked: bpy.props.BoolProperty(
+        name="Baked", default=False,
+        description="The result's positions over the frame range are stored in shape keys")
+    status: bpy.props.StringProperty(name="Status", default="")
+
+
 class Run:
     """One quilting run: inputs exported, the engine jobs in turn, the result imported. Both the
     modal operator (UI) and the blocking one (scripts) drive it through step()."""
@@ -97,7 +133,12 @@ class Run:
         depsgraph = context.evaluated_depsgraph_get()
         base_path = os.path.join(self.dir, "base.ply")
         field = field_file = None
-        V = self._export(depsgraph, base, base_path)[0]
+        self.topology = {}
+        V, T = self._export(depsgraph, base, base_path, topology=self.topology)[:2]
+        self.base_matrix = np.array(base.matrix_world)
+        # The quilt saved for following the base (not over a base the engine would simplify).
+        self.quilt_path = os.path.join(self.dir, "quilt.mqq") \
+            if len(T) <= follow.PROXY_MIN_FACES else None
         if settings.guidance == "AXIS":
             axis = {"X": 0, "Y": 1, "Z": 2}[settings.guide_axis]
             field = tuple(settings.guide_object.matrix_world.to_3x3().col[axis])
@@ -116,7 +157,8 @@ class Run:
                                                        settings.seed))
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.result_path, settings.scale,
-            seed=settings.seed, stretch=settings.stretch, field=field, field_file=field_file))
+            seed=settings.seed, stretch=settings.stretch, field=field, field_file=field_file,
+            save_quilt=self.quilt_path))
         self.total = len(self.jobs)
         self.job = None
         self.state = "running"
@@ -124,11 +166,14 @@ class Run:
         self.result = None
 
     @staticmethod
-    def _export(depsgraph, obj, path, with_kinds=False):
+    def _export(depsgraph, obj, path, with_kinds=False, topology=None):
         evaluated = obj.evaluated_get(depsgraph)
         me = evaluated.to_mesh()
         try:
             V, T, M = exchange.mesh_arrays(me)
+            if topology is not None:
+                topology["T"] = T
+                topology["loops"], topology["totals"] = follow.topology(me)
             kinds = None
             if with_kinds:
                 kinds = [slot.material.name if slot.material else "element"
@@ -203,6 +248,9 @@ class Run:
         # The result is in world coordinates: parented without moving.
         obj.parent = self.base
         obj.matrix_parent_inverse = self.base.matrix_world.inverted()
+        if self.quilt_path and os.path.exists(self.quilt_path):
+            follow.bind(obj, self.base, self.quilt_path, self.topology["T"],
+                        self.topology["loops"], self.topology["totals"], self.base_matrix)
         self.result = obj
         return obj
 
@@ -388,6 +436,94 @@ class MESHQUILT_OT_select_element(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _bound_result(context):
+    obj = context.active_object
+    return obj if follow.is_bound(obj) and "element_id" in obj.data.attributes else None
+
+
+class MESHQUILT_OT_bake(bpy.types.Operator):
+    """Place the result on its base at every frame of the scene's range (one engine run) and
+    keep the positions in shape keys: playback needs no engine"""
+    bl_idname = "meshquilt.bake"
+    bl_label = "Bake frames"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return _bound_result(context) is not None and "run" not in _running
+
+    def execute(self, context):
+        obj = _bound_result(context)
+        if obj.mode != "OBJECT":
+            bpy.ops.object.mode_set(mode="OBJECT")
+        try:
+            count = follow.bake(context, obj)
+        except (engine.EngineError, OSError, ValueError, KeyError) as e:
+            obj.meshquilt.status = str(e)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "meshquilt: %s baked over %d frames" % (obj.name, count))
+        return {"FINISHED"}
+
+
+class MESHQUILT_OT_clear_bake(bpy.types.Operator):
+    """Remove the baked positions (the result's shape keys and their animation)"""
+    bl_idname = "meshquilt.clear_bake"
+    bl_label = "Clear bake"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = _bound_result(context)
+        return obj is not None and obj.meshquilt.baked and obj.mode == "OBJECT"
+
+    def execute(self, context):
+        follow.clear_bake(_bound_result(context))
+        return {"FINISHED"}
+
+
+class MESHQUILT_OT_remove_selected(bpy.types.Operator):
+    """Remove the elements with a selected face from the saved quilt and place the rest on the
+    base as it is now (a baked result is baked again)"""
+    bl_idname = "meshquilt.remove_selected"
+    bl_label = "Remove selected elements"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return _bound_result(context) is not None and "run" not in _running
+
+    def execute(self, context):
+        obj = _bound_result(context)
+        editing = obj.mode == "EDIT"
+        if editing:
+            bpy.ops.object.mode_set(mode="OBJECT")  # the edit-mode selection into the mesh
+        try:
+            me = obj.data
+            selected = np.empty(len(me.polygons), dtype=bool)
+            me.polygons.foreach_get("select", selected)
+            ids = np.empty(len(me.polygons), dtype=np.int32)
+            me.attributes["element_id"].data.foreach_get("value", ids)
+            chosen = np.unique(ids[selected])
+            if len(chosen) == 0:
+                self.report({"ERROR"}, "select faces of the elements to remove")
+                return {"CANCELLED"}
+            if len(chosen) == len(np.unique(ids)):
+                self.report({"ERROR"}, "that is every element: delete the object instead")
+                return {"CANCELLED"}
+            try:
+                follow.remove_elements(context, obj, chosen)
+            except (engine.EngineError, OSError, ValueError, KeyError) as e:
+                obj.meshquilt.status = str(e)
+                self.report({"ERROR"}, str(e))
+                return {"CANCELLED"}
+        finally:
+            if editing:
+                bpy.ops.object.mode_set(mode="EDIT")
+        self.report({"INFO"}, "meshquilt: %d elements removed from %s" % (len(chosen), obj.name))
+        return {"FINISHED"}
+
+
 class MESHQUILT_PT_panel(bpy.types.Panel):
     bl_label = "meshquilt"
     bl_idname = "MESHQUILT_PT_panel"
@@ -420,22 +556,43 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         obj = context.active_object
         if obj is not None and obj.type == "MESH" and "element_id" in obj.data.attributes:
             layout.operator("meshquilt.select_element")
+            b = obj.meshquilt
+            box = layout.box()
+            if not b.quilt:
+                box.label(text="No saved quilt: cannot follow its base", icon="INFO")
+                return
+            box.label(text="Base: %s" % (b.base.name if b.base else "(gone)"))
+            box.prop(b, "follow")
+            row = box.row(align=True)
+            row.operator("meshquilt.bake", icon="REC",
+                         text="Bake frames %d-%d" % (context.scene.frame_start,
+                                                      context.scene.frame_end))
+            if b.baked:
+                row.operator("meshquilt.clear_bake", icon="X", text="")
+            box.operator("meshquilt.remove_selected", icon="TRASH")
+            if b.status:
+                box.label(text=b.status, icon="ERROR")
 
 
-classes = (MeshquiltPreferences, MeshquiltSettings, MESHQUILT_OT_run, MESHQUILT_OT_cancel,
-           MESHQUILT_OT_select_element, MESHQUILT_PT_panel)
+classes = (MeshquiltPreferences, MeshquiltSettings, MeshquiltBinding, MESHQUILT_OT_run,
+           MESHQUILT_OT_cancel, MESHQUILT_OT_select_element, MESHQUILT_OT_bake,
+           MESHQUILT_OT_clear_bake, MESHQUILT_OT_remove_selected, MESHQUILT_PT_panel)
 
 
 def register():
     for c in classes:
         bpy.utils.register_class(c)
     bpy.types.Scene.meshquilt = bpy.props.PointerProperty(type=MeshquiltSettings)
+    bpy.types.Object.meshquilt = bpy.props.PointerProperty(type=MeshquiltBinding)
+    follow.register()
 
 
 def unregister():
     run = _running.pop("run", None)
     if run is not None:
         run.cancel()
+    follow.unregister()
+    del bpy.types.Object.meshquilt
     del bpy.types.Scene.meshquilt
     for c in reversed(classes):
         bpy.utils.unregister_class(c)

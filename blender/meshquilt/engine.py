@@ -176,12 +176,15 @@ def swatch_job(engine, kind, output, seed=1):
 
 
 def surface_job(engine, base, swatch, output, scale, seed=1, stretch=True, field=None,
-                field_file=None, threads=0):
+                field_file=None, threads=0, save_quilt=None):
     """Quilts the swatch over the base; `field` is an (x, y, z) direction, `field_file` a file
-    of one vector per base vertex (at most one of them)."""
+    of one vector per base vertex (at most one of them); `save_quilt` also saves the result
+    over the base (.mqq) for embed_job."""
     args = ["surface", "--base", base, "--swatch", swatch, "-o", output,
             "--scale", repr(float(scale)), "--seed", str(int(seed)),
             "--threads", str(int(threads))]
+    if save_quilt:
+        args += ["--save-quilt", save_quilt]
     if not stretch:
         args.append("--no-stretch-opt")
     if field is not None:
@@ -189,3 +192,38 @@ def surface_job(engine, base, swatch, output, scale, seed=1, stretch=True, field
     if field_file:
         args += ["--field-file", field_file]
     return Job(engine, args)
+
+
+def embed_job(engine, quilt, base, output, frames=None, keep_intersecting=False, threads=0):
+    """Places a saved quilt on its base with the vertices moved, without a new synthesis; with
+    frames=(a, b), `base` and `output` are patterns with one frame number (%04d) and every
+    frame has the same faces. keep_intersecting: no element is moved off its place, shrunk or
+    removed for pressing into a neighbour (the output then has every element of the quilt)."""
+    args = ["embed", "--quilt", quilt, "--base", base, "-o", output,
+            "--threads", str(int(threads))]
+    if frames is not None:
+        args += ["--frames", "%d-%d" % (int(frames[0]), int(frames[1]))]
+    if keep_intersecting:
+        args.append("--keep-intersecting")
+    return Job(engine, args)
+
+
+def id_ranges(ids):
+    """Sorted ids as the engine's list: [3, 7, 10, 11, 12] -> "3,7,10-12"."""
+    parts, ids = [], sorted(set(int(i) for i in ids))
+    start = prev = None
+    for i in ids + [None]:
+        if start is not None and i is not None and i == prev + 1:
+            prev = i
+            continue
+        if start is not None:
+            parts.append(str(start) if start == prev else "%d-%d" % (start, prev))
+        start = prev = i
+    return ",".join(parts)
+
+
+def edit_job(engine, quilt, output, ids):
+    """Removes the elements with these ids (the element_id of every output) from a saved
+    quilt, writing a new one; the other elements keep their order (and are numbered again)."""
+    return Job(engine, ["edit", "--quilt", quilt, "-o", output, "--ids", id_ranges(ids),
+                        "--remove", "--quiet"], progress=False)

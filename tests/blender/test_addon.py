@@ -7,11 +7,14 @@ Installs the zipped add-on as a user would, then: registration; Run on a generat
 the sample chain mail (an object parented to the base, element ids, one material per kind);
 Cancel (the engine stops, no object, no files left); an engine error reported; the engine's OBJ
 and .glb outputs through Blender's own importers with per-element data intact; selecting an
-element by id.
+element by id; the result following its twisted base frame by frame (exactly the quilted result
+at rest), stopping with the engine's message when the base's connectivity changes, baked into
+shape keys that play without the engine, and elements removed from the saved quilt.
 """
 
 import glob
 import json
+import math
 import os
 import struct
 import sys
@@ -72,11 +75,14 @@ def test_installs_and_registers():
     enable_addon()
     check("meshquilt" in bpy.context.preferences.addons, "add-on not enabled")
     check(hasattr(bpy.types.Scene, "meshquilt"), "scene settings not registered")
-    for op in ("run", "cancel", "select_element"):
+    for op in ("run", "cancel", "select_element", "bake", "clear_bake", "remove_selected"):
         check(hasattr(bpy.ops.meshquilt, op), "operator meshquilt.%s missing" % op)
     check(hasattr(bpy.types, "MESHQUILT_PT_panel"), "panel not registered")
     s = bpy.context.scene.meshquilt
     check(s.stretch is True, "distortion minimisation must be on by default")
+    import meshquilt.follow
+    check(bpy.app.handlers.frame_change_post.count(meshquilt.follow.on_frame_change) == 1,
+          "frame change handler not registered once")
 
 
 @test
@@ -325,6 +331,198 @@ def test_glb_imports_with_materials_and_has_the_element_id_attribute():
     check(mats == ["thread_x", "thread_y"], "materials %s" % mats)
     faces = sum(gltf["accessors"][p["indices"]]["count"] // 3 for p in prims)
     check(len(objs[0].data.polygons) == faces, "%d faces for %d" % (len(objs[0].data.polygons), faces))
+
+
+def positions(obj, evaluated=False):
+    """The object's vertex positions: its mesh's, or evaluated (shape keys applied)."""
+    if evaluated:
+        ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        me = ev.to_mesh()
+        try:
+            V = np.empty(3 * len(me.vertices))
+            me.vertices.foreach_get("co", V)
+        finally:
+            ev.to_mesh_clear()
+        return V.reshape(-1, 3)
+    V = np.empty(3 * len(obj.data.vertices))
+    obj.data.vertices.foreach_get("co", V)
+    return V.reshape(-1, 3)
+
+
+def twisting_grid_quilt():
+    """A 12 x 12 grid twisted about y by a Simple Deform modifier keyed from 0 (frame 0, the
+    rest) to 90 degrees (frame 24), quilted at rest with a small chain mail (16 rings of 64 faces): about
+    60 rings, 4,000 faces. Returns the scene, the base and the result."""
+    scene = new_scene()
+    import meshquilt
+    from meshquilt import engine, exchange
+    path = os.path.join(WORK, "small_chainmail.ply")
+    if not os.path.exists(path):
+        job = engine.Job(ENGINE, ["swatch", "chainmail", "-o", path, "--rows", "4", "--cols",
+                                  "4", "--detail", "6", "--quiet"], progress=False)
+        check(job.wait(60) == "done", "swatch failed: %s" % job.error)
+    swatch = bpy.data.objects.new("mail", exchange.build_mesh(
+        bpy, "mail", exchange.read_ply(path), meshquilt.material_for))
+    scene.collection.objects.link(swatch)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=13, y_subdivisions=13, size=2)
+    base = bpy.context.active_object
+    base.name = "Grid"
+    bend = base.modifiers.new("twist", "SIMPLE_DEFORM")
+    bend.deform_method, bend.deform_axis = "TWIST", "Y"
+    bend.angle = 0.0
+    bend.keyframe_insert("angle", frame=0)
+    bend.angle = math.radians(90)
+    bend.keyframe_insert("angle", frame=24)
+    scene.frame_start, scene.frame_end = 1, 24
+    scene.frame_set(0)
+    s = scene.meshquilt
+    s.base, s.swatch_source, s.swatch, s.scale, s.stretch = base, "OBJECT", swatch, 0.4, False
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    return scene, base, bpy.data.objects["Grid_quilt"]
+
+
+@test
+def test_follow_base_places_the_result_on_the_deformed_base_every_frame():
+    scene, base, obj = twisting_grid_quilt()
+    b = obj.meshquilt
+    check(b.base == base, "result not bound to its base")
+    quilt = bpy.path.abspath(b.quilt)
+    check(quilt.endswith(".mqq") and os.path.isfile(quilt), "no saved quilt at %r" % b.quilt)
+    rest, ids, faces = positions(obj), face_ids(obj), len(obj.data.polygons)
+    check(faces > 1000, "only %d faces" % faces)
+    # The handler leaves results that do not follow alone.
+    scene.frame_set(12)
+    check(np.array_equal(positions(obj), rest), "a result not following moved")
+    b.follow = True  # placed at once on the base as it is (twisted at frame 12)
+    bent = positions(obj)
+    check(np.abs(bent - rest).max() > 0.05, "the result did not move with the base")
+    for frame in (6, 18, 24):
+        scene.frame_set(frame)
+        V = positions(obj)
+        check(np.abs(V - bent).max() > 1e-3, "frame %d: the result did not move" % frame)
+        check(len(obj.data.polygons) == faces, "frame %d: %d faces for %d"
+              % (frame, len(obj.data.polygons), faces))
+        check(np.array_equal(face_ids(obj), ids), "frame %d: element ids changed" % frame)
+        bent = V
+    # Back at the rest pose: the synthesis's own positions, exactly.
+    scene.frame_set(0)
+    check(np.array_equal(positions(obj), rest), "frame 0 differs from the quilted result by %g"
+          % np.abs(positions(obj) - rest).max())
+    check(b.follow and b.status == "", "status: %r" % b.status)
+    # Moving the base object carries the result by the parenting; the shape is unchanged.
+    base.location = (3.0, 0.0, 0.0)
+    scene.frame_set(0)
+    check(np.array_equal(positions(obj), rest), "moving the base object changed the shape")
+    check(abs(obj.matrix_world.translation.x - 3.0) < 1e-6, "the result did not go with its base")
+
+
+@test
+def test_follow_stops_with_the_engines_message_when_the_base_connectivity_changes():
+    scene, base, obj = twisting_grid_quilt()
+    obj.meshquilt.follow = True
+    scene.frame_set(5)
+    moved = positions(obj)
+    base.modifiers.new("subdivide", "SUBSURF").levels = 1
+    scene.frame_set(6)
+    b = obj.meshquilt
+    check(not b.follow, "still following a base of other connectivity")
+    check("the quilt was made on one of" in b.status and "meshquilt embed" in b.status,
+          "status: %r" % b.status)
+    check(np.array_equal(positions(obj), moved), "the result changed")
+    # Switching it on again reports the same at once; without the modifier it follows again.
+    b.follow = True
+    check(not b.follow and "the quilt was made on" in b.status, "status: %r" % b.status)
+    base.modifiers.remove(base.modifiers["subdivide"])
+    b.follow = True
+    check(b.follow and b.status == "", "status: %r" % b.status)
+
+
+@test
+def test_bake_keeps_every_frame_in_shape_keys_and_plays_without_the_engine():
+    scene, base, obj = twisting_grid_quilt()
+    rest, faces = positions(obj), len(obj.data.polygons)
+    # The followed positions at frame 12, for the bake to match.
+    obj.meshquilt.follow = True
+    scene.frame_set(12)
+    followed = positions(obj)
+    scene.frame_set(0)
+    bpy.context.view_layer.objects.active = obj
+    start = time.monotonic()
+    check(bpy.ops.meshquilt.bake() == {"FINISHED"}, "bake failed")
+    print("[blender]   bake of 24 frames: %.1f s" % (time.monotonic() - start), flush=True)
+    b = obj.meshquilt
+    check(b.baked and not b.follow, "baked %s, follow %s" % (b.baked, b.follow))
+    key = obj.data.shape_keys
+    check(key is not None and not key.use_relative, "no absolute shape keys")
+    check(len(key.key_blocks) == 24, "%d shape keys" % len(key.key_blocks))
+    # Playback needs no engine.
+    prefs = bpy.context.preferences.addons["meshquilt"].preferences
+    prefs.engine_path = "/nonexistent/meshquilt"
+    path = os.environ.get("PATH", "")
+    os.environ["PATH"] = "/nonexistent"
+    try:
+        previous = None
+        for frame in range(1, 25):
+            scene.frame_set(frame)
+            V = positions(obj, evaluated=True)
+            check(len(V) == len(rest) and len(obj.data.polygons) == faces,
+                  "frame %d: connectivity changed" % frame)
+            if previous is not None:
+                check(np.abs(V - previous).max() > 1e-4, "frame %d equals the one before" % frame)
+            if frame == 12:
+                check(np.allclose(V, followed, atol=1e-5), "frame 12 differs from following by %g"
+                      % np.abs(V - followed).max())
+            previous = V
+        check(b.status == "", "status: %r" % b.status)
+    finally:
+        os.environ["PATH"] = path
+        prefs.engine_path = ENGINE
+    check(bpy.ops.meshquilt.clear_bake() == {"FINISHED"}, "clear bake failed")
+    check(obj.data.shape_keys is None and not b.baked, "bake not cleared")
+
+
+@test
+def test_remove_selected_elements_removes_them_from_the_quilt():
+    scene, base, obj = twisting_grid_quilt()
+    ids = face_ids(obj)
+    elements = len(np.unique(ids))
+    old_quilt = obj.meshquilt.quilt
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.meshquilt.select_element(element=3)
+    bpy.ops.meshquilt.select_element(element=7, extend=True)
+    bpy.ops.meshquilt.select_element(element=elements - 1, extend=True)
+    removed_faces = int(np.isin(ids, [3, 7, elements - 1]).sum())
+    scene.frame_set(10)  # the base twisted: the rest placed on it as it is now
+    bpy.ops.object.mode_set(mode="EDIT")
+    check(bpy.ops.meshquilt.remove_selected() == {"FINISHED"}, "remove failed")
+    check(obj.mode == "EDIT", "edit mode not restored")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    after = face_ids(obj)
+    check(len(np.unique(after)) == elements - 3, "%d elements for %d - 3"
+          % (len(np.unique(after)), elements))
+    check(int(after.max()) == elements - 4, "ids are not 0..%d" % (elements - 4))
+    check(len(obj.data.polygons) == len(ids) - removed_faces, "%d faces for %d"
+          % (len(obj.data.polygons), len(ids) - removed_faces))
+    check(obj.meshquilt.quilt != old_quilt, "the saved quilt was not replaced")
+    check([m.name for m in obj.data.materials] == ["ring"], "materials %s"
+          % [m.name for m in obj.data.materials])
+    check(obj.data.validate() is False, "Blender had to repair the mesh")
+    # Placed on the twisted base, and still following it.
+    V = positions(obj)
+    obj.meshquilt.follow = True
+    check(np.array_equal(positions(obj), V), "not placed on the base of frame 10")
+    scene.frame_set(0)
+    check(np.abs(positions(obj) - V).max() > 0.05, "does not follow after the removal")
+    bpy.ops.object.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    try:
+        bpy.ops.meshquilt.remove_selected()
+        check(False, "an empty selection was not reported")
+    except RuntimeError as e:
+        check("select faces" in str(e), "reported: %s" % e)
+    bpy.ops.object.mode_set(mode="OBJECT")
 
 
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
