@@ -100,6 +100,7 @@ void write_stats(const std::string& path, const std::string& quilt_path,
         .value("unmoved", f.stats.unmoved)
         .value("unbent", f.stats.unbent)
         .value("shrunk", f.stats.shrunk)
+        .value("pressed_pairs", f.stats.pressed_pairs)
         .value("removed", f.stats.num_removed)
         .value("largest_rigid_offset", f.stats.largest_rigid_offset)
         .end_object();
@@ -131,6 +132,10 @@ int run_embed(int argc, char** argv, int first) {
   cl.option("base", "FILE", "the base, its vertices moved (a pattern with --frames)");
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off, .glb; a pattern with --frames)");
   cl.option("frames", "A-B", "embed frames A to B of the --base pattern, one output each");
+  cl.flag("keep-elements",
+          "never remove an element (every output has the quilt's faces and element ids: a "
+          "result bound to an animated base): those that would go stay shrunk to 60%, pressed "
+          "into a neighbour");
   cl.flag("keep-intersecting",
           "keep elements as moved even where they press into a neighbour (by default a rigid "
           "element that would follows the surface instead, and one that still does is removed, "
@@ -149,6 +154,7 @@ int run_embed(int argc, char** argv, int first) {
   FollowBaseOptions follow;
   follow.rigid_radius = cl.get_double("rigid-radius", 0, 0.0, 1e6);
   follow.resolve_intersections = !cl.has("keep-intersecting");
+  follow.keep_elements = cl.has("keep-elements");
 
   // The frames: one (the base and output as given) or a range over two patterns.
   std::vector<FrameResult> frames;
@@ -187,7 +193,7 @@ int run_embed(int argc, char** argv, int first) {
       }
   // A sequence removes in every frame what any frame removes (a mesh cache keeps its faces):
   // a first pass finds them.
-  if (frames.size() > 1 && follow.resolve_intersections) {
+  if (frames.size() > 1 && follow.resolve_intersections && !follow.keep_elements) {
     std::vector<char> removed;
     for (const FrameResult& f : frames) {
       FollowBaseStats pass;

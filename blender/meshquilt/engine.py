@@ -194,17 +194,16 @@ def surface_job(engine, base, swatch, output, scale, seed=1, stretch=True, field
     return Job(engine, args)
 
 
-def embed_job(engine, quilt, base, output, frames=None, keep_intersecting=False, threads=0):
+def embed_job(engine, quilt, base, output, frames=None, threads=0):
     """Places a saved quilt on its base with the vertices moved, without a new synthesis; with
-    frames=(a, b), `base` and `output` are patterns with one frame number (%04d) and every
-    frame has the same faces. keep_intersecting: no element is moved off its place, shrunk or
-    removed for pressing into a neighbour (the output then has every element of the quilt)."""
+    frames=(a, b), `base` and `output` are patterns with one frame number (%04d). No element is
+    removed (--keep-elements): a result bound to its base keeps its faces and element ids in
+    every frame; an element pressed into a neighbour follows the surface or shrinks instead."""
     args = ["embed", "--quilt", quilt, "--base", base, "-o", output,
             "--threads", str(int(threads))]
     if frames is not None:
         args += ["--frames", "%d-%d" % (int(frames[0]), int(frames[1]))]
-    if keep_intersecting:
-        args.append("--keep-intersecting")
+    args.append("--keep-elements")
     return Job(engine, args)
 
 

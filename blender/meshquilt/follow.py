@@ -123,17 +123,9 @@ def _run(job, files=None):
         raise engine.EngineError(message)
 
 
-def _embed(exe, quilt, base, output, faces, frames=None):
-    """embed, then (when the engine removed elements pressed into a neighbour, which would
-    change the faces and the element ids) again keeping every element: a bound result keeps
-    its connectivity. Returns whether the second run was needed."""
+def _embed(exe, quilt, base, output, frames=None):
+    """embed keeping every element (a bound result keeps its faces and element ids)."""
     _run(engine.embed_job(exe, quilt, base, output, frames=frames), {base + ": ": ""})
-    first = output % frames[0] if frames else output
-    if faces is None or len(exchange.read_ply(first).F) == faces:
-        return False
-    _run(engine.embed_job(exe, quilt, base, output, frames=frames, keep_intersecting=True),
-         {base + ": ": ""})
-    return True
 
 
 def place(obj, depsgraph, context=None, faces=None, force=False):
@@ -152,8 +144,7 @@ def place(obj, depsgraph, context=None, faces=None, force=False):
         base_path = os.path.join(directory, "base.ply")
         out_path = os.path.join(directory, "result.ply")
         exchange.write_ply(base_path, V, T)
-        kept = _embed(_engine(context), quilt, base_path, out_path,
-                      len(me.polygons) if in_place else faces)
+        _embed(_engine(context), quilt, base_path, out_path)
         result = exchange.read_ply(out_path)
     finally:
         shutil.rmtree(directory, ignore_errors=True)
@@ -167,8 +158,7 @@ def place(obj, depsgraph, context=None, faces=None, force=False):
     else:
         rebuild(obj, result)
     _placed[obj.name_full] = key
-    obj.meshquilt.status = ("elements pressed into a neighbour kept where they are"
-                            if kept else "")
+    obj.meshquilt.status = ""
     return True
 
 
@@ -231,10 +221,6 @@ def bake(context, obj):
         job = engine.embed_job(exe, quilt_path(obj), base_pattern, out_pattern,
                                frames=(0, count - 1))
         _run(job, names)
-        faces = len(obj.data.polygons)
-        if len(exchange.read_ply(out_pattern % 0).F) != faces:
-            _run(engine.embed_job(exe, quilt_path(obj), base_pattern, out_pattern,
-                                  frames=(0, count - 1), keep_intersecting=True), names)
         frames = [exchange.read_ply(out_pattern % i).V for i in range(count)]
     finally:
         shutil.rmtree(directory, ignore_errors=True)

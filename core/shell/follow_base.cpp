@@ -257,7 +257,7 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
   // what even that does not free goes (the later element of each pair).
   std::vector<char> removed = options.remove;
   removed.resize(static_cast<size_t>(elements), 0);
-  int unbent = 0, shrunk = 0;
+  int unbent = 0, shrunk = 0, still_pressed = 0;
   if (options.resolve_intersections) {
     ElementPairs pairs_of(out, face_component, faces, elements);
     std::vector<char> active(static_cast<size_t>(elements), 0);
@@ -266,6 +266,7 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
       active[static_cast<size_t>(e)] =
           kind[static_cast<size_t>(e)] == 1 && !removed[static_cast<size_t>(e)];
     std::vector<char> changed(static_cast<size_t>(elements), 0);
+    const MatrixX3d rigid = options.keep_elements ? out.V : MatrixX3d();
     for (const auto& [a, b] : pairs_of.intersecting(active, removed))
       for (const int e : {a, b})
         if (kind[static_cast<size_t>(e)] == 1 && !changed[static_cast<size_t>(e)]) {
@@ -276,8 +277,17 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
         }
     // Following the surface can fold an element through itself where the surface creases
     // (the synthesis removes such elements too; kept rigid and shrunk instead, more go).
+    // Kept whole (keep_elements), it goes back to its rigid place, to be shrunk below.
     if (unbent > 0)
-      for (const int e : pairs_of.self_intersecting(changed)) removed[static_cast<size_t>(e)] = 1;
+      for (const int e : pairs_of.self_intersecting(changed)) {
+        if (!options.keep_elements) {
+          removed[static_cast<size_t>(e)] = 1;
+          continue;
+        }
+        --unbent;
+        for (const int f : faces[static_cast<size_t>(e)])
+          for (int k = 0; k < 3; ++k) out.V.row(out.F(f, k)) = rigid.row(out.F(f, k));
+      }
     std::vector<std::pair<int, int>> pairs = pairs_of.intersecting(changed, removed);
     const MatrixX3d unshrunk = out.V;
     std::vector<char> pressed(static_cast<size_t>(elements), 0);
@@ -291,7 +301,9 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
       pairs = pairs_of.intersecting(pressed, removed);
     }
     for (const auto& [a, b] : pairs)
-      if (!removed[static_cast<size_t>(a)]) removed[static_cast<size_t>(b)] = 1;
+      if (!options.keep_elements && !removed[static_cast<size_t>(a)])
+        removed[static_cast<size_t>(b)] = 1;
+    still_pressed = static_cast<int>(pairs.size());
     for (int e = 0; e < elements; ++e)
       shrunk += !removed[static_cast<size_t>(e)] && pairs_of.was_scaled(e);
   }
@@ -301,6 +313,7 @@ TriMesh follow_base(const SavedQuilt& saved, const MatrixX3d& V, const FollowBas
     *stats = FollowBaseStats{};
     stats->unbent = unbent;
     stats->shrunk = shrunk;
+    stats->pressed_pairs = options.keep_elements ? still_pressed : 0;
     stats->removed = removed;
     stats->num_removed = static_cast<int>(std::count(removed.begin(), removed.end(), 1));
     stats->elements = elements;

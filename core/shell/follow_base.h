@@ -28,6 +28,10 @@ struct FollowBaseOptions {
   // (95% to 60% of their size) or else removed, as the synthesis's post-processing does.
   // false: keep every element as moved.
   bool resolve_intersections = true;
+  // Never remove an element (a result bound to its base in Blender keeps its faces and element
+  // ids from frame to frame): those that would go stay at 60% of their size, pressed into a
+  // neighbour, or rigid where following the surface folds them.
+  bool keep_elements = false;
   // Elements removed whatever happens (#elements flags, or empty): a sequence removes the union
   // of what each frame removes, so every frame has the same faces.
   std::vector<char> remove;
@@ -42,6 +46,7 @@ struct FollowBaseStats {
   int unmoved = 0;            // where the base did not move: kept bit for bit
   int unbent = 0;             // rigid elements that intersected another, made to follow the surface
   int shrunk = 0;             // then still intersecting, kept at 60-95% of their size
+  int pressed_pairs = 0;      // keep_elements: pairs of elements left intersecting
   std::vector<char> removed;  // #elements: removed (intersecting after that, or asked to)
   int num_removed = 0;
   // Over the moved elements: the largest displacement, in shell heights, of a vertex from where

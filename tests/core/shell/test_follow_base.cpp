@@ -126,6 +126,11 @@ TEST(FollowBase, ElementsPressedTogetherFollowOrGoInEveryFrame) {
     } else {
       EXPECT_GT(stats.unbent, 0);
     }
+    // Kept whole: the same faces whatever happens.
+    FollowBaseOptions keep;
+    keep.keep_elements = true;
+    EXPECT_EQ(follow_base(saved, V, keep, &stats).F, saved.output.F);
+    EXPECT_EQ(stats.num_removed, 0);
     // Asked to remove element 3 (as a sequence does), it is gone and nothing else.
     FollowBaseOptions options;
     options.remove.assign(19, 0);
