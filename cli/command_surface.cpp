@@ -12,6 +12,7 @@
 #include "cli/stats_json.h"
 #include "core/common/errors.h"
 #include "core/mesh/atomic_file.h"
+#include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/shell/quilt_embedding.h"
@@ -177,6 +178,9 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("scale", "S", "swatch's longer side as a fraction of the base's bounding-box diagonal",
             "0.1");
+  cl.option("element-size", "L",
+            "instead of --scale: the swatch's longer side in the base's units, whatever the "
+            "base's extent");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");
@@ -233,9 +237,12 @@ int run_surface(int argc, char** argv, int first) {
   std::vector<std::string> outputs = output_files(out_path, write_options);
   outputs.push_back(cl.get("stats"));
   check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
+  if (cl.has("scale") && cl.has("element-size"))
+    throw UsageError("give --scale or --element-size, not both");
 
   SurfaceQuiltingOptions options;
   options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
+  if (cl.has("element-size")) options.element_size = cl.get_double("element-size", 0, 1e-300);
   options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
   options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
   options.patch.deform = !cl.has("no-deform");
@@ -285,6 +292,12 @@ int run_surface(int argc, char** argv, int first) {
              ": the swatch is flat (no thickness along its smallest side), and surface grows it "
              "in a shell as thick as the swatch; give it thickness, or use plane");
   }
+  // --scale's range, relative to the base's diagonal.
+  const double diagonal = base.num_vertices() ? bounding_box(base.V).extent().norm() : 0.0;
+  if (options.element_size > 0 && diagonal > 0 &&
+      !(options.element_size >= 1e-6 * diagonal && options.element_size <= 10 * diagonal))
+    throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
+                     std::to_string(diagonal));
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));
@@ -344,8 +357,8 @@ int run_surface(int argc, char** argv, int first) {
   // A run that makes no geometry is an error, not an empty file (issue 14).
   MQ_CHECK(!quilt.elements.empty(), InvalidInput,
            "no element of the swatch could be placed on "
-           "the base at --scale ",
-           options.scale,
+           "the base at ",
+           size_option(options),
            " (is the swatch larger than the base?); "
            "nothing written");
   MQ_CHECK(result.num_faces() > 0, InvalidInput, "all ", quilt.elements.size(),
