@@ -19,6 +19,7 @@
 #include "core/shell/surface_coverage.h"
 #include "core/structure/texture_structure.h"
 #include "core/surface/global_quilting.h"
+#include "core/surface/surface_mask.h"
 #include "core/surface/surface_quilting.h"
 #include "core/surface/tangent_field.h"
 #include "core/surface/vine_growth.h"
@@ -181,6 +182,11 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("element-size", "L",
             "instead of --scale: the swatch's longer side in the base's units, whatever the "
             "base's extent");
+  cl.option("mask", "FILE",
+            "quilt only where the mask is set: one weight in [0, 1] per base vertex (set where "
+            ">= 0.5), or a first line 'faces' and then one 0-based face index per line; '#' "
+            "lines are comments. Whole elements are kept or dropped (by where most of their "
+            "vertices lie); coverage is judged over the mask");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");
@@ -236,7 +242,8 @@ int run_surface(int argc, char** argv, int first) {
   const WriteOptions write_options = output_options(cl);
   std::vector<std::string> outputs = output_files(out_path, write_options);
   outputs.push_back(cl.get("stats"));
-  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
+  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys"),
+                        cl.get("mask")});
   if (cl.has("scale") && cl.has("element-size"))
     throw UsageError("give --scale or --element-size, not both");
 
@@ -298,6 +305,7 @@ int run_surface(int argc, char** argv, int first) {
       !(options.element_size >= 1e-6 * diagonal && options.element_size <= 10 * diagonal))
     throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
                      std::to_string(diagonal));
+  const SurfaceMask mask = cl.has("mask") ? read_surface_mask(cl.get("mask"), base) : SurfaceMask();
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));
@@ -344,13 +352,17 @@ int run_surface(int argc, char** argv, int first) {
   GlobalQuiltingStats gstats;
   bool global = method == "global", vines = method == "vines";
   VineGrowthStats vstats;
-  const SurfaceQuilt quilt =
+  SurfaceQuilt quilt =
       method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
                                             run.progress(), &global, &vines, &vstats)
       : global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
       : vines ? quilt_surface_vines(base, swatch, options, {}, &stats, &vstats, run.progress())
               : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+  if (cl.has("mask")) {
+    embedding.coverage_faces = mask_quilt_faces(mask, base, quilt);
+    drop_unmasked_elements(quilt, embedding.coverage_faces);
+  }
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
