@@ -13,6 +13,7 @@
 #include "cli/stats_json.h"
 #include "core/common/errors.h"
 #include "core/mesh/atomic_file.h"
+#include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/shell/follow_base.h"
@@ -21,6 +22,7 @@
 #include "core/shell/surface_coverage.h"
 #include "core/structure/texture_structure.h"
 #include "core/surface/global_quilting.h"
+#include "core/surface/surface_mask.h"
 #include "core/surface/surface_quilting.h"
 #include "core/surface/tangent_field.h"
 #include "core/surface/vine_growth.h"
@@ -180,6 +182,14 @@ int run_surface(int argc, char** argv, int first) {
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
   cl.option("scale", "S", "swatch's longer side as a fraction of the base's bounding-box diagonal",
             "0.1");
+  cl.option("element-size", "L",
+            "instead of --scale: the swatch's longer side in the base's units, whatever the "
+            "base's extent");
+  cl.option("mask", "FILE",
+            "quilt only where the mask is set: one weight in [0, 1] per base vertex (set where "
+            ">= 0.5), or a first line 'faces' and then one 0-based face index per line; '#' "
+            "lines are comments. Whole elements are kept or dropped (by where most of their "
+            "vertices lie); coverage is judged over the mask");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");
@@ -240,10 +250,14 @@ int run_surface(int argc, char** argv, int first) {
   std::vector<std::string> outputs = output_files(out_path, write_options);
   outputs.push_back(cl.get("stats"));
   outputs.push_back(cl.get("save-quilt"));
-  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys")});
+  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys"),
+                        cl.get("mask")});
+  if (cl.has("scale") && cl.has("element-size"))
+    throw UsageError("give --scale or --element-size, not both");
 
   SurfaceQuiltingOptions options;
   options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
+  if (cl.has("element-size")) options.element_size = cl.get_double("element-size", 0, 1e-300);
   options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
   options.matching.epsilon = cl.get_double("variety", 0, 0.0, 10.0);
   options.patch.deform = !cl.has("no-deform");
@@ -298,6 +312,13 @@ int run_surface(int argc, char** argv, int first) {
       base.num_faces() > options.proxy_min_faces)
     throw UsageError("--save-quilt on a base of over " + std::to_string(options.proxy_min_faces) +
                      " faces needs --no-proxy (a simplified proxy cannot follow the base)");
+  // --scale's range, relative to the base's diagonal.
+  const double diagonal = base.num_vertices() ? bounding_box(base.V).extent().norm() : 0.0;
+  if (options.element_size > 0 && diagonal > 0 &&
+      !(options.element_size >= 1e-6 * diagonal && options.element_size <= 10 * diagonal))
+    throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
+                     std::to_string(diagonal));
+  const SurfaceMask mask = cl.has("mask") ? read_surface_mask(cl.get("mask"), base) : SurfaceMask();
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));
@@ -344,21 +365,25 @@ int run_surface(int argc, char** argv, int first) {
   GlobalQuiltingStats gstats;
   bool global = method == "global", vines = method == "vines";
   VineGrowthStats vstats;
-  const SurfaceQuilt quilt =
+  SurfaceQuilt quilt =
       method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
                                             run.progress(), &global, &vines, &vstats)
       : global
           ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
       : vines ? quilt_surface_vines(base, swatch, options, {}, &stats, &vstats, run.progress())
               : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+  if (cl.has("mask")) {
+    embedding.coverage_faces = mask_quilt_faces(mask, base, quilt);
+    drop_unmasked_elements(quilt, embedding.coverage_faces);
+  }
   std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
   QuiltEmbeddingStats embedding_stats;
   const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
   // A run that makes no geometry is an error, not an empty file (issue 14).
   MQ_CHECK(!quilt.elements.empty(), InvalidInput,
            "no element of the swatch could be placed on "
-           "the base at --scale ",
-           options.scale,
+           "the base at ",
+           size_option(options),
            " (is the swatch larger than the base?); "
            "nothing written");
   // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
@@ -372,8 +397,11 @@ int run_surface(int argc, char** argv, int first) {
     ScopedStageTimer timer(stats.times, "save quilt");
     SavedQuiltHeader header;
     header.base = fingerprint(base);
-    header.origin = "surface --swatch " + cl.get("swatch") + " --method " + method + " --scale " +
-                    cl.get("scale") + " --seed " + cl.get("seed");
+    header.origin = "surface --swatch " + cl.get("swatch") + " --method " + method +
+                    (cl.has("element-size") ? " --element-size " + cl.get("element-size")
+                                            : " --scale " + cl.get("scale")) +
+                    (cl.has("mask") ? " --mask " + cl.get("mask") : std::string()) + " --seed " +
+                    cl.get("seed");
     saved = make_saved_quilt(quilt, result, header);
   }
   {

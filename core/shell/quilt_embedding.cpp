@@ -855,8 +855,9 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
     // figure jump by 0.2 between runs of nearly identical output).
     // Only geometry on the base's outer side counts (issue 23: texture inside the base
     // covered the open quadruped's legs from within).
-    stats.coverage = surface_coverage(quilt.base, out, 1.5 * quilt.shell_height,
-                                      stats.placement_tolerance * quilt.shell_height);
+    stats.coverage =
+        surface_coverage(quilt.base, out, 1.5 * quilt.shell_height,
+                         stats.placement_tolerance * quilt.shell_height, options.coverage_faces);
   }
   if (stats_out) *stats_out = std::move(stats);
   return out;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/shell/tet_stretch.h"
 #include "core/surface/surface_quilting.h"
@@ -21,6 +22,9 @@ struct QuiltEmbeddingOptions {
   // (core/shell/ring_separation).
   bool separate_rings = true;
   std::uint64_t seed = 1;
+  // Per face of quilt.base, where coverage is measured (a mask, core/surface/surface_mask);
+  // empty: the whole base.
+  std::vector<char> coverage_faces;
 };
 
 struct QuiltEmbeddingStats {
@@ -71,6 +75,7 @@ struct QuiltEmbeddingStats {
   double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
   // Fraction of the base's area with output geometry within 1.5 shell heights on its outer
   // side (surface_coverage), sampled at the centroids of the refined base's faces; in [0, 1].
+  // Over the faces of options.coverage_faces when it is set.
   double coverage = 0;
   StageTimes times;
 };

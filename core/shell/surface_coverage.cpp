@@ -76,14 +76,20 @@ bool visit(RTCPointQueryFunctionArguments* args) {
 
 }  // namespace
 
-double surface_coverage(const TriMesh& base, const TriMesh& output, double radius, double below) {
+double surface_coverage(const TriMesh& base, const TriMesh& output, double radius, double below,
+                        const std::vector<char>& faces) {
   MQ_CHECK(base.F.rows() > 0, InvalidInput, "coverage: the base has no faces");
   MQ_CHECK(base.V.allFinite(), InvalidInput, "coverage: the base has non-finite vertices");
   MQ_CHECK(radius >= 0 && std::isfinite(radius), InvalidInput,
            "coverage: radius must be finite and >= 0, got ", radius);
   MQ_CHECK(below >= 0 && std::isfinite(below), InvalidInput,
            "coverage: below must be finite and >= 0, got ", below);
+  MQ_CHECK(faces.empty() || static_cast<Eigen::Index>(faces.size()) == base.F.rows(), InvalidInput,
+           "coverage: ", faces.size(), " mask flags for ", base.F.rows(), " faces");
   if (output.F.rows() == 0) return 0.0;
+  const auto counted = [&](Eigen::Index f) {
+    return faces.empty() || faces[static_cast<size_t>(f)] != 0;
+  };
   MQ_CHECK(output.V.allFinite(), InvalidInput, "coverage: the output has non-finite vertices");
   MQ_CHECK(output.F.minCoeff() >= 0 && output.F.maxCoeff() < output.V.rows(), InvalidInput,
            "coverage: an output face index is out of range");
@@ -122,6 +128,7 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
                          1e-30;
     const MatrixX3d N = face_normals(base.V, base.F);
     tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
+      if (!counted(f)) return;
       Query q;
       q.output = &output;
       q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
@@ -150,6 +157,7 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
   // Summed in face order so the result does not depend on the thread count.
   double sum = 0, total = 0;
   for (Eigen::Index f = 0; f < base.F.rows(); ++f) {
+    if (!counted(f)) continue;
     total += A(f);
     if (covered[static_cast<size_t>(f)]) sum += A(f);
   }

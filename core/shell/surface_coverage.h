@@ -4,6 +4,8 @@
 // into the open quadruped's legs counted as covering them from within).
 #pragma once
 
+#include <vector>
+
 #include "core/mesh/mesh.h"
 
 namespace mq {
@@ -14,10 +16,12 @@ namespace mq {
 // output triangle is exact (the triangle clipped by that half-space); Embree prunes the
 // triangles, parallel over base faces, deterministic. An empty output covers nothing; a
 // degenerate base face (no normal) counts as covered by any point within the radius.
-// Throws InvalidInput for a base without faces, non-finite vertices, radius or below < 0 / NaN;
-// Error naming the Embree error if Embree fails.
+// `faces` (#F(base), or empty: all) limits the measure to the faces set (a mask, issue 25): the
+// fraction of their area covered; 0 when none is set.
+// Throws InvalidInput for a base without faces, non-finite vertices, radius or below < 0 / NaN,
+// `faces` of the wrong size; Error naming the Embree error if Embree fails.
 double surface_coverage(const TriMesh& base, const TriMesh& output, double radius,
-                        double below = 0.0);
+                        double below = 0.0, const std::vector<char>& faces = {});
 
 // What a swatch covers of its own footprint, measured as above: the footprint (the swatch's
 // two longer bounding-box sides, prepare_swatch's frame) sampled by a 48 x 48 grid of squares

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <unordered_map>
 
 #include "core/common/errors.h"
@@ -387,14 +388,26 @@ TriMesh embed_by_normal_displacement(const SurfaceQuilt& quilt) {
   return out;
 }
 
+double longer_footprint_side(const TriMesh& swatch) {
+  MQ_CHECK(swatch.num_faces() > 0, InvalidInput, "the swatch scale needs a non-empty swatch");
+  const PreparedSwatch unit = prepare_swatch(swatch);
+  return std::max(unit.size.x(), unit.size.y());
+}
+
+std::string size_option(const SurfaceQuiltingOptions& options) {
+  std::ostringstream s;
+  s << (options.element_size > 0 ? "--element-size " : "--scale ")
+    << (options.element_size > 0 ? options.element_size : options.scale);
+  return s.str();
+}
+
 double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale) {
   MQ_CHECK(std::isfinite(scale) && scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", scale);
   MQ_CHECK(base.num_faces() > 0 && swatch.num_faces() > 0, InvalidInput,
            "the swatch scale needs a non-empty base and swatch");
   const double diagonal = bounding_box(base.V, base.F).extent().norm();
-  const PreparedSwatch unit = prepare_swatch(swatch);
-  return scale * diagonal / std::max(unit.size.x(), unit.size.y());
+  return scale * diagonal / longer_footprint_side(swatch);
 }
 
 SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mesh,
@@ -405,6 +418,8 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
            options.base_edge_fraction);
   MQ_CHECK(std::isfinite(options.scale) && options.scale > 0, InvalidInput,
            "the swatch scale must be positive and finite, got ", options.scale);
+  MQ_CHECK(std::isfinite(options.element_size) && options.element_size >= 0, InvalidInput,
+           "the element size must be positive and finite, got ", options.element_size);
   MQ_CHECK(options.proxy_min_faces >= 0 && std::isfinite(options.proxy_error) &&
                options.proxy_error >= 0,
            InvalidInput, "the base simplification needs a face count >= 0 and an error >= 0, got ",
@@ -429,23 +444,29 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   std::sort(swatch_sides.data(), swatch_sides.data() + 3);
   {
     // The refined base below has the same bounding box, so this is the scale used throughout.
-    job.swatch_scale = swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
+    job.swatch_scale =
+        options.element_size > 0
+            ? options.element_size / std::max(longer_footprint_side(swatch_mesh), 1e-300)
+            : swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
     const double k = job.swatch_scale;
     const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
     const double faces = static_cast<double>(swatch_mesh.num_faces()) *
                          face_areas(base_in.V, base_in.F).sum() / footprint;
     stats.estimated_faces = faces;
-    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
+    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
              " the texture would have about ", faces, " faces, more than the limit of ",
              options.max_faces,
              " (--max-faces, or --max-memory at 400 bytes a face); use a "
-             "larger --scale");
+             "larger ",
+             options.element_size > 0 ? "--element-size" : "--scale");
   }
   // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
   // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
   // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
   const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-  const double max_edge = options.scale * diagonal * options.base_edge_fraction;
+  const double max_edge =
+      (options.element_size > 0 ? options.element_size : options.scale * diagonal) *
+      options.base_edge_fraction;
   // A base far finer than the texture costs the patches and the shell map in proportion to
   // its faces, not to its surface (issue 14: 354 s for a 1.1M-face bunny that is the 70k one
   // split twice): simplified to the refinement's edge length within a twentieth of the shell

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/common/progress.h"
@@ -60,6 +61,10 @@ struct SurfaceQuiltingOptions {
   // The swatch is scaled uniformly so that its longer footprint side is `scale` times the base
   // mesh's bounding-box diagonal; its thickness, scaled alike, is the shell height.
   double scale = 0.1;
+  // When > 0, replaces `scale`: the swatch's longer footprint side in the base's units (issue
+  // 25: a size that masking or extending the base does not change). element_size = scale times
+  // the diagonal gives the same job bit for bit.
+  double element_size = 0;
   // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
   MatrixX3d field;
   // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
@@ -184,16 +189,23 @@ struct SurfaceJob {
 // empty base or swatch.
 double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale);
 
+// The swatch's longer footprint side (of its prepared footprint, swatch units): the element
+// size is this times the swatch scale. Throws InvalidInput for an empty swatch.
+double longer_footprint_side(const TriMesh& swatch);
+
+// "--scale S" or "--element-size L", whichever sets the size in `options`: for messages.
+std::string size_option(const SurfaceQuiltingOptions& options);
+
 // Validates the inputs (the same throws as quilt_surface) and prepares a SurfaceJob; times go
 // to the stage "prepare", welded vertices and base faces to stats.
 SurfaceJob prepare_surface_job(const TriMesh& base, const TriMesh& swatch,
                                const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats);
 
 // Runs mesh quilting over `base`. Local coordinates in the result refer to the base (coincident
-// vertices welded) refined by bisect_longest_edges(base, scale * diagonal * base_edge_fraction,
-// 2'000'000); SurfaceQuilt::refinement maps them back. Throws
-// InvalidInput for an empty or non-finite base or swatch, scale <= 0 or not finite, a field of the
-// wrong size.
+// vertices welded) refined by bisect_longest_edges(base, element size * base_edge_fraction,
+// 2'000'000), the element size being element_size or else scale * diagonal;
+// SurfaceQuilt::refinement maps them back. Throws InvalidInput for an empty or non-finite base or
+// swatch, scale <= 0 or not finite, element_size < 0 or not finite, a field of the wrong size.
 SurfaceQuilt quilt_surface(const TriMesh& base, const TriMesh& swatch,
                            const SurfaceQuiltingOptions& options,
                            TranslationCostEvaluator& evaluator,

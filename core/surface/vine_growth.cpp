@@ -1113,9 +1113,10 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     const double faces =
         length * (2.0 * model.segments / model.ring_spacing + leaf_faces / model.period);
     stats.estimated_faces = faces;  // the memory estimate's (--stats `memory`), not the patches'
-    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at --scale ", options.scale,
+    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
              " the vines would have about ", faces, " faces, more than the limit of ",
-             options.max_faces, " (--max-faces); use a larger --scale");
+             options.max_faces, " (--max-faces); use a larger ",
+             options.element_size > 0 ? "--element-size" : "--scale");
   }
   if (options.global.count_only) {
     if (stats_out) *stats_out = std::move(stats);

@@ -72,6 +72,26 @@ TEST(SurfaceCoverage, ClosedBaseIndependentOfThreads) {
   EXPECT_THROW(surface_coverage(TriMesh(), texture, 0.1), InvalidInput);
 }
 
+TEST(SurfaceCoverage, OverTheMaskedFacesOnly) {
+  // The cube's top face covered, nothing else: over the top alone 1, over top and bottom 1/2,
+  // over the bottom 0 (issue 25: a masked quilt is judged over its mask).
+  const TriMesh cube = test::unit_cube();
+  const TriMesh texture = moved(test::plane_grid(1, 1, 3, 3), Vector3d(0, 0, 1.05));
+  std::vector<char> top(12, 0), bottom(12, 0);
+  for (int f = 0; f < 12; ++f) {
+    const double z = (cube.V(cube.F(f, 0), 2) + cube.V(cube.F(f, 1), 2) + cube.V(cube.F(f, 2), 2));
+    top[f] = z == 3;
+    bottom[f] = z == 0;
+  }
+  std::vector<char> both = top;
+  for (int f = 0; f < 12; ++f) both[f] = top[f] || bottom[f];
+  EXPECT_DOUBLE_EQ(surface_coverage(cube, texture, 0.1, 0, top), 1.0);
+  EXPECT_DOUBLE_EQ(surface_coverage(cube, texture, 0.1, 0, both), 0.5);
+  EXPECT_DOUBLE_EQ(surface_coverage(cube, texture, 0.1, 0, bottom), 0.0);
+  EXPECT_DOUBLE_EQ(surface_coverage(cube, texture, 0.1, 0, std::vector<char>(12, 0)), 0.0);
+  EXPECT_THROW(surface_coverage(cube, texture, 0.1, 0, std::vector<char>(11, 1)), InvalidInput);
+}
+
 TEST(SurfaceCoverage, WhatASwatchCoversOfItself) {
   // Chain mail covers its footprint; vines and leaves only part of theirs.
   EXPECT_GT(swatch_coverage(chainmail_4in1()), 0.99);

@@ -1,0 +1,45 @@
+// Where a surface texture is wanted (issue 25, `meshquilt surface --mask`): the base is quilted
+// as usual, then whole elements over the rest are dropped, so that none is cut at the mask's
+// border; coverage is then judged over the mask alone.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/mesh/mesh.h"
+#include "core/surface/surface_quilting.h"
+
+namespace mq {
+
+// One of the two is set: a weight per base vertex in [0, 1], the mask being where the weight
+// interpolated linearly across the faces is >= 0.5; or a flag per base face.
+struct SurfaceMask {
+  Eigen::VectorXd vertex_weight;  // #V(base), or empty
+  std::vector<char> face;         // #F(base), or empty
+  // Whether the point with barycentric coordinates b on face f of the base lies in the mask.
+  bool contains(const TriMesh& base, int f, const Vector3d& b) const;
+};
+
+// Parses a mask for `base` (the base as given) from `text`, named `name` in messages. Lines
+// empty or starting with '#' are skipped. Either one number per base vertex, in [0, 1]; or a
+// first line `faces` and then one 0-based face index per line. Throws InvalidInput (one line:
+// name, line number) for a wrong count, a value that is not a number in [0, 1], an index out of
+// range, or a mask that sets nothing.
+SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
+                               const TriMesh& base);
+
+// parse_surface_mask on a file's contents (a regular file, core/mesh/input_file).
+SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base);
+
+// Per face of quilt.base: whether its centroid lies in the mask, located on `base` (the base
+// as given, which the mask describes) by its closest point: exact where quilt.base is a
+// refinement of it, the nearest point of it under a simplified proxy.
+std::vector<char> mask_quilt_faces(const SurfaceMask& mask, const TriMesh& base,
+                                   const SurfaceQuilt& quilt);
+
+// Drops the elements most of whose vertices lie above faces of quilt.base not in `faces`
+// (#F(quilt.base)): whole elements go and none is cut, so the border has no clipped ones, and
+// what is kept reaches at most about one element past the mask. Returns how many were dropped.
+int drop_unmasked_elements(SurfaceQuilt& quilt, const std::vector<char>& faces);
+
+}  // namespace mq

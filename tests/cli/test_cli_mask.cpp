@@ -1,0 +1,91 @@
+// surface --element-size and --mask (issue 25 item 3): the size in the base's units gives the
+// bytes --scale gives for the same size; a masked run writes whole elements over the mask, and
+// a bad mask file fails in one line before any work, writing nothing.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_io.h"
+#include "tests/cli/cli_support.h"
+
+namespace mq {
+namespace {
+
+// A 10 x 10 grid (exact coordinates) and the 3 x 3 chain mail, written in dir.
+void write_inputs(const std::string& dir) {
+  ASSERT_EQ(
+      meshquilt(dir, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw.obj --quiet").status, 0);
+  write_mesh(dir + "/grid.obj", test::plane_grid(10, 10, 20, 20));
+}
+
+TEST(CliSize, ElementSizeGivesTheBytesOfTheSameScale) {
+  const std::string dir = test::temp_dir();
+  write_inputs(dir);
+  const TriMesh grid = read_mesh(dir + "/grid.obj");
+  // The size --scale 0.07 gives, in the same arithmetic, printed to round-trip exactly.
+  char size[64];
+  std::snprintf(size, sizeof size, "%.17g", 0.07 * bounding_box(grid.V, grid.F).extent().norm());
+  const std::string job = "surface --base grid.obj --swatch sw.obj --field 1 0 0 --quiet";
+  // Same file names (an OBJ names its .mtl), in two folders.
+  fs::create_directories(dir + "/a");
+  fs::create_directories(dir + "/b");
+  ASSERT_EQ(meshquilt(dir, job + " --scale 0.07 -o a/out.obj").status, 0);
+  const CliRun b = meshquilt(dir, job + " --element-size " + size + " -o b/out.obj");
+  ASSERT_EQ(b.status, 0) << b.err;
+  const std::string a_bytes = slurp(dir + "/a/out.obj"), b_bytes = slurp(dir + "/b/out.obj");
+  EXPECT_GT(a_bytes.size(), 1000u);
+  EXPECT_TRUE(a_bytes == b_bytes);  // not EXPECT_EQ: its diff of megabytes takes gigabytes
+  // One of the two; within --scale's range relative to the base.
+  for (const std::string bad :
+       {" --scale 0.07 --element-size 1", " --element-size 0", " --element-size 1e-9",
+        " --element-size 1e3", " --element-size nan"}) {
+    const CliRun r = meshquilt(dir, job + bad + " -o c.obj");
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/c.obj"));
+}
+
+TEST(CliMask, MaskedRunAndBadMaskFiles) {
+  const std::string dir = test::temp_dir();
+  write_inputs(dir);
+  const TriMesh grid = read_mesh(dir + "/grid.obj");
+  // The faces of the left half, listed.
+  std::string faces = "faces\n";
+  for (int f = 0; f < grid.num_faces(); ++f)
+    if (grid.V(grid.F(f, 0), 0) + grid.V(grid.F(f, 1), 0) + grid.V(grid.F(f, 2), 0) < 15)
+      faces += std::to_string(f) + "\n";
+  spit(dir + "/half.txt", faces);
+  const std::string job =
+      "surface --base grid.obj --swatch sw.obj --field 1 0 0 --scale 0.07 --quiet";
+  const CliRun m = meshquilt(dir, job + " --mask half.txt -o m.obj --stats m.json");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const TriMesh out = read_mesh(dir + "/m.obj");
+  ASSERT_GT(out.num_faces(), 0);
+  // Within about one ring (0.07 of the diagonal, a third of it a ring) of x = 5.
+  EXPECT_LE(out.V.col(0).maxCoeff(), 5 + 0.5);
+  EXPECT_GE(std::stod(json_value(slurp(dir + "/m.json"), "coverage")), 0.9);
+  // Bad files: one line, exit 1, nothing written.
+  std::string weights;
+  for (int v = 0; v + 1 < grid.num_vertices(); ++v) weights += "1\n";
+  spit(dir + "/short.txt", weights);
+  spit(dir + "/nan.txt", weights + "nan\n");
+  std::string zeros;
+  for (int v = 0; v < grid.num_vertices(); ++v) zeros += "0\n";
+  spit(dir + "/zero.txt", zeros);
+  spit(dir + "/range.txt", "faces\n" + std::to_string(grid.num_faces()) + "\n");
+  spit(dir + "/none.txt", "faces\n");
+  for (const char* bad :
+       {"short.txt", "nan.txt", "zero.txt", "range.txt", "none.txt", "missing.txt"}) {
+    const CliRun r = meshquilt(dir, job + " --mask " + bad + " -o x.obj --stats x.json");
+    EXPECT_EQ(r.status, 1) << bad;
+    EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/x.obj"));
+  EXPECT_FALSE(fs::exists(dir + "/x.json"));
+}
+
+}  // namespace
+}  // namespace mq
