@@ -211,6 +211,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
     std::vector<int> replaced, crossing;
     for (const int k : related) (frame_inside[k] && !busy[k] ? replaced : crossing).push_back(k);
     std::vector<int> replaced_ids;
+    replaced_ids.reserve(replaced.size());
     for (const int k : replaced) replaced_ids.push_back(near[k]);
     if (crossing.empty()) {
       if (fits(output, in, replaced_ids)) {

@@ -222,7 +222,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
     const int px1 = std::min(grid.nx(), px0 + window) - 1,
               py1 = std::min(grid.ny(), py0 + window) - 1;
     const Vector2d sub_lo(px0 * cell, py0 * cell), sub_hi((px1 + 1) * cell, (py1 + 1) * cell);
-    const Vector2d t_min = sub_hi - swatch.size.head<2>(), t_max = sub_lo;
+    const Vector2d t_min = sub_hi - swatch.size.head<2>();
+    const Vector2d& t_max = sub_lo;
     OffsetChoice choice;
     {
       ScopedStageTimer timer(times, "matching");
