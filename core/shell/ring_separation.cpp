@@ -212,6 +212,7 @@ std::vector<char> separate_rings(MatrixX3d& V, const std::vector<Eigen::Index>& 
   // movable tubes' boxes (cell: the median box size).
   {
     std::vector<double> sizes;
+    sizes.reserve(tubes.size());
     for (const Tube& t : tubes) sizes.push_back(t.box.extent().maxCoeff());
     std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
     const double cell = std::max(sizes[sizes.size() / 2], 1e-12);

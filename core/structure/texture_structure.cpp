@@ -100,6 +100,7 @@ int farthest(const std::vector<double>& dist) {
 }
 
 // Per-element figures that need only the element itself (and the swatch, for its shape).
+// NOLINTNEXTLINE(bugprone-reserved-identifier): clang-tidy 14 sees the implicit copy's __i0
 struct ElementFigures {
   ElementStructure s;
   std::optional<Loop> loop;
@@ -705,14 +706,14 @@ StructureReport measure_structure(const TriMesh& mesh, const StructureOptions& o
 
   // Areas: given, or for a flat layer the centres' box grown by one spacing (a lattice of
   // a x b cells then has exactly its area).
-  double area = options.area, end_area = options.area;
+  double area = options.area;
   if (!(area > 0) && border.kind == TextureBorder::Kind::FlatBox) {
     const Vector2d ext = plane.hi - plane.lo;
     const double d = report.median_spacing;
     area = (ext.x() + d) * (ext.y() + d);
   }
   if (area > 0) {
-    end_area = area;
+    double end_area = area;
     if (border.kind == TextureBorder::Kind::FlatBox) {
       const Vector2d ext = plane.hi - plane.lo;
       end_area = std::max(0.0, ext.x() - 2 * end_margin) * std::max(0.0, ext.y() - 2 * end_margin);
