@@ -1273,6 +1273,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
 
   vs.stems = static_cast<int>(kept.size());
   std::vector<double> lengths;
+  lengths.reserve(kept.size());
   for (const Stem& st : kept) lengths.push_back(st.line.back().s);
   for (const double l : lengths) vs.total_length += l;
   if (!lengths.empty()) {
