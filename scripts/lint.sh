@@ -7,7 +7,8 @@
 #     in a fresh clone of main) HEAD~1; with no parent commit nothing is tidied. The diff is to
 #     the work tree, so uncommitted changes are tidied too. A changed header is tidied through
 #     its .cpp (or, with none, the first source that includes it); sources not in the
-#     compilation database (the fuzz targets, tests/data) are skipped.
+#     compilation database (the fuzz targets, tests/data) are skipped, and so are tests/ and
+#     bench/ (not made tidy-clean yet: core/ cli/ host/ are).
 # Needs $MESHQUILT_LINT_BUILD (default build)/compile_commands.json and the generated kernel
 # headers, i.e. a configured and built build directory. Exits non-zero on any finding.
 # MESHQUILT_LINT_ALL=1 tidies every source of core/ cli/ host/ instead of the changed ones.
@@ -77,6 +78,14 @@ for f in "${changed[@]}"; do
     echo "lint: clang-tidy: skipping $f (no source of it in $database)"
     continue
   fi
+  case "$source" in
+    core/* | cli/* | host/*) ;;
+    *)
+      # tests/ and bench/ have not been made tidy-clean yet: tidying them would fail on old code.
+      echo "lint: clang-tidy: skipping $f (only core/ cli/ host/ are tidied)"
+      continue
+      ;;
+  esac
   sources+=("$source")
 done
 
