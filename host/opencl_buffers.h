@@ -29,6 +29,8 @@ inline std::size_t padded(std::size_t n, std::size_t group) {
 // clSetKernelArg for a value or a cl_mem handle, checked.
 template <typename T>
 void set_arg(cl_kernel kernel, cl_uint index, const T& value) {
+  // sizeof(T) is the size OpenCL wants, also for a cl_mem (a pointer to an opaque struct).
+  // NOLINTNEXTLINE(bugprone-sizeof-expression)
   MQ_CL_CHECK(clSetKernelArg(kernel, index, sizeof(T), &value));
 }
 

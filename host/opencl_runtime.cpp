@@ -87,7 +87,8 @@ Runtime::Runtime(const RuntimeOptions& options) {
       const std::string pname = platform_info(p, CL_PLATFORM_NAME);
       for (cl_device_id d : devices(p, CL_DEVICE_TYPE_ALL)) {
         const std::string dname = device_info(d, CL_DEVICE_NAME);
-        seen += (seen.empty() ? "" : ", ") + ("\"" + pname + " / " + dname + "\"");
+        seen.append(seen.empty() ? "\"" : ", \"").append(pname).append(" / ").append(dname);
+        seen += '"';
         if (device_ || !contains(pname, want_platform) || !contains(dname, want_device)) continue;
         platform_ = p;
         device_ = d;

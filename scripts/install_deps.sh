@@ -5,7 +5,7 @@ packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libtbb-dev libeigen3-dev libembree-dev libtet1.5-dev libboost-graph-dev
   libpng-dev libgtest-dev libbenchmark-dev libtinygltf-dev python3
-  clang libclang-rt-14-dev)
+  clang libclang-rt-14-dev clang-format-14 clang-tidy-14)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -11,6 +11,8 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHQUILT_WERROR=ON
 # bases are exported by headless Blender.
 cmake --build build -j"$jobs" --target meshquilt test_core test_host test_cli test_slow \
   blender_bases
+# clang-format on the whole tree, clang-tidy on the sources changed since main (issue 24).
+bash scripts/lint.sh
 ctest --test-dir build --output-on-failure -j"$jobs"
 # The Blender add-on in real Blender, headless (issue 15); installs Blender when missing.
 if [ "${MESHQUILT_SKIP_BLENDER:-0}" != 1 ]; then

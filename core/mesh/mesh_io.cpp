@@ -336,8 +336,8 @@ TriMesh read_off(const std::string& path, const std::string& data) {
   std::string h = header;
   bool has_normals = false;
   if (h.rfind("ST", 0) == 0) h = h.substr(2);
-  if (h.rfind("C", 0) == 0) h = h.substr(1);
-  if (h.rfind("N", 0) == 0) {
+  if (h.rfind('C', 0) == 0) h = h.substr(1);
+  if (h.rfind('N', 0) == 0) {
     has_normals = true;
     h = h.substr(1);
   }

@@ -95,6 +95,8 @@ void bridge(const MatrixX3d& V, const std::vector<int>& a, const std::vector<int
   const int n = static_cast<int>(a.size()), m = static_cast<int>(b.size());
   auto [p, q] = closest_pair(V, a, b);
   for (int done_a = 0, done_b = 0; done_a < n || done_b < m;) {
+    // n, m > 0: the caller bridges two boundary loops.
+    // NOLINTNEXTLINE(clang-analyzer-core.DivideZero)
     const int ap = a[p], a_prev = a[(p + n - 1) % n], bq = b[q], b_next = b[(q + 1) % m];
     bool advance_a = done_b == m;
     if (done_a < n && done_b < m)

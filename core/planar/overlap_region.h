@@ -16,7 +16,7 @@ class OverlapRegion {
 
   // patch_lo, patch_hi: the xy footprint of the translated swatch. `processed` must describe the
   // output before this patch is merged (take a snapshot if the caller's state changes).
-  OverlapRegion(Vector2d patch_lo, Vector2d patch_hi, ProcessedTest processed)
+  OverlapRegion(const Vector2d& patch_lo, const Vector2d& patch_hi, ProcessedTest processed)
       : lo_(patch_lo), hi_(patch_hi), processed_(std::move(processed)) {}
 
   // Inside the patch footprint and over synthesised output.

@@ -7,7 +7,7 @@
 
 namespace mq {
 
-SynthesisGrid::SynthesisGrid(Vector2d origin, double cell_size, int nx, int ny)
+SynthesisGrid::SynthesisGrid(const Vector2d& origin, double cell_size, int nx, int ny)
     : origin_(origin), cell_size_(cell_size), nx_(nx), ny_(ny) {
   MQ_CHECK(std::isfinite(cell_size) && cell_size > 0, InvalidInput,
            "grid cell size must be positive and finite, got ", cell_size);

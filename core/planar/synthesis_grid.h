@@ -20,7 +20,7 @@ class SynthesisGrid {
  public:
   // A grid of nx by ny cells of side cell_size with its (0,0) cell's corner at origin (x, y).
   // Throws InvalidInput for non-positive or non-finite sizes, or more than 2^26 cells.
-  SynthesisGrid(Vector2d origin, double cell_size, int nx, int ny);
+  SynthesisGrid(const Vector2d& origin, double cell_size, int nx, int ny);
 
   int nx() const { return nx_; }
   int ny() const { return ny_; }

@@ -649,6 +649,7 @@ SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
       ScopedStageTimer timer(times, "matching");
       const double half = 0.5 * window * cell;
       std::vector<const Element*> near;
+      near.reserve(flat.size());
       for (const auto& [id, e] : flat) near.push_back(&e);
       MatrixX3d P, NP;
       // Seeds lie just beyond the synthesised surface (faces within 1.5 shell heights of

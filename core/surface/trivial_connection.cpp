@@ -216,6 +216,7 @@ TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
   const Eigen::SparseMatrix<double> W = [&] {
     Eigen::SparseMatrix<double> w(ne, ne);
     std::vector<Eigen::Triplet<double>> d;
+    d.reserve(static_cast<size_t>(ne));
     for (int e = 0; e < ne; ++e) d.emplace_back(e, e, weight_(e));
     w.setFromTriplets(d.begin(), d.end());
     return w;

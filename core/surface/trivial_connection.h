@@ -55,7 +55,7 @@ class TrivialConnection {
   // #V component of each vertex, and whether each component is closed (no interior-less vertex).
   const std::vector<int>& vertex_component() const { return component_; }
   const std::vector<char>& closed_component() const { return closed_; }
-  int N() const { return N_; }
+  int N() const { return N_; }  // NOLINT(readability-identifier-naming): the paper's N
 
   // Indices (#V, units of 1/N turn) are admissible when every closed component's sum is N chi.
   // Returns the first closed component where it is not, or -1.

@@ -164,7 +164,9 @@ VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index) {
   const Element& vine = swatch.elements[static_cast<size_t>(vine_index)];
   VineModel m;
   m.kind = vine.kind;
-  const auto [origin, axis] = principal_axis(vine.V);
+  // Not a structured binding: lambdas capture those only from C++20 (clang rejects it in C++17).
+  const std::pair<Vector2d, Vector2d> origin_axis = principal_axis(vine.V);
+  const Vector2d &origin = origin_axis.first, &axis = origin_axis.second;
   const Vector2d left(-axis.y(), axis.x());
   const auto frame = [&](const Vector3d& q) {
     const Vector2d d = q.head<2>() - origin;
@@ -1272,6 +1274,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
 
   vs.stems = static_cast<int>(kept.size());
   std::vector<double> lengths;
+  lengths.reserve(kept.size());
   for (const Stem& st : kept) lengths.push_back(st.line.back().s);
   for (const double l : lengths) vs.total_length += l;
   if (!lengths.empty()) {
