@@ -188,7 +188,10 @@ class QuadricCollapser {
   }
 
  private:
-  Vector3d P(int v) const { return mesh_.V.row(v).transpose() - centre_; }
+  // A vertex position relative to the centre (the short name keeps the formulas readable).
+  Vector3d P(int v) const {  // NOLINT(readability-identifier-naming)
+    return mesh_.V.row(v).transpose() - centre_;
+  }
   std::vector<int> neighbours(int v) const {
     std::vector<int> n;
     for (const int f : faces_of_[v])
@@ -248,7 +251,7 @@ class QuadricCollapser {
   bool face_stays_valid(int f, int from, int to, const int shared[2]) const {
     const Vector3d pt = P(to);
     Vector3d old_c[3], new_c[3];
-    int others[2], m = 0;
+    int others[2] = {-1, -1}, m = 0;
     for (int k = 0; k < 3; ++k) {
       const int w = F_(f, k);
       old_c[k] = P(w);

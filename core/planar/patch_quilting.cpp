@@ -202,6 +202,7 @@ class PatchMerger {
     for (const int k : related)
       (patch_.frame_inside[k] && !busy_[k] ? replaced : crossing).push_back(k);
     std::vector<int> replaced_ids;
+    replaced_ids.reserve(replaced.size());
     for (const int k : replaced) replaced_ids.push_back(patch_.near[k]);
     if (crossing.empty()) return replace(in, replaced_ids);
     if (crossing.size() != 1 || busy_[crossing[0]]) {

@@ -234,7 +234,8 @@ class PlaneQuilter {
     const int px1 = std::min(grid_.nx(), px0 + window_) - 1,
               py1 = std::min(grid_.ny(), py0 + window_) - 1;
     const Vector2d sub_lo(px0 * cell_, py0 * cell_), sub_hi((px1 + 1) * cell_, (py1 + 1) * cell_);
-    const Vector2d t_min = sub_hi - swatch_.size.head<2>(), t_max = sub_lo;
+    const Vector2d t_min = sub_hi - swatch_.size.head<2>();
+    const Vector2d& t_max = sub_lo;
     ScopedStageTimer timer(stats_.times, "matching");
     std::vector<const Element*> near;
     for (const int id : output_.query(sub_lo, sub_hi)) near.push_back(&output_[id]);

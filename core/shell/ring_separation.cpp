@@ -209,6 +209,7 @@ void add_obstacles(const MatrixX3d& V, const std::vector<Eigen::Index>& first,
                    const std::vector<std::optional<RingBins>>& bins, RingScene& scene) {
   std::vector<Tube>& tubes = scene.tubes;
   std::vector<double> sizes;
+  sizes.reserve(tubes.size());
   for (const Tube& t : tubes) sizes.push_back(t.box.extent().maxCoeff());
   std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
   const double cell = std::max(sizes[sizes.size() / 2], 1e-12);

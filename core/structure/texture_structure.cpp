@@ -100,6 +100,7 @@ int farthest(const std::vector<double>& dist) {
 }
 
 // Per-element figures that need only the element itself (and the swatch, for its shape).
+// NOLINTNEXTLINE(bugprone-reserved-identifier): clang-tidy 14 sees the implicit copy's __i0
 struct ElementFigures {
   ElementStructure s;
   std::optional<Loop> loop;

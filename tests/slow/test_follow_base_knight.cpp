@@ -46,8 +46,10 @@ TEST(FollowBaseKnight, TheArmorFollowsTheKnightBent) {
   const std::string embed = slurp(dir + "/e.json");
   EXPECT_LE(number(embed, "removed"), 0.02 * number(embed, "elements"));
   auto measure = [&](const std::string& mesh, const std::string& base) {
-    const CliRun m = meshquilt(dir, "info " + mesh + " --json --intersections --links --swatch "
-                                    "sw.obj --base '" + base + "' --scale 0.13");
+    const CliRun m = meshquilt(dir, "info " + mesh +
+                                        " --json --intersections --links --swatch "
+                                        "sw.obj --base '" +
+                                        base + "' --scale 0.13");
     EXPECT_EQ(m.status, 0) << m.err;
     return m.out;
   };
