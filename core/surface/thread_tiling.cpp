@@ -15,9 +15,9 @@ namespace mq {
 namespace {
 
 // Points in a hash grid of cell `cell`, for "the point nearest p within tol" (tol <= cell).
-class PointGrid {
+class EndGrid {
  public:
-  PointGrid(const MatrixX3d& V, double cell) : V_(V), cell_(cell) {
+  EndGrid(const MatrixX3d& V, double cell) : V_(V), cell_(cell) {
     for (Eigen::Index i = 0; i < V.rows(); ++i)
       cells_[key(cell_of(V.row(i).transpose()))].push_back(static_cast<int>(i));
   }
@@ -59,13 +59,13 @@ class PointGrid {
 };
 
 // The footprint's principal axis d (sign: +x, else +y) and the extents along and across it.
-struct Axis {
+struct FootprintAxis {
   Vector2d d = Vector2d::UnitX();
   double along = 0, across = 0;
 };
 
-Axis principal_axis(const MatrixX3d& V) {
-  Axis out;
+FootprintAxis footprint_axis(const MatrixX3d& V) {
+  FootprintAxis out;
   if (V.rows() < 2) return out;
   const Vector2d mean = V.leftCols<2>().colwise().mean().transpose();
   Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
@@ -92,7 +92,7 @@ Axis principal_axis(const MatrixX3d& V) {
 }
 
 bool is_long(const Element& e, const Vector2d& size) {
-  const Axis a = principal_axis(e.V);
+  const FootprintAxis a = footprint_axis(e.V);
   return a.along >= 4 * a.across && ((e.hi - e.lo).array() > 0.6 * size.array()).any();
 }
 
@@ -113,7 +113,7 @@ bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& sy
   const Element& e = swatch.elements[static_cast<size_t>(index)];
   const MatrixX3d& V = e.V;
   const MatrixX3i& F = e.F;
-  const Axis axis = principal_axis(V);
+  const FootprintAxis axis = footprint_axis(V);
   const double margin = std::max(axis.across, tol);
   // Lattice vectors along the thread, shortest first.
   const Vector2d a = basis.col(0), b = basis.col(1);
@@ -132,7 +132,7 @@ bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& sy
     if (p.first != q.first) return p.first < q.first;
     return std::make_pair(p.second.x(), p.second.y()) < std::make_pair(q.second.x(), q.second.y());
   });
-  const PointGrid grid(V, std::max(tol, 1e-300));
+  const EndGrid grid(V, std::max(tol, 1e-300));
   Vector2d period = Vector2d::Zero();
   double lo = 0, hi = 0;
   std::vector<double> t(static_cast<size_t>(V.rows()));
@@ -292,7 +292,7 @@ bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& sy
     if (!symmetry.half_turn) return true;
     const Eigen::Index nv = p.V.rows() - 2;
     const MatrixX3d tube = p.V.topRows(nv);
-    const PointGrid grid(tube, std::max(tol, 1e-300));
+    const EndGrid grid(tube, std::max(tol, 1e-300));
     const auto image = [&](Eigen::Index v) {
       return Vector3d(symmetry.c.x() - p.V(v, 0), symmetry.c.y() - p.V(v, 1), p.V(v, 2));
     };
@@ -371,7 +371,7 @@ ThreadTiling thread_tiling(const PreparedSwatch& swatch, const SwatchSymmetry& s
     return distance[p] != distance[q] ? distance[p] < distance[q] : p < q;
   });
   ThreadTiling out;
-  std::vector<PointGrid> grids;
+  std::vector<EndGrid> grids;
   grids.reserve(swatch.elements.size());
   for (const int i : order) {
     const Element& e = swatch.elements[static_cast<size_t>(i)];

@@ -65,6 +65,17 @@ inline std::vector<std::string> listing(const std::string& dir) {
   return names;
 }
 
+// A mesh as a plain OBJ (positions at full precision, faces), for bases made in a test.
+inline void write_obj(const std::string& path, const TriMesh& m) {
+  std::ostringstream obj;
+  obj.precision(17);
+  for (int v = 0; v < m.num_vertices(); ++v)
+    obj << "v " << m.V(v, 0) << " " << m.V(v, 1) << " " << m.V(v, 2) << "\n";
+  for (int f = 0; f < m.num_faces(); ++f)
+    obj << "f " << m.F(f, 0) + 1 << " " << m.F(f, 1) + 1 << " " << m.F(f, 2) + 1 << "\n";
+  spit(path, obj.str());
+}
+
 // The value printed for "key": in a JSON text (the first occurrence), as text.
 inline std::string json_value(const std::string& json, const std::string& key) {
   const std::string k = "\"" + key + "\":";

@@ -17,16 +17,6 @@
 namespace mq {
 namespace {
 
-void write_obj(const std::string& path, const TriMesh& m) {
-  std::ostringstream obj;
-  obj.precision(17);
-  for (int v = 0; v < m.num_vertices(); ++v)
-    obj << "v " << m.V(v, 0) << " " << m.V(v, 1) << " " << m.V(v, 2) << "\n";
-  for (int f = 0; f < m.num_faces(); ++f)
-    obj << "f " << m.F(f, 0) + 1 << " " << m.F(f, 1) + 1 << " " << m.F(f, 2) + 1 << "\n";
-  spit(path, obj.str());
-}
-
 // The tube bent about the y axis by `degrees` over its height (z in [0, 2]), as a bend deformer.
 TriMesh bent(TriMesh m, double degrees) {
   if (degrees == 0) return m;
