@@ -51,14 +51,20 @@ struct SwatchRequest {
   }
 };
 
-TriMesh make_chainmail(const CommandLine& cl, const SwatchRequest& q) {
-  ChainMailOptions o;
+// The options both ring patterns share: rows and columns, sizes at --scale, --detail.
+template <class RingOptions>
+void set_ring_grid(const CommandLine& cl, const SwatchRequest& q, RingOptions& o) {
   o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
   o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
   o.ring_radius *= q.scale;
   o.wire_radius *= q.scale;
   if (q.detail)
     o.ring_segments = std::max(8, q.detail), o.wire_segments = std::max(4, q.detail / 4);
+}
+
+TriMesh make_chainmail(const CommandLine& cl, const SwatchRequest& q) {
+  ChainMailOptions o;
+  set_ring_grid(cl, q, o);
   ChainMailOptions one = o;
   one.rows = one.cols = 1;
   q.check_size(static_cast<double>(chainmail_4in1(one).num_faces()) * o.rows * o.cols);
@@ -67,12 +73,7 @@ TriMesh make_chainmail(const CommandLine& cl, const SwatchRequest& q) {
 
 TriMesh make_square_mail(const CommandLine& cl, const SwatchRequest& q) {
   SquareMailOptions o;
-  o.rows = static_cast<int>(cl.get_int("rows", 1, 200));
-  o.cols = static_cast<int>(cl.get_int("cols", 1, 200));
-  o.ring_radius *= q.scale;
-  o.wire_radius *= q.scale;
-  if (q.detail)
-    o.ring_segments = std::max(8, q.detail), o.wire_segments = std::max(4, q.detail / 4);
+  set_ring_grid(cl, q, o);
   SquareMailOptions one = o;
   one.rows = one.cols = 1;
   // A flat ring per cell and up to two connectors of as many faces.
