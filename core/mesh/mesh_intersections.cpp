@@ -159,19 +159,56 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
 
-  // Face bounding boxes (double, for the grid).
-  MatrixX3d lo(nf, 3), hi(nf, 3);
-  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
-    for (int f = r.begin(); f != r.end(); ++f) {
-      lo.row(f) = V.row(F(f, 0)).cwiseMin(V.row(F(f, 1))).cwiseMin(V.row(F(f, 2)));
-      hi.row(f) = V.row(F(f, 0)).cwiseMax(V.row(F(f, 1))).cwiseMax(V.row(F(f, 2)));
+  // What the narrow phase reads of a candidate, in one cache line: its box rounded outward to
+  // float (a quick, conservative rejection; the exact test decides), its first and last cells,
+  // its label. The boxes are made first (cells 0), in one pass that also sums their sizes and
+  // bounds per block (in block order: the same cell size whatever the threads); no
+  // double-precision box arrays (2 x 24 bytes a face, freshly mapped pages on every call).
+  struct Candidate {
+    float lo[3], hi[3];
+    int c0[3], c1[3];
+    int label;
+  };
+  std::vector<Candidate> box(static_cast<size_t>(nf));
+  constexpr int kBoxBlock = 16384;
+  struct BlockSum {
+    Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Vector3d hi = Vector3d::Constant(-std::numeric_limits<double>::infinity());
+    double size = 0;
+  };
+  std::vector<BlockSum> block_sum(static_cast<size_t>((nf + kBoxBlock - 1) / kBoxBlock));
+  tbb::parallel_for(0, static_cast<int>(block_sum.size()), [&](int b) {
+    BlockSum& sum = block_sum[static_cast<size_t>(b)];
+    for (int f = b * kBoxBlock, end = std::min(nf, f + kBoxBlock); f < end; ++f) {
+      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
+      sum.lo = sum.lo.cwiseMin(lo);
+      sum.hi = sum.hi.cwiseMax(hi);
+      sum.size += (hi - lo).maxCoeff();
+      Candidate& c = box[static_cast<size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        float l = static_cast<float>(lo[k]), u = static_cast<float>(hi[k]);
+        if (static_cast<double>(l) > lo[k])
+          l = std::nextafter(l, -std::numeric_limits<float>::infinity());
+        if (static_cast<double>(u) < hi[k])
+          u = std::nextafter(u, std::numeric_limits<float>::infinity());
+        c.lo[k] = l;
+        c.hi[k] = u;
+      }
+      c.label = label ? (*label)[static_cast<size_t>(f)] : 0;
     }
   });
-  const Vector3d gmin = lo.colwise().minCoeff().transpose();
-  const Vector3d gext = (hi.colwise().maxCoeff().transpose() - gmin);
+  BlockSum all;
+  for (const BlockSum& b : block_sum) {
+    all.lo = all.lo.cwiseMin(b.lo);
+    all.hi = all.hi.cwiseMax(b.hi);
+    all.size += b.size;
+  }
+  const Vector3d gmin = all.lo;
+  const Vector3d gext = all.hi - all.lo;
 
   // Cell size: the mean face box size, enlarged if the grid would have too many cells.
-  double h = (hi - lo).rowwise().maxCoeff().mean();
+  double h = all.size / nf;
   if (!(h > 0)) h = std::max(gext.maxCoeff(), 1.0);
   const double max_cells = 4.0 * nf + 64.0;
   std::array<int, 3> n{};
@@ -188,37 +225,27 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     return std::clamp(static_cast<int>(std::floor((x - gmin[k]) / h)), 0, n[k] - 1);
   };
   const auto cell_index = [&](int i, int j, int k) { return (k * n[1] + j) * n[0] + i; };
-
-  // What the narrow phase reads of a candidate, in one cache line: its box rounded outward to
-  // float (a quick, conservative rejection; the exact test decides), its first cell, its label.
-  struct Candidate {
-    float lo[3], hi[3];
-    int c0[3], c1[3];
-    int label;
-  };
-  std::vector<Candidate> box(static_cast<size_t>(nf));
+  // The cells from the exact (double) box, as the grid's bounds are exact.
   tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
     for (int f = r.begin(); f != r.end(); ++f) {
+      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
       Candidate& c = box[static_cast<size_t>(f)];
       for (int k = 0; k < 3; ++k) {
-        float l = static_cast<float>(lo(f, k)), u = static_cast<float>(hi(f, k));
-        if (static_cast<double>(l) > lo(f, k))
-          l = std::nextafter(l, -std::numeric_limits<float>::infinity());
-        if (static_cast<double>(u) < hi(f, k))
-          u = std::nextafter(u, std::numeric_limits<float>::infinity());
-        c.lo[k] = l;
-        c.hi[k] = u;
-        c.c0[k] = cell_coord(lo(f, k), k);
-        c.c1[k] = cell_coord(hi(f, k), k);
+        c.c0[k] = cell_coord(lo[k], k);
+        c.c1[k] = cell_coord(hi[k], k);
       }
-      c.label = label ? (*label)[static_cast<size_t>(f)] : 0;
     }
   });
 
-  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order).
+  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order). With
+  // an active set only the active faces: every pair to test has one, and the rest (60% of the
+  // faces in the fold repair's updates) need not be sorted into the grid.
+  const auto bucketed = [&](int f) { return !active || (*active)[f]; };
   const int num_cells = n[0] * n[1] * n[2];
   std::vector<int> offsets(num_cells + 1, 0);
   for (int f = 0; f < nf; ++f) {
+    if (!bucketed(f)) continue;
     const Candidate& c = box[static_cast<size_t>(f)];
     for (int k = c.c0[2]; k <= c.c1[2]; ++k)
       for (int j = c.c0[1]; j <= c.c1[1]; ++j)
@@ -229,6 +256,7 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   {
     std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
     for (int f = 0; f < nf; ++f) {
+      if (!bucketed(f)) continue;
       const Candidate& c = box[static_cast<size_t>(f)];
       for (int k = c.c0[2]; k <= c.c1[2]; ++k)
         for (int j = c.c0[1]; j <= c.c1[1]; ++j)
@@ -236,10 +264,10 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     }
   }
 
-  // Narrow phase per face f against later faces g; a pair is tested only in the cell holding
-  // the min corner of the intersection of the two boxes (per axis the larger of their first
-  // cells), so it is tested once. With an active set, a pair is tested by its active face (the
-  // first, if both are).
+  // Narrow phase per face f against the bucketed faces g, each pair once: g later than f, or
+  // with an active set g active and f inactive or earlier. A pair is tested only in the cell
+  // holding the min corner of the intersection of the two boxes (per axis the larger of their
+  // first cells). The exact test takes the active face first (the earlier if both are).
   // Found per block of faces (a vector per face would zero 24 bytes per face for nothing),
   // joined in block order: the same pairs in the same order whatever the threads.
   constexpr int kBlock = 4096;
@@ -249,16 +277,19 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     std::vector<std::pair<int, int>>& out = found[static_cast<size_t>(block)];
     std::vector<int> hits;
     for (int f = block * kBlock, end = std::min(nf, f + kBlock); f < end; ++f) {
-      if (active && !(*active)[f]) continue;
+      const bool f_first = bucketed(f);
       hits.clear();
       const Candidate a = box[static_cast<size_t>(f)];
       for (int k = a.c0[2]; k <= a.c1[2]; ++k)
         for (int j = a.c0[1]; j <= a.c1[1]; ++j)
           for (int i = a.c0[0]; i <= a.c1[0]; ++i) {
             const int c = cell_index(i, j, k);
-            for (int m = offsets[c]; m < offsets[c + 1]; ++m) {
-              const int g = members[m];
-              if (g == f || (g < f && (!active || (*active)[g]))) continue;
+            // Buckets are ascending: the faces after f start at its upper bound.
+            const int* const first = members.data() + offsets[c];
+            const int* const last = members.data() + offsets[c + 1];
+            for (const int* m = f_first ? std::upper_bound(first, last, f) : first; m != last;
+                 ++m) {
+              const int g = *m;
               const Candidate& b = box[static_cast<size_t>(g)];
               if (label && (a.label == b.label) != same_label) continue;
               if (a.lo[0] > b.hi[0] || b.lo[0] > a.hi[0] || a.lo[1] > b.hi[1] ||
@@ -267,7 +298,8 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
               if (std::max(a.c0[0], b.c0[0]) != i || std::max(a.c0[1], b.c0[1]) != j ||
                   std::max(a.c0[2], b.c0[2]) != k)
                 continue;
-              if (faces_intersect(V, F, f, g)) hits.push_back(g);
+              if (f_first ? faces_intersect(V, F, f, g) : faces_intersect(V, F, g, f))
+                hits.push_back(g);
             }
           }
       std::sort(hits.begin(), hits.end());
