@@ -56,6 +56,9 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
       .value("welded_vertices", s.welded_vertices)
       .value("duplicate_faces", s.duplicate_faces)
       .value("flipped_components", s.flipped_components)
+      .value("fin_faces", s.fin_faces)
+      .value("fin_area_share", s.fin_area_share)
+      .value("non_manifold_edges", s.non_manifold_edges)
       .value("proxy_faces", s.proxy_faces)
       .value("proxy_error", s.proxy_error)
       .value("swatch_scale", s.swatch_scale)
@@ -437,11 +440,16 @@ int run_surface(int argc, char** argv, int first) {
         stats.shell_height, 100.0 * embedding_stats.coverage);
     // Faces meeting three or more at an edge (fins, flaps): the layout ends there as at a
     // border, which the user should know of rather than find (issue 28, item 7).
-    if (const int fins = topology_report(base).num_non_manifold_edges; fins > 0)
+    if (stats.fin_faces > 0)
+      std::printf(
+          "base: %d faces in fins (pieces sticking out at non-manifold edges, %.2g%% of the "
+          "area) were left out: the texture covers the surface they stand on\n",
+          stats.fin_faces, 100.0 * stats.fin_area_share);
+    if (stats.non_manifold_edges > 0)
       std::printf(
           "base: %d non-manifold edges (three or more faces meeting) are borders: the "
           "texture ends at them on every side\n",
-          fins);
+          stats.non_manifold_edges);
     if (stats.flipped_components > 0)
       std::printf(
           "base: %d components faced inward and were turned outward "

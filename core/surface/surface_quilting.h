@@ -151,6 +151,9 @@ struct SurfaceQuiltingStats {
   int welded_vertices = 0;     // base vertices merged with another at the same position
   int duplicate_faces = 0;     // base faces that repeated another, removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
+  int fin_faces = 0;           // base faces in fins (core/mesh/fins.h), left out
+  double fin_area_share = 0;   // their share of the base's area
+  int non_manifold_edges = 0;  // of the base without its fins: borders for the texture
   int proxy_faces = 0;         // faces of the simplified base (0: the base was not simplified)
   double proxy_error = 0;      // the simplification's largest quadric error (mesh units)
   int patches_shrunk = 0;
