@@ -99,7 +99,7 @@ def median(xs):
     return statistics.median(xs) if xs else None
 
 
-def run_job_once(meshquilt, argv, workdir, tag):
+def run_job_once(meshquilt, argv, workdir, tag, keep_output=False):
     out = os.path.join(workdir, tag + ".obj")
     stats_path = os.path.join(workdir, tag + ".json")
     if os.path.exists(stats_path):
@@ -110,10 +110,25 @@ def run_job_once(meshquilt, argv, workdir, tag):
         raise JobFailed("exit %d: %s" % (code, last_line(err)))
     with open(stats_path) as f:
         stats = json.load(f)
-    for p in (out, stats_path):
+    for p in (stats_path,) if keep_output else (out, stats_path):
         if os.path.exists(p):
             os.remove(p)
-    return {"wall_seconds": wall, "max_rss_kib": rss, "stats": stats, "argv": full}
+    return {"wall_seconds": wall, "max_rss_kib": rss, "stats": stats, "argv": full,
+            "output_path": out}
+
+
+def measure_floor(job_floor, job, values, output, runs):
+    """The job's floor (bench/job_floor.cpp): reading its inputs, one closest-point query per
+    output vertex against its base (or plane), writing its output again; medians of `runs`."""
+    argv = [job_floor, "--swatch", values["swatch"], "--output", output, "--runs", str(runs)]
+    if "base" in values:
+        argv += ["--base", values["base"]]
+    else:
+        argv += ["--plane", values["length"], values["width"]]
+    p = subprocess.run(argv, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise JobFailed("job_floor exit %d: %s" % (p.returncode, last_line(p.stderr)))
+    return json.loads(last_line(p.stdout))
 
 
 def summarize_runs(runs):
@@ -137,7 +152,26 @@ def summarize_runs(runs):
     }
 
 
-def run_job(meshquilt, job, runs, workdir, available):
+def finish_result(result, measured):
+    """Medians of the measured runs and the ratios to the paper's figures and to the floor."""
+    result["status"] = "ok"
+    result.update(summarize_runs(measured))
+    minutes = result["paper"].get("minutes")
+    if minutes and result["wall_seconds"] > 0:
+        result["paper_over_ours"] = minutes * 60.0 / result["wall_seconds"]
+    floor = result.get("floor", {}).get("floor_seconds")
+    if floor:
+        result["over_floor"] = result["wall_seconds"] / floor
+    paper_faces = result["paper"].get("output_faces")
+    if paper_faces and result["output"].get("faces"):
+        result["output_faces_over_paper"] = result["output"]["faces"] / paper_faces
+    return result
+
+
+def run_job(meshquilt, job, runs, workdir, available, job_floor=None, other=None):
+    """Runs `job` `runs` times; with `other` (a second meshquilt) that binary's run follows each
+    of meshquilt's (A B A B ...), so both see the same drift of the machine's speed. Returns
+    meshquilt's result, and other's (None without it)."""
     result = {"name": job["name"], "paper_name": job.get("paper_name", job["name"]),
               "paper": job.get("paper", {})}
     required = job.get("requires")
@@ -145,7 +179,7 @@ def run_job(meshquilt, job, runs, workdir, available):
         result["status"] = "skipped"
         result["reason"] = "needs the %s command" % required
         log("%-12s skipped: needs the %s command" % (job["name"], required))
-        return result
+        return result, (dict(result) if other else None)
     swatch = os.path.join(workdir, job["name"] + "_swatch.obj")
     values = {"swatch": swatch}
     try:
@@ -165,27 +199,39 @@ def run_job(meshquilt, job, runs, workdir, available):
         argv = substitute(job["argv"], values)
         shown = dict(values, swatch="SWATCH.obj", base=job.get("base", ""))
         result["command"] = "meshquilt " + " ".join(substitute(job["argv"], shown))
-        measured = []
+        measured, measured_other = [], []
         for i in range(runs):
-            r = run_job_once(meshquilt, argv, workdir, "%s_%d" % (job["name"], i))
+            last = i == runs - 1
+            r = run_job_once(meshquilt, argv, workdir, "%s_%d" % (job["name"], i),
+                             keep_output=last and job_floor is not None)
             log("%-12s run %d/%d: %.2f s, %d MiB, %s faces" %
                 (job["name"], i + 1, runs, r["wall_seconds"], r["max_rss_kib"] // 1024,
                  r["stats"].get("output", {}).get("faces")))
             measured.append(r)
+            if other:
+                o = run_job_once(other, argv, workdir, "%s_%d_vs" % (job["name"], i))
+                log("%-12s run %d/%d (--vs): %.2f s, %d MiB" %
+                    (job["name"], i + 1, runs, o["wall_seconds"], o["max_rss_kib"] // 1024))
+                measured_other.append(o)
+            if last and job_floor is not None:
+                try:
+                    result["floor"] = measure_floor(job_floor, job, values, r["output_path"],
+                                                    runs)
+                finally:
+                    for ext in (".obj", ".mtl"):
+                        p = os.path.splitext(r["output_path"])[0] + ext
+                        if os.path.exists(p):
+                            os.remove(p)
     except JobFailed as e:
         result["status"] = "failed"
         result["error"] = str(e)
         log("%-12s FAILED: %s" % (job["name"], e))
-        return result
-    result["status"] = "ok"
-    result.update(summarize_runs(measured))
-    minutes = result["paper"].get("minutes")
-    if minutes and result["wall_seconds"] > 0:
-        result["paper_over_ours"] = minutes * 60.0 / result["wall_seconds"]
-    paper_faces = result["paper"].get("output_faces")
-    if paper_faces and result["output"].get("faces"):
-        result["output_faces_over_paper"] = result["output"]["faces"] / paper_faces
-    return result
+        return result, (dict(result) if other else None)
+    other_result = None
+    if other:
+        other_result = finish_result(
+            {k: v for k, v in result.items() if k not in ("status",)}, measured_other)
+    return finish_result(result, measured), other_result
 
 
 def calibrate(meshquilt, spec, workdir):
@@ -339,8 +385,18 @@ def main(argv=None):
                     help="run a plane job at 1x, 2x and 4x the domain area instead")
     ap.add_argument("--no-calibration", action="store_true",
                     help="skip the calibration measurement")
+    ap.add_argument("--no-floor", action="store_true",
+                    help="skip each job's floor (job_floor in the build directory: reading the "
+                    "inputs, one closest-point query per output vertex, writing the output)")
+    ap.add_argument("--vs", metavar="BUILD",
+                    help="a second build directory (the baseline): its meshquilt runs after each "
+                    "run of this one, A B A B, on the same machine in the same minutes; its "
+                    "result goes to --vs-output, for bench/compare.py")
+    ap.add_argument("--vs-output", metavar="FILE", help="result JSON of the --vs build")
     ap.add_argument("-o", "--output", help="result JSON (default: stdout)")
     args = ap.parse_args(argv)
+    if bool(args.vs) != bool(args.vs_output):
+        ap.error("--vs and --vs-output go together")
     if args.runs < 1:
         ap.error("--runs must be at least 1")
 
@@ -349,6 +405,19 @@ def main(argv=None):
         log("run_jobs: no executable meshquilt in '%s' (build it first: cmake --build %s)" %
             (args.build, args.build))
         return 2
+    other = None
+    if args.vs:
+        other = find_meshquilt(args.vs)
+        if not other:
+            log("run_jobs: no executable meshquilt in '%s'" % args.vs)
+            return 2
+    job_floor = None
+    if not args.no_floor:
+        job_floor = os.path.join(os.path.dirname(meshquilt), "job_floor")
+        if not os.access(job_floor, os.X_OK):
+            log("run_jobs: no job_floor beside meshquilt (build it: cmake --build %s --target "
+                "job_floor); floors not measured" % args.build)
+            job_floor = None
     with open(args.jobs_file) as f:
         spec = json.load(f)
     jobs = {j["name"]: j for j in spec["jobs"]}
@@ -391,10 +460,13 @@ def main(argv=None):
             if args.scaling:
                 result["scaling"] = run_scaling(meshquilt, jobs[args.scaling], args.runs, workdir)
             result["jobs"] = []
+            other_jobs = []
             for job in selected:
-                r = run_job(meshquilt, job, args.runs, workdir, available)
+                r, o = run_job(meshquilt, job, args.runs, workdir, available, job_floor, other)
                 failed |= r["status"] == "failed"
                 result["jobs"].append(r)
+                if o is not None:
+                    other_jobs.append(o)
         except JobFailed as e:
             log("run_jobs: %s" % e)
             return 1
@@ -404,29 +476,41 @@ def main(argv=None):
     result["device"] = ", ".join(devices) if devices else None
     text = json.dumps(result, indent=1, sort_keys=False) + "\n"
     if args.output:
-        tmp = args.output + ".tmp"
-        with open(tmp, "w") as f:
-            f.write(text)
-        os.replace(tmp, args.output)
+        write_atomically(args.output, text)
     else:
         sys.stdout.write(text)
+    if other:
+        paired = dict(result, meshquilt=other, jobs=other_jobs, paired_with=meshquilt)
+        paired.pop("calibration", None)  # measured with meshquilt's binary only
+        write_atomically(args.vs_output, json.dumps(paired, indent=1) + "\n")
     print_table(result)
     return 1 if failed else 0
+
+
+def write_atomically(path, text):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
 
 
 def print_table(result):
     rows = result.get("jobs", [])
     if rows:
-        log("%-12s %9s %9s %9s %10s %10s %7s %8s" % ("job", "ours s", "paper min", "paper/us",
-                                                    "faces", "paper F", "F ratio", "MiB"))
+        log("%-12s %9s %9s %9s %8s %8s %10s %10s %7s %8s" % (
+            "job", "ours s", "paper min", "paper/us", "floor s", "x floor", "faces", "paper F",
+            "F ratio", "MiB"))
         for r in rows:
             if r["status"] != "ok":
                 log("%-12s %s" % (r["name"], r["status"] + ": " + r.get("reason",
                                                                          r.get("error", ""))))
                 continue
             p = r["paper"]
-            log("%-12s %9.2f %9s %9.1f %10s %10s %7.2f %8d" % (
+            floor = r.get("floor", {}).get("floor_seconds")
+            log("%-12s %9.2f %9s %9.1f %8s %8s %10s %10s %7.2f %8d" % (
                 r["name"], r["wall_seconds"], p.get("minutes"), r.get("paper_over_ours", 0),
+                "%.2f" % floor if floor else "-",
+                "%.1f" % r["over_floor"] if "over_floor" in r else "-",
                 r["output"].get("faces"), p.get("output_faces"),
                 r.get("output_faces_over_paper", 0), r["max_rss_kib"] // 1024))
     if "scaling" in result:

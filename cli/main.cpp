@@ -1,6 +1,4 @@
 // meshquilt: geometric texture synthesis by mesh quilting (Zhou et al. 2006).
-#include <malloc.h>
-
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -56,11 +54,6 @@ int main(int argc, char** argv) {
     std::puts("meshquilt 0.1.0");
     return 0;
   }
-  // Large buffers (face boxes, intersection grids, the output's arrays: tens to hundreds of MB)
-  // are allocated and freed many times per job. Above glibc's mmap threshold (at most 32 MB)
-  // each one is a fresh mapping, zeroed page by page on first touch: page faults were 17% of
-  // the armor job's time (perf). From the heap they are reused; the peak stays the same.
-  mallopt(M_MMAP_THRESHOLD, 1 << 30);
   mq::install_temporary_file_cleanup();  // no .NAME.tmp-* left behind on SIGINT or SIGTERM
   for (const Command& c : kCommands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
