@@ -74,6 +74,45 @@ def small_sphere(name="Sphere"):
     return obj
 
 
+class FakeLayout:
+    """Records what a panel draws (labels and operators), for draw() tested headless."""
+
+    def __init__(self, texts):
+        self.texts = texts
+
+    def label(self, text="", **kw):
+        self.texts.append(text)
+
+    def operator(self, idname, text=None, **kw):
+        self.texts.append("op:%s" % idname)
+
+    def prop(self, *args, **kw):
+        pass
+
+    def row(self, **kw):
+        return self
+
+    column = box = row
+
+
+def drawn_panel():
+    """The texts the meshquilt panel draws now; the engine must not run meanwhile."""
+    import subprocess
+    import meshquilt
+    texts = []
+    saved = subprocess.Popen, subprocess.run
+
+    def refuse(*args, **kw):
+        raise AssertionError("the panel ran a process while drawing")
+    subprocess.Popen = subprocess.run = refuse
+    try:
+        panel = type("P", (), {"layout": FakeLayout(texts)})()
+        meshquilt.MESHQUILT_PT_panel.draw(panel, bpy.context)
+    finally:
+        subprocess.Popen, subprocess.run = saved
+    return texts
+
+
 def face_ids(obj):
     ids = np.empty(len(obj.data.polygons), dtype=np.int32)
     obj.data.attributes["element_id"].data.foreach_get("value", ids)
@@ -346,9 +385,11 @@ def test_estimate_for_the_current_settings_is_stored_for_the_panel():
               s.estimate_faces, s.estimate_gib, s.estimate_seconds, s.estimate_fits))
     text = meshquilt.estimate_text(s)
     check(text.startswith("~") and "faces" in text and "GiB" in text, "text %r" % text)
+    check(text in drawn_panel(), "the panel does not show %r: %s" % (text, drawn_panel()))
     faces = s.estimate_faces
     s.scale = 0.2  # a setting changed: the panel no longer shows the old estimate
     check(s.estimate_key != meshquilt.estimate_key(bpy.context, s), "stale estimate kept")
+    check("Size: not estimated" in drawn_panel(), "stale estimate shown")
     bpy.ops.meshquilt.estimate()
     check(s.estimate_faces > 2 * faces, "scale 0.2: %d faces, 0.4: %d" % (s.estimate_faces,
                                                                            faces))
@@ -403,6 +444,12 @@ def test_structure_report_is_stored_on_the_result():
     distorted = list(obj["meshquilt_distorted_ids"])
     check(report["distorted"] == len(distorted) and all(0 <= i <= ids.max() for i in distorted),
           "distorted %d: %s" % (report["distorted"], distorted))
+    bpy.context.view_layer.objects.active = obj
+    texts = drawn_panel()
+    for text in ("Elements: %d" % report["elements"], "Coverage: %.0f%%" % report["coverage"],
+                 "Links kept: %.0f%%" % report["links_kept"],
+                 "Over 1.5x size: %d" % report["distorted"]):
+        check(text in texts, "the panel does not show %r: %s" % (text, texts))
 
 
 @test
