@@ -27,6 +27,7 @@ import tempfile
 
 import bpy
 import numpy as np
+from bpy_extras.io_utils import ImportHelper
 
 from . import engine, exchange, follow
 
@@ -37,14 +38,25 @@ def _mesh_poll(self, obj):
     return obj.type == "MESH"
 
 
+# The memory limit's default: half the machine's memory (Blender and the rest keep the other).
+_MACHINE_GIB = engine.machine_memory_gib()
+_DEFAULT_LIMIT_GIB = round(0.5 * _MACHINE_GIB, 1) if _MACHINE_GIB > 0 else 8.0
+
+
 class MeshquiltPreferences(bpy.types.AddonPreferences):
     bl_idname = __name__
     engine_path: bpy.props.StringProperty(
         name="Engine", subtype="FILE_PATH", default="",
         description="The meshquilt executable (empty: $MESHQUILT_ENGINE or meshquilt on PATH)")
+    max_memory: bpy.props.FloatProperty(
+        name="Memory limit (GiB)", default=_DEFAULT_LIMIT_GIB, min=0.01, soft_min=0.5,
+        precision=2,
+        description="Refuse a job the engine estimates to need more memory, before any work "
+        "(default: half of this machine's memory)")
 
     def draw(self, context):
         self.layout.prop(self, "engine_path")
+        self.layout.prop(self, "max_memory")
 
 
 class MeshquiltSettings(bpy.types.PropertyGroup):
@@ -78,6 +90,51 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Minimise distortion", default=True,
         description="Minimise the shell map's stretch (slower, less distorted elements)")
     seed: bpy.props.IntProperty(name="Seed", default=1, min=0)
+    # The engine's last estimate (meshquilt.estimate) and the settings it was made for.
+    estimate_key: bpy.props.StringProperty(options={"SKIP_SAVE"})
+    estimate_faces: bpy.props.IntProperty(name="Estimated faces", options={"SKIP_SAVE"})
+    estimate_gib: bpy.props.FloatProperty(name="Estimated memory (GiB)", options={"SKIP_SAVE"})
+    estimate_seconds: bpy.props.FloatProperty(name="Estimated time (s)", options={"SKIP_SAVE"})
+    estimate_fits: bpy.props.BoolProperty(name="Within the memory limit", options={"SKIP_SAVE"})
+    estimate_error: bpy.props.StringProperty(options={"SKIP_SAVE"})
+
+
+def estimate_key(context, settings):
+    """The settings an estimate depends on, as a string cheap enough for draw(): the base (its
+    mesh's size, modifiers and placement), the swatch, scale, seed, guidance and the limit."""
+    base = settings.base
+    if base is None or base.type != "MESH":
+        return ""
+    parts = [base.name, len(base.data.vertices), len(base.data.polygons),
+             [(m.name, m.show_viewport) for m in base.modifiers],
+             [round(x, 5) for row in base.matrix_world for x in row]]
+    if settings.swatch_source == "OBJECT":
+        sw = settings.swatch
+        parts += ["object", sw.name if sw else "", len(sw.data.polygons) if sw else 0]
+    else:
+        parts += ["sample", settings.sample]
+    parts += [round(settings.scale, 6), settings.seed, settings.stretch, settings.guidance]
+    if settings.guidance == "AXIS" and settings.guide_object is not None:
+        parts += [settings.guide_object.name, settings.guide_axis,
+                  [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
+                      "XYZ".index(settings.guide_axis)]]]
+    elif settings.guidance == "ATTRIBUTE":
+        parts.append(settings.guide_attribute)
+    parts.append(round(_preferences(context).max_memory, 3))
+    return repr(parts)
+
+
+def estimate_text(settings):
+    """The estimate in the panel: 'about 388k faces, 0.3 GiB, 2 s'."""
+    n = settings.estimate_faces
+    faces = "%.1fM" % (n / 1e6) if n >= 1e6 else "%dk" % round(n / 1e3) if n >= 1e4 else str(n)
+    t = settings.estimate_seconds
+    time_text = "%d s" % max(1, round(t)) if t < 90 else "%d min" % round(t / 60)
+    return "~%s faces, %.1f GiB, %s" % (faces, settings.estimate_gib, time_text)
+
+
+def _preferences(context):
+    return context.preferences.addons[__name__].preferences
 
 
 def _follow_changed(self, context):
@@ -117,8 +174,10 @@ class Run:
     modal operator (UI) and the blocking one (scripts) drive it through step()."""
 
     def __init__(self, context, settings):
-        prefs = context.preferences.addons[__name__].preferences
+        prefs = _preferences(context)
         self.engine = engine.find_engine(prefs.engine_path)
+        self.max_memory = prefs.max_memory
+        self.scale = settings.scale
         base = settings.base
         if base is None or base.type != "MESH":
             raise engine.EngineError("pick a base mesh object")
@@ -155,10 +214,21 @@ class Run:
             swatch_path = os.path.join(self.dir, "swatch_%s.ply" % settings.sample)
             self.jobs.append(lambda: engine.swatch_job(self.engine, settings.sample, swatch_path,
                                                        settings.seed))
+        self.preparation = len(self.jobs)  # the jobs before the surface job
+        self.paths = (base_path, swatch_path)
+        self.stats_path = os.path.join(self.dir, "stats.json")
+        self.elements_path = os.path.join(self.dir, "elements.csv")
+        self.options = dict(seed=settings.seed, stretch=settings.stretch, field=field,
+                            field_file=field_file, max_memory=self.max_memory)
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.result_path, settings.scale,
-            seed=settings.seed, stretch=settings.stretch, field=field, field_file=field_file,
-            save_quilt=self.quilt_path))
+            save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
+        # The structure measured against the swatch for the report (optional: a failure
+        # there leaves the result and the rest of the report).
+        self.jobs.append(lambda: engine.info_job(
+            self.engine, self.result_path, swatch_path, base_path, self.elements_path,
+            settings.scale))
+        self.optional_jobs = 1
         self.total = len(self.jobs)
         self.job = None
         self.state = "running"
@@ -211,8 +281,13 @@ class Run:
         if self.job is None:
             self.job = self.jobs.pop(0)()
         state = self.job.poll()
+        if state == "failed" and len(self.jobs) < self.optional_jobs:
+            state = "done"  # an optional job: the run goes on without what it adds
         if state == "failed":
             self.state, self.error = "failed", self.job.error
+            refused = engine.refusal_message(self.error, self.scale, self.max_memory)
+            if refused:
+                self.error = refused
         elif state == "cancelled":
             self.state = "cancelled"
         elif state == "done":
@@ -220,6 +295,17 @@ class Run:
             if not self.jobs:
                 self.state = "done"
         return self.state
+
+    def estimate(self):
+        """The engine's estimate for these settings (blocking: runs a sample swatch's job
+        first); the run's surface job is then not started. Returns engine.estimate's dict."""
+        for _ in range(self.preparation):
+            job = self.jobs.pop(0)()
+            if job.wait(60) != "done":
+                raise engine.EngineError(job.error)
+        self.preparation = 0
+        return engine.estimate(self.engine, self.paths[0], self.paths[1], self.result_path,
+                               self.scale, **self.options)
 
     def fraction(self):
         done = self.total - len(self.jobs) - (1 if self.job else 0)
@@ -251,11 +337,24 @@ class Run:
         if self.quilt_path and os.path.exists(self.quilt_path):
             follow.bind(obj, self.base, self.quilt_path, self.topology["T"],
                         self.topology["loops"], self.topology["totals"], self.base_matrix)
+        try:
+            store_report(obj, exchange.structure_report(self.stats_path, self.elements_path))
+        except (OSError, ValueError, KeyError) as e:
+            print("meshquilt: no structure report: %s" % e)
         self.result = obj
         return obj
 
     def cleanup(self):
         shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def store_report(obj, report):
+    """The structure report on the result object, as custom properties (meshquilt_report:
+    elements, links_kept %, coverage %, distorted; meshquilt_distorted_ids)."""
+    ids = report.pop("distorted_ids", None)
+    obj["meshquilt_report"] = report
+    if ids is not None:
+        obj["meshquilt_distorted_ids"] = ids
 
 
 def _engine_kind_name(name):
@@ -377,6 +476,109 @@ class MESHQUILT_OT_run(bpy.types.Operator):
         if run is None:
             return {"CANCELLED"}
         return self._finish(context, run)
+
+
+class MESHQUILT_OT_estimate(bpy.types.Operator):
+    """Ask the engine how large the job of the current settings is (faces, memory, rough
+    time) without running it; shown in the panel until a setting changes"""
+    bl_idname = "meshquilt.estimate"
+    bl_label = "Estimate"
+
+    @classmethod
+    def poll(cls, context):
+        return "run" not in _running
+
+    def execute(self, context):
+        s = context.scene.meshquilt
+        key = estimate_key(context, s)
+        run = None
+        try:
+            run = Run(context, s)
+            e = run.estimate()
+        except (engine.EngineError, OSError, ValueError) as e:
+            s.estimate_key, s.estimate_error = key, str(e)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        finally:
+            if run is not None:
+                run.cleanup()
+        s.estimate_key, s.estimate_error = key, ""
+        s.estimate_faces, s.estimate_gib = e["faces"], e["bytes"] / 2.0 ** 30
+        s.estimate_seconds, s.estimate_fits = e["seconds"], e["fits"]
+        self.report({"INFO"}, "meshquilt: " + estimate_text(s))
+        return {"FINISHED"}
+
+
+class MESHQUILT_OT_import(bpy.types.Operator, ImportHelper):
+    """Import a result of the meshquilt engine (a PLY it wrote): element ids and kinds as face
+    attributes, a material per kind"""
+    bl_idname = "import_mesh.meshquilt_ply"
+    bl_label = "Import meshquilt result"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".ply"
+    filter_glob: bpy.props.StringProperty(default="*.ply", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            result = exchange.read_ply(self.filepath)
+        except (OSError, ValueError, KeyError) as e:
+            self.report({"ERROR"}, "cannot read %s as a meshquilt result (a binary PLY the "
+                        "engine wrote): %s" % (os.path.basename(self.filepath), e))
+            return {"CANCELLED"}
+        name = os.path.splitext(os.path.basename(self.filepath))[0] or "meshquilt"
+        me = exchange.build_mesh(bpy, name, result, material_for)
+        obj = bpy.data.objects.new(name, me)
+        context.collection.objects.link(obj)
+        for other in context.selected_objects:
+            other.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        self.report({"INFO"}, "meshquilt: %s, %d elements, %d faces"
+                    % (obj.name, len(np.unique(result.face_element)), len(me.polygons)))
+        return {"FINISHED"}
+
+
+def _menu_import(self, context):
+    self.layout.operator(MESHQUILT_OT_import.bl_idname, text="meshquilt result (.ply)")
+
+
+class MESHQUILT_OT_select_distorted(bpy.types.Operator):
+    """Select the faces of the elements over 1.5x their swatch element's size (the run's
+    structure report)"""
+    bl_idname = "meshquilt.select_distorted"
+    bl_label = "Select distorted"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.type == "MESH" and "element_id" in obj.data.attributes \
+            and "meshquilt_distorted_ids" in obj
+
+    def execute(self, context):
+        obj = context.active_object
+        editing = obj.mode == "EDIT"
+        if editing:
+            bpy.ops.object.mode_set(mode="OBJECT")
+        try:
+            me = obj.data
+            ids = np.empty(len(me.polygons), dtype=np.int32)
+            me.attributes["element_id"].data.foreach_get("value", ids)
+            distorted = np.array(list(obj["meshquilt_distorted_ids"]), dtype=np.int32)
+            chosen = np.isin(ids, distorted)
+            me.vertices.foreach_set("select", np.zeros(len(me.vertices), dtype=bool))
+            me.edges.foreach_set("select", np.zeros(len(me.edges), dtype=bool))
+            me.polygons.foreach_set("select", chosen)
+        finally:
+            if editing:
+                bpy.ops.object.mode_set(mode="EDIT")
+        if not chosen.any():
+            self.report({"INFO"}, "no element over 1.5x its swatch size")
+        else:
+            self.report({"INFO"}, "%d distorted elements: %d faces selected"
+                        % (len(np.unique(ids[chosen])), int(chosen.sum())))
+        return {"FINISHED"}
 
 
 class MESHQUILT_OT_cancel(bpy.types.Operator):
@@ -517,11 +719,64 @@ class MESHQUILT_OT_remove_selected(bpy.types.Operator):
                 obj.meshquilt.status = str(e)
                 self.report({"ERROR"}, str(e))
                 return {"CANCELLED"}
+            _report_after_removal(obj, chosen)
         finally:
             if editing:
                 bpy.ops.object.mode_set(mode="EDIT")
         self.report({"INFO"}, "meshquilt: %d elements removed from %s" % (len(chosen), obj.name))
         return {"FINISHED"}
+
+
+def _report_after_removal(obj, removed):
+    """The structure report after removing elements: the ids after them move down (the engine
+    numbers the rest again in order); the removed are no longer counted."""
+    if "meshquilt_report" not in obj:
+        return
+    report = obj["meshquilt_report"]
+    if "elements" in report:
+        report["elements"] = max(0, int(report["elements"]) - len(removed))
+    if "meshquilt_distorted_ids" in obj:
+        old = np.array(list(obj["meshquilt_distorted_ids"]), dtype=np.int64)
+        kept = old[~np.isin(old, removed)]
+        new = kept - np.searchsorted(np.sort(removed), kept)
+        obj["meshquilt_distorted_ids"] = [int(i) for i in new]
+        report["distorted"] = len(new)
+
+
+def _draw_estimate(layout, context, s):
+    """The estimate for the current settings (stored by meshquilt.estimate; draw() runs no
+    engine): shown while the settings are those it was made for."""
+    current = s.estimate_key and s.estimate_key == estimate_key(context, s)
+    row = layout.row(align=True)
+    if current and s.estimate_error:
+        row.label(text="Estimate failed", icon="ERROR")
+    elif current:
+        row.label(text=estimate_text(s), icon="INFO" if s.estimate_fits else "ERROR")
+    else:
+        row.label(text="Size: not estimated")
+    row.operator("meshquilt.estimate", text="", icon="FILE_REFRESH")
+    if current and not s.estimate_error and not s.estimate_fits:
+        layout.label(text="Over the memory limit: raise Scale")
+
+
+def _draw_report(layout, obj):
+    """The run's structure report stored on the result."""
+    report = obj.get("meshquilt_report")
+    if report is None:
+        return
+    box = layout.box()
+    box.label(text="Structure")
+    col = box.column(align=True)
+    if "elements" in report:
+        col.label(text="Elements: %d" % report["elements"])
+    if "links_kept" in report:
+        col.label(text="Links kept: %.0f%%" % report["links_kept"])
+    if "coverage" in report:
+        col.label(text="Coverage: %.0f%%" % report["coverage"])
+    if "distorted" in report:
+        col.label(text="Over 1.5x size: %d" % report["distorted"])
+        if report["distorted"]:
+            box.operator("meshquilt.select_distorted", icon="RESTRICT_SELECT_OFF")
 
 
 class MESHQUILT_PT_panel(bpy.types.Panel):
@@ -547,6 +802,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             layout.prop(s, "guide_attribute")
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
+        _draw_estimate(layout, context, s)
         if "run" in _running:
             run = _running["run"]
             layout.label(text=run.status_text())
@@ -556,6 +812,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         obj = context.active_object
         if obj is not None and obj.type == "MESH" and "element_id" in obj.data.attributes:
             layout.operator("meshquilt.select_element")
+            _draw_report(layout, obj)
             b = obj.meshquilt
             box = layout.box()
             if not b.quilt:
@@ -575,6 +832,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
 
 
 classes = (MeshquiltPreferences, MeshquiltSettings, MeshquiltBinding, MESHQUILT_OT_run,
+           MESHQUILT_OT_estimate, MESHQUILT_OT_import, MESHQUILT_OT_select_distorted,
            MESHQUILT_OT_cancel, MESHQUILT_OT_select_element, MESHQUILT_OT_bake,
            MESHQUILT_OT_clear_bake, MESHQUILT_OT_remove_selected, MESHQUILT_PT_panel)
 
@@ -584,6 +842,7 @@ def register():
         bpy.utils.register_class(c)
     bpy.types.Scene.meshquilt = bpy.props.PointerProperty(type=MeshquiltSettings)
     bpy.types.Object.meshquilt = bpy.props.PointerProperty(type=MeshquiltBinding)
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
     follow.register()
 
 
@@ -592,6 +851,7 @@ def unregister():
     if run is not None:
         run.cancel()
     follow.unregister()
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
     del bpy.types.Object.meshquilt
     del bpy.types.Scene.meshquilt
     for c in reversed(classes):

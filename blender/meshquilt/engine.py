@@ -175,23 +175,100 @@ def swatch_job(engine, kind, output, seed=1):
                progress=False)
 
 
-def surface_job(engine, base, swatch, output, scale, seed=1, stretch=True, field=None,
-                field_file=None, threads=0, save_quilt=None):
-    """Quilts the swatch over the base; `field` is an (x, y, z) direction, `field_file` a file
-    of one vector per base vertex (at most one of them); `save_quilt` also saves the result
-    over the base (.mqq) for embed_job."""
+def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
+                 field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None):
+    """The arguments of a surface job (surface_job; estimate with the same settings)."""
     args = ["surface", "--base", base, "--swatch", swatch, "-o", output,
             "--scale", repr(float(scale)), "--seed", str(int(seed)),
             "--threads", str(int(threads))]
     if save_quilt:
         args += ["--save-quilt", save_quilt]
+    if max_memory:
+        args += ["--max-memory", "%.6g" % max_memory]  # a float32 property: 0.01 stays 0.01
+    if stats:
+        args += ["--stats", stats]
     if not stretch:
         args.append("--no-stretch-opt")
     if field is not None:
         args += ["--field"] + [repr(float(c)) for c in field]
     if field_file:
         args += ["--field-file", field_file]
-    return Job(engine, args)
+    return args
+
+
+def surface_job(engine, base, swatch, output, scale, **options):
+    """Quilts the swatch over the base; options (surface_args): `field` an (x, y, z) direction
+    or `field_file` a file of one vector per base vertex (at most one of them); `save_quilt`
+    also saves the result over the base (.mqq) for embed_job; `max_memory` (GiB) refuses a
+    larger job before any work; `stats` writes the run's figures as JSON."""
+    return Job(engine, surface_args(base, swatch, output, scale, **options))
+
+
+def estimate(engine, base, swatch, output, scale, timeout=60, **options):
+    """The engine's estimate of a surface job (--estimate: nothing is written, well under a
+    second): {"faces", "bytes", "seconds", "fits"}. Blocks: for an operator, never draw()."""
+    args = [engine] + surface_args(base, swatch, output, scale, **options) + \
+        ["--estimate"]
+    try:
+        done = subprocess.run(args, stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                              errors="replace", timeout=timeout)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        raise EngineError("cannot estimate the job: %s" % e)
+    for line in done.stdout.splitlines():
+        w = line.split()
+        if len(w) == 9 and w[0] == "estimate":
+            return {"faces": int(float(w[2])), "bytes": float(w[4]), "seconds": float(w[6]),
+                    "fits": w[8] == "1"}
+    lines = [l for l in done.stderr.splitlines() if l.strip()]
+    raise EngineError(lines[-1] if lines else "meshquilt gave no estimate (exit %d)"
+                      % done.returncode)
+
+
+def machine_memory_gib():
+    """The machine's memory in GiB (0 when it cannot be read)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2.0 ** 30
+    except (ValueError, OSError, AttributeError):
+        pass
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemTotal:"):
+                    return int(line.split()[1]) / 2.0 ** 20
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0.0
+
+
+def refusal_message(error, scale, limit_gib):
+    """The artist's words for the engine refusing a job over --max-memory or --max-faces (None
+    for any other error): what the job would need and what to change in Blender."""
+    if ("--max-memory" not in error and "--max-faces" not in error) or \
+            "limit of" not in error:
+        return None  # not a refusal (e.g. a value out of range)
+    import re
+    faces = re.search(r"about ([0-9.e+]+) faces", error)
+    need = ""
+    if faces:
+        n = float(faces.group(1))
+        # The engine's own rule: about 400 bytes a face.
+        need = " would make about %s faces (about %.2g GiB)" % (format(int(n), ","),
+                                                              n * 400 / 2.0 ** 30)
+    else:
+        need = " is too large"
+    return ("meshquilt: at Scale %g the texture%s, over the memory limit of %.3g GiB: raise "
+            "Scale in the panel (fewer, larger elements), or raise Memory limit in Edit > "
+            "Preferences > Add-ons > meshquilt" % (scale, need, limit_gib))
+
+
+def info_job(engine, result, swatch, base, elements_csv, scale):
+    """Measures a result's structure against its swatch (meshquilt info --links): one CSV line
+    per element (its id, size ratio against its swatch element, ...)."""
+    job = Job(engine, ["info", result, "--links", "--swatch", swatch, "--base", base,
+                       "--scale", repr(float(scale)), "--elements", elements_csv],
+              progress=False)
+    job.stage = "measuring"
+    return job
 
 
 def embed_job(engine, quilt, base, output, frames=None, threads=0):

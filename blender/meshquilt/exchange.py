@@ -152,6 +152,52 @@ def build_mesh(bpy, name, result, material_for):
     ids.data.foreach_set("value", result.face_element.astype(np.int32))
     kinds = me.attributes.new("kind", "INT", "FACE")
     kinds.data.foreach_set("value", result.face_kind.astype(np.int32))
-    me.use_auto_smooth = True
-    me.auto_smooth_angle = math.radians(60)
+    # Mesh.use_auto_smooth and auto_smooth_angle were removed in Blender 4.1 (sharp edges by
+    # angle became the "Smooth by Angle" modifier); checked with bpy.app.version, so 3.4 to
+    # 4.0 keep the 60 degrees and 4.1 and later only lose that setting.
+    if bpy.app.version < (4, 1, 0):
+        me.use_auto_smooth = True
+        me.auto_smooth_angle = math.radians(60)
     return me
+
+
+DISTORTED_SIZE_RATIO = 1.5  # an element over 1.5x its swatch element's size is "distorted"
+
+
+def read_elements_csv(path):
+    """meshquilt info --elements: each element's id and size ratio against its swatch element
+    (0 where not measured)."""
+    import csv
+    ids, ratios = [], []
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            ids.append(int(row["element"]))
+            ratios.append(float(row.get("size_ratio") or 0.0))
+    return np.array(ids, dtype=np.int32), np.array(ratios, dtype=np.float64)
+
+
+def structure_report(stats_path=None, elements_csv=None):
+    """A result's structure for the artist, from surface --stats JSON and info --elements CSV
+    (either may be missing): elements, links_kept (% of interior rings with their swatch kind's
+    links; rings only), coverage (%), distorted (count) and distorted_ids."""
+    import json
+    import os
+    report = {}
+    if stats_path and os.path.exists(stats_path):
+        with open(stats_path) as f:
+            stats = json.load(f)
+        structure = stats.get("structure") or {}
+        elements = structure.get("elements", (stats.get("output") or {}).get("elements"))
+        if elements is not None:
+            report["elements"] = int(elements)
+        if structure.get("share_with_swatch_links") is not None:
+            report["links_kept"] = 100.0 * float(structure["share_with_swatch_links"])
+        if stats.get("coverage") is not None:
+            report["coverage"] = 100.0 * float(stats["coverage"])
+    if elements_csv and os.path.exists(elements_csv):
+        ids, ratios = read_elements_csv(elements_csv)
+        report.setdefault("elements", len(ids))
+        distorted = ids[ratios > DISTORTED_SIZE_RATIO]
+        report["distorted"] = len(distorted)
+        report["distorted_ids"] = [int(i) for i in distorted]
+    return report

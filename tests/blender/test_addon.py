@@ -9,7 +9,10 @@ Cancel (the engine stops, no object, no files left); an engine error reported; t
 and .glb outputs through Blender's own importers with per-element data intact; selecting an
 element by id; the result following its twisted base frame by frame (exactly the quilted result
 at rest), stopping with the engine's message when the base's connectivity changes, baked into
-shape keys that play without the engine, and elements removed from the saved quilt.
+shape keys that play without the engine, and elements removed from the saved quilt; a
+command-line result through File > Import; the engine's estimate for the panel; the memory
+limit refusing a job in the artist's words; the structure report on a result and selecting its
+distorted elements.
 """
 
 import glob
@@ -63,6 +66,53 @@ def sphere(name="Sphere", radius=1.0):
     return obj
 
 
+def small_sphere(name="Sphere"):
+    """A UV sphere of 16 x 8 segments: the engine quilts it in a few seconds at a large scale."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=16, ring_count=8)
+    obj = bpy.context.active_object
+    obj.name = name
+    return obj
+
+
+class FakeLayout:
+    """Records what a panel draws (labels and operators), for draw() tested headless."""
+
+    def __init__(self, texts):
+        self.texts = texts
+
+    def label(self, text="", **kw):
+        self.texts.append(text)
+
+    def operator(self, idname, text=None, **kw):
+        self.texts.append("op:%s" % idname)
+
+    def prop(self, *args, **kw):
+        pass
+
+    def row(self, **kw):
+        return self
+
+    column = box = row
+
+
+def drawn_panel():
+    """The texts the meshquilt panel draws now; the engine must not run meanwhile."""
+    import subprocess
+    import meshquilt
+    texts = []
+    saved = subprocess.Popen, subprocess.run
+
+    def refuse(*args, **kw):
+        raise AssertionError("the panel ran a process while drawing")
+    subprocess.Popen = subprocess.run = refuse
+    try:
+        panel = type("P", (), {"layout": FakeLayout(texts)})()
+        meshquilt.MESHQUILT_PT_panel.draw(panel, bpy.context)
+    finally:
+        subprocess.Popen, subprocess.run = saved
+    return texts
+
+
 def face_ids(obj):
     ids = np.empty(len(obj.data.polygons), dtype=np.int32)
     obj.data.attributes["element_id"].data.foreach_get("value", ids)
@@ -75,8 +125,15 @@ def test_installs_and_registers():
     enable_addon()
     check("meshquilt" in bpy.context.preferences.addons, "add-on not enabled")
     check(hasattr(bpy.types.Scene, "meshquilt"), "scene settings not registered")
-    for op in ("run", "cancel", "select_element", "bake", "clear_bake", "remove_selected"):
+    for op in ("run", "cancel", "select_element", "bake", "clear_bake", "remove_selected",
+               "estimate", "select_distorted"):
         check(hasattr(bpy.ops.meshquilt, op), "operator meshquilt.%s missing" % op)
+    check(hasattr(bpy.ops.import_mesh, "meshquilt_ply"), "import operator missing")
+    import meshquilt
+    check(meshquilt._menu_import in bpy.types.TOPBAR_MT_file_import._dyn_ui_initialize(),
+          "not in File > Import")
+    prefs = bpy.context.preferences.addons["meshquilt"].preferences
+    check(prefs.max_memory > 0.1, "memory limit %g GiB" % prefs.max_memory)
     check(hasattr(bpy.types, "MESHQUILT_PT_panel"), "panel not registered")
     s = bpy.context.scene.meshquilt
     check(s.stretch is True, "distortion minimisation must be on by default")
@@ -272,6 +329,153 @@ def test_a_killed_or_crashed_engine_is_reported_in_words():
         check(job.wait(30) == "failed", "state %s" % job.state)
         check(words in job.error, "message: %r" % job.error)
     check("memory" in engine.killed_message(9), engine.killed_message(9))
+
+
+@test
+def test_import_a_command_line_result_with_element_ids_and_materials():
+    """File > Import > meshquilt result (.ply): a result the engine wrote on the command line
+    comes in with its element ids and a material per kind (issue 26)."""
+    import subprocess
+    scene = new_scene()
+    from meshquilt import exchange
+    base_obj = small_sphere()
+    V, T, _ = exchange.mesh_arrays(base_obj.data)
+    base = os.path.join(WORK, "import_base.ply")
+    exchange.write_ply(base, V, T)
+    sw, out = os.path.join(WORK, "import_weave.ply"), os.path.join(WORK, "cli result.ply")
+    subprocess.run([ENGINE, "swatch", "weave", "-o", sw, "--quiet"], check=True)
+    subprocess.run([ENGINE, "surface", "--base", base, "--swatch", sw, "--scale", "0.7",
+                    "--no-stretch-opt", "-o", out, "--quiet"], check=True, timeout=120)
+    header = open(out, "rb").read(4096).split(b"end_header")[0].decode("ascii", "replace")
+    elements = int(header.split("comment meshquilt: ")[1].split()[0])
+    before = set(bpy.data.objects)
+    check(bpy.ops.import_mesh.meshquilt_ply(filepath=out) == {"FINISHED"}, "import failed")
+    added = [o for o in bpy.data.objects if o not in before]
+    check(len(added) == 1 and added[0].name == "cli result", "added %s" % added)
+    obj = added[0]
+    check(bpy.context.active_object == obj, "the import is not the active object")
+    check(obj.data.attributes["element_id"].domain == "FACE", "no element_id face attribute")
+    ids = face_ids(obj)
+    check(len(np.unique(ids)) == elements and ids.max() == elements - 1,
+          "%d ids for %d elements" % (len(np.unique(ids)), elements))
+    check(sorted(m.name for m in obj.data.materials) == ["thread_x", "thread_y"],
+          "materials %s" % [m.name for m in obj.data.materials])
+    check(obj.data.validate() is False, "Blender had to repair the mesh")
+    # Not a PLY: an error in words, no object.
+    bad = os.path.join(WORK, "not_a_result.ply")
+    open(bad, "w").write("hello\n")
+    try:
+        bpy.ops.import_mesh.meshquilt_ply(filepath=bad)
+        check(False, "a bad file was not reported")
+    except RuntimeError as e:
+        check("cannot read not_a_result.ply" in str(e), "reported: %s" % e)
+
+
+@test
+def test_estimate_for_the_current_settings_is_stored_for_the_panel():
+    scene = new_scene()
+    import meshquilt
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.4
+    check(s.estimate_key != meshquilt.estimate_key(bpy.context, s), "an estimate before asking")
+    check(bpy.ops.meshquilt.estimate() == {"FINISHED"}, "estimate failed")
+    check(s.estimate_key == meshquilt.estimate_key(bpy.context, s), "estimate not current")
+    check(1e4 < s.estimate_faces < 1e7 and s.estimate_gib > 0 and s.estimate_seconds > 0
+          and s.estimate_fits, "estimate %d faces %g GiB %g s fits %s" % (
+              s.estimate_faces, s.estimate_gib, s.estimate_seconds, s.estimate_fits))
+    text = meshquilt.estimate_text(s)
+    check(text.startswith("~") and "faces" in text and "GiB" in text, "text %r" % text)
+    check(text in drawn_panel(), "the panel does not show %r: %s" % (text, drawn_panel()))
+    faces = s.estimate_faces
+    s.scale = 0.2  # a setting changed: the panel no longer shows the old estimate
+    check(s.estimate_key != meshquilt.estimate_key(bpy.context, s), "stale estimate kept")
+    check("Size: not estimated" in drawn_panel(), "stale estimate shown")
+    bpy.ops.meshquilt.estimate()
+    check(s.estimate_faces > 2 * faces, "scale 0.2: %d faces, 0.4: %d" % (s.estimate_faces,
+                                                                           faces))
+    check(not [o for o in bpy.data.objects if o.name.endswith("_quilt")], "estimate added")
+
+
+@test
+def test_memory_limit_refuses_the_job_in_the_artists_words():
+    scene = new_scene()
+    import meshquilt
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.4
+    prefs = bpy.context.preferences.addons["meshquilt"].preferences
+    prefs.max_memory = 0.01  # the engine's smallest: about 27,000 faces
+    try:
+        bpy.ops.meshquilt.estimate()
+        check(not s.estimate_fits, "the estimate fits a limit of 10 MiB")
+        before = set(bpy.data.objects)
+        start = time.monotonic()
+        try:
+            bpy.ops.meshquilt.run()
+            check(False, "a job over the limit was not refused")
+        except RuntimeError as e:
+            message = str(e)
+        check("memory limit of" in message and "raise Scale" in message and
+              "Memory limit" in message and "--max" not in message, "reported: %s" % message)
+        check(time.monotonic() - start < 15, "refused after %.1f s" % (time.monotonic() - start))
+        check(set(bpy.data.objects) == before, "a refused run added an object")
+    finally:
+        enable_addon()
+        prefs.max_memory = meshquilt._DEFAULT_LIMIT_GIB
+
+
+def quilted_small_sphere():
+    scene = new_scene()
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.5
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    return scene, bpy.data.objects["Sphere_quilt"]
+
+
+@test
+def test_structure_report_is_stored_on_the_result():
+    scene, obj = quilted_small_sphere()
+    report = obj.get("meshquilt_report")
+    check(report is not None, "no report on the result")
+    ids = face_ids(obj)
+    check(report["elements"] == len(np.unique(ids)), "%d elements for %d ids"
+          % (report["elements"], len(np.unique(ids))))
+    check(50 <= report["links_kept"] <= 100, "links kept %g%%" % report["links_kept"])
+    check(90 <= report["coverage"] <= 100, "coverage %g%%" % report["coverage"])
+    distorted = list(obj["meshquilt_distorted_ids"])
+    check(report["distorted"] == len(distorted) and all(0 <= i <= ids.max() for i in distorted),
+          "distorted %d: %s" % (report["distorted"], distorted))
+    bpy.context.view_layer.objects.active = obj
+    texts = drawn_panel()
+    for text in ("Elements: %d" % report["elements"], "Coverage: %.0f%%" % report["coverage"],
+                 "Links kept: %.0f%%" % report["links_kept"],
+                 "Over 1.5x size: %d" % report["distorted"]):
+        check(text in texts, "the panel does not show %r: %s" % (text, texts))
+
+
+@test
+def test_select_distorted_selects_their_faces_and_follows_removals():
+    scene, obj = quilted_small_sphere()
+    import meshquilt
+    ids = face_ids(obj)
+    if not obj["meshquilt_distorted_ids"]:
+        # This sphere quilts without distortion; the ids as a run over a bent base stores them.
+        obj["meshquilt_distorted_ids"] = [2, 5, 9]
+        obj["meshquilt_report"]["distorted"] = 3
+    distorted = list(obj["meshquilt_distorted_ids"])
+    bpy.context.view_layer.objects.active = obj
+    check(bpy.ops.meshquilt.select_distorted() == {"FINISHED"}, "select failed")
+    sel = np.empty(len(obj.data.polygons), dtype=bool)
+    obj.data.polygons.foreach_get("select", sel)
+    check(np.array_equal(sel, np.isin(ids, distorted)), "selection is not the distorted elements")
+    # Removing elements numbers the rest again: the stored ids move with them.
+    obj["meshquilt_distorted_ids"] = [2, 5, 9]
+    elements = obj["meshquilt_report"]["elements"]
+    meshquilt._report_after_removal(obj, np.array([2, 3]))
+    check(list(obj["meshquilt_distorted_ids"]) == [3, 7], "ids %s"
+          % list(obj["meshquilt_distorted_ids"]))
+    check(obj["meshquilt_report"]["distorted"] == 2 and
+          obj["meshquilt_report"]["elements"] == elements - 2, "report %s"
+          % obj["meshquilt_report"].to_dict())
 
 
 def engine_output(name):
