@@ -354,8 +354,10 @@ int run_surface(int argc, char** argv, int first) {
       quilt_surface_vines(base, swatch, counting, {}, &estimate);
     else
       prepare_surface_job(base, swatch, counting, estimate);
+    // Under a mask only the masked part is kept (whole elements, about as many as its area).
     const double faces =
-        global && layout.layout_faces > 0 ? layout.layout_faces : estimate.estimated_faces;
+        (global && layout.layout_faces > 0 ? layout.layout_faces : estimate.estimated_faces) *
+        (cl.has("mask") ? masked_area_share(mask, base) : 1.0);
     const double bytes = faces * kBytesPerOutputFace + kBaseBytes;
     const double limit = memory_limit(cl);
     const bool fits = faces <= options.max_faces && (!(limit > 0) || bytes <= limit);

@@ -7,6 +7,7 @@
 
 #include "core/common/errors.h"
 #include "core/mesh/closest_point_query.h"
+#include "core/mesh/geometry_measures.h"
 #include "core/mesh/input_file.h"
 
 namespace mq {
@@ -82,6 +83,18 @@ SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
 
 SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base) {
   return parse_surface_mask(read_input_file(path, "mask file", std::size_t{1} << 30), path, base);
+}
+
+double masked_area_share(const SurfaceMask& mask, const TriMesh& base) {
+  const Eigen::VectorXd area = face_areas(base.V, base.F);
+  const Vector3d samples[4] = {Vector3d::Constant(1.0 / 3), Vector3d(2.0 / 3, 1.0 / 6, 1.0 / 6),
+                               Vector3d(1.0 / 6, 2.0 / 3, 1.0 / 6),
+                               Vector3d(1.0 / 6, 1.0 / 6, 2.0 / 3)};
+  double in = 0;
+  for (int f = 0; f < base.num_faces(); ++f)
+    for (const Vector3d& b : samples) in += 0.25 * area(f) * (mask.contains(base, f, b) ? 1 : 0);
+  const double total = area.sum();
+  return total > 0 ? std::clamp(in / total, 0.0, 1.0) : 0.0;
 }
 
 std::vector<char> mask_quilt_faces(const SurfaceMask& mask, const TriMesh& base,

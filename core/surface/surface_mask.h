@@ -37,6 +37,11 @@ SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base);
 std::vector<char> mask_quilt_faces(const SurfaceMask& mask, const TriMesh& base,
                                    const SurfaceQuilt& quilt);
 
+// The share of the base's area (the base as given) in the mask, sampled at four points of each
+// face (its centroid and the middles of its corners' thirds): what the job's face estimate is
+// multiplied by when a mask is given (issue 25: the estimate ignored the mask). In [0, 1].
+double masked_area_share(const SurfaceMask& mask, const TriMesh& base);
+
 // Drops the elements most of whose vertices lie above faces of quilt.base not in `faces`
 // (#F(quilt.base)): whole elements go and none is cut, so the border has no clipped ones, and
 // what is kept reaches at most about one element past the mask. Returns how many were dropped.

@@ -63,6 +63,12 @@ TEST(CliMask, MaskedRunAndBadMaskFiles) {
   ASSERT_EQ(m.status, 0) << m.err;
   const TriMesh out = read_mesh(dir + "/m.obj");
   ASSERT_GT(out.num_faces(), 0);
+  // The estimate counts the masked part only: within 15% of the faces written (it was the
+  // whole base's, 2x).
+  const CliRun e = meshquilt(dir, job + " --mask half.txt -o e.obj --estimate");
+  ASSERT_EQ(e.status, 0) << e.err;
+  const double estimated = std::stod(e.out.substr(e.out.find("faces ") + 6));
+  EXPECT_NEAR(estimated / out.num_faces(), 1.0, 0.15) << e.out << out.num_faces();
   // Within about one ring (0.07 of the diagonal, a third of it a ring) of x = 5.
   EXPECT_LE(out.V.col(0).maxCoeff(), 5 + 0.5);
   EXPECT_GE(std::stod(json_value(slurp(dir + "/m.json"), "coverage")), 0.9);
