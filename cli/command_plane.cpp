@@ -18,9 +18,10 @@ namespace mq::cli {
 
 namespace {
 
-void write_stats(const std::string& path, const PlanarQuiltingStats& s, const std::string& device,
-                 int threads, double wall, const std::string& swatch, double length, double width,
-                 const StructureSummary& structure) {
+// The --stats file's JSON (written with the mesh, as one commit).
+std::string stats_json(const PlanarQuiltingStats& s, const std::string& device, int threads,
+                       double wall, const std::string& swatch, double length, double width,
+                       const StructureSummary& structure) {
   JsonWriter j;
   j.begin_object()
       .value("command", "plane")
@@ -48,7 +49,7 @@ void write_stats(const std::string& path, const PlanarQuiltingStats& s, const st
   j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
-  write_file_atomically(path, j.str());
+  return j.str();
 }
 
 void declare_plane_options(CommandLine& cl) {
@@ -127,23 +128,38 @@ int run_plane(int argc, char** argv, int first) {
   MQ_CHECK(result.num_faces() > 0, InvalidInput,
            "the layer is empty: no element of the swatch fits the ", options.length, " x ",
            options.width, " domain; nothing written");
+  // The structure figures for --stats, not part of the run's wall time; the stats then land
+  // with the mesh as one commit (issue 28), made once it is written out.
+  StructureSummary structure;
+  double measuring = 0;
+  if (!run.stats_path().empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ScopedStageTimer timer(stats.times, "structure");
+    structure = summarize_structure(result, swatch, nullptr, 1.0);
+    measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  double wall = 0;
   {
-    ScopedStageTimer timer(stats.times, "write");
     ScopedStageProgress shown(run.progress(), "writing");
-    write_output(out_path, result, write_options);
+    const auto write_start = std::chrono::steady_clock::now();
+    const auto finish_timing = [&] {
+      const auto now = std::chrono::steady_clock::now();
+      stats.times.add("write", std::chrono::duration<double>(now - write_start).count());
+      wall = std::chrono::duration<double>(now - start).count() - measuring;
+    };
+    WriteOptions with_stats = write_options;
+    if (!run.stats_path().empty()) {
+      with_stats.companion_path = run.stats_path();
+      with_stats.companion_bytes = [&] {
+        finish_timing();
+        return stats_json(stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
+                          options.length, options.width, structure);
+      };
+    }
+    write_output(out_path, result, with_stats);
+    if (run.stats_path().empty()) finish_timing();
   }
   run.progress()->finish();
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  StructureSummary structure;
-  if (!run.stats_path().empty()) {
-    {
-      ScopedStageTimer timer(stats.times, "structure");
-      structure = summarize_structure(result, swatch, nullptr, 1.0);
-    }
-    write_stats(run.stats_path(), stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
-                options.length, options.width, structure);
-  }
   if (!run.quiet()) {
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
     if (!run.stats_path().empty())

@@ -33,12 +33,13 @@ namespace mq::cli {
 
 namespace {
 
-void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
-                 const QuiltEmbeddingStats& em, const std::string& embedding,
-                 const std::string& device, int threads, double wall, const std::string& base,
-                 const std::string& swatch, const std::string& method,
-                 const GlobalQuiltingStats* global, const StructureSummary& structure,
-                 double memory_limit_bytes, double min_coverage, double swatch_cover) {
+// The --stats file's JSON (written with the mesh, as one commit).
+std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats& em,
+                       const std::string& embedding, const std::string& device, int threads,
+                       double wall, const std::string& base, const std::string& swatch,
+                       const std::string& method, const GlobalQuiltingStats* global,
+                       const StructureSummary& structure, double memory_limit_bytes,
+                       double min_coverage, double swatch_cover) {
   // The global layout counts its output exactly before building it; else the estimate made
   // before any work.
   const double estimated_faces =
@@ -170,7 +171,7 @@ void write_stats(const std::string& path, const SurfaceQuiltingStats& s,
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   for (const auto& [stage, seconds] : em.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
-  write_file_atomically(path, j.str());
+  return j.str();
 }
 
 }  // namespace
@@ -409,31 +410,46 @@ int run_surface(int argc, char** argv, int first) {
                     cl.get("seed");
     saved = make_saved_quilt(quilt, result, header);
   }
+  // The structure figures (issue 13) are measured for --stats: a second or so on a million
+  // faces, not worth it on every run; not part of the run's wall time.
+  StructureSummary structure;
+  double measuring = 0;
+  if (!run.stats_path().empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ScopedStageTimer timer(stats.times, "structure");
+    structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
+    measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  // The mesh and the --stats file are one commit (issue 28): the stats, made once the mesh is
+  // written out (they hold its writing time), land with it or not at all.
+  double wall = 0;
   {
-    ScopedStageTimer timer(stats.times, "write");
     ScopedStageProgress shown(run.progress(), "writing");
-    write_output(out_path, result, write_options);
+    const auto write_start = std::chrono::steady_clock::now();
+    const auto finish_timing = [&] {
+      const auto now = std::chrono::steady_clock::now();
+      stats.times.add("write", std::chrono::duration<double>(now - write_start).count());
+      wall = std::chrono::duration<double>(now - start).count() - measuring;
+    };
     if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
+    WriteOptions with_stats = write_options;
+    if (!run.stats_path().empty()) {
+      with_stats.companion_path = run.stats_path();
+      with_stats.companion_bytes = [&] {
+        finish_timing();
+        return stats_json(stats, embedding_stats, embedding_name, evaluator->name(), run.threads(),
+                          wall, cl.get("base"), cl.get("swatch"),
+                          global  ? "global"
+                          : vines ? "vines"
+                                  : "patches",
+                          global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
+                          own_coverage);
+      };
+    }
+    write_output(out_path, result, with_stats);
+    if (run.stats_path().empty()) finish_timing();
   }
   run.progress()->finish();
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The structure figures (issue 13) are measured for --stats: a second or so on a million
-  // faces, not worth it on every run.
-  StructureSummary structure;
-  if (!run.stats_path().empty()) {
-    {
-      ScopedStageTimer timer(stats.times, "structure");
-      structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
-    }
-    write_stats(run.stats_path(), stats, embedding_stats, embedding_name, evaluator->name(),
-                run.threads(), wall, cl.get("base"), cl.get("swatch"),
-                global  ? "global"
-                : vines ? "vines"
-                        : "patches",
-                global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
-                own_coverage);
-  }
   if (!run.quiet()) {
     std::printf(
         "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "

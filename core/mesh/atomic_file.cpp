@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 
 #include "core/common/errors.h"
 #include "core/common/fnv1a.h"
@@ -158,12 +159,16 @@ void AtomicOutputFile::finish() {
 }
 
 void commit_together(AtomicOutputFile& first, AtomicOutputFile& second) {
+  commit_together({&first, &second});
+}
+
+void commit_together(const std::vector<AtomicOutputFile*>& files) {
   namespace fs = std::filesystem;
-  first.finish();
-  second.finish();
-  const fs::path dir = fs::path(second.path_).has_parent_path()
-                           ? fs::path(second.path_).parent_path()
-                           : fs::path(".");
+  if (files.empty()) return;
+  for (AtomicOutputFile* f : files) f->finish();
+  const std::string& last_path = files.back()->path_;
+  const fs::path dir =
+      fs::path(last_path).has_parent_path() ? fs::path(last_path).parent_path() : fs::path(".");
   // flock on the directory itself: no lock file to leave behind; released by close().
   const int lock = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (lock >= 0) ::flock(lock, LOCK_EX);
@@ -173,30 +178,58 @@ void commit_together(AtomicOutputFile& first, AtomicOutputFile& second) {
       if (fd >= 0) ::close(fd);
     }
   } unlock{lock};
-  // A hard link keeps first's old file while first's new one takes its name.
-  const std::string kept = first.temp_ + "-old";
-  const bool had_old = ::link(first.path_.c_str(), kept.c_str()) == 0;
-  if (std::rename(first.temp_.c_str(), first.path_.c_str()) != 0) {
-    const int err = errno;
-    if (had_old) ::unlink(kept.c_str());
-    MQ_THROW(Error, first.path_, ": cannot write: rename failed: ", std::strerror(err));
+  // Hard links keep the old files while the new ones take their names; a failed rename puts
+  // back every file renamed before it (or removes it where there was none).
+  std::vector<std::string> kept(files.size());
+  std::vector<char> had_old(files.size(), 0);
+  for (size_t i = 0; i < files.size(); ++i) {
+    AtomicOutputFile& f = *files[i];
+    if (i + 1 < files.size()) {
+      kept[i] = f.temp_ + "-old";
+      had_old[i] = ::link(f.path_.c_str(), kept[i].c_str()) == 0;
+    }
+    if (std::rename(f.temp_.c_str(), f.path_.c_str()) != 0) {
+      const int err = errno;
+      std::string restored;
+      for (size_t j = 0; j < i; ++j) {
+        AtomicOutputFile& g = *files[j];
+        if (had_old[j])
+          std::rename(kept[j].c_str(), g.path_.c_str());
+        else
+          ::unlink(g.path_.c_str());
+        restored += (restored.empty() ? "" : ", ") + g.path_;
+      }
+      if (had_old[i]) ::unlink(kept[i].c_str());
+      MQ_THROW(Error, f.path_, ": cannot write: rename failed: ", std::strerror(err),
+               restored.empty() ? "" : " (", restored, restored.empty() ? "" : " left as it was)");
+    }
+    f.committed_ = true;
+    release_slot(f.slot_);
+    f.slot_ = -1;
   }
-  first.committed_ = true;
-  release_slot(first.slot_);
-  first.slot_ = -1;
-  if (std::rename(second.temp_.c_str(), second.path_.c_str()) != 0) {
-    const int err = errno;
-    if (had_old)
-      std::rename(kept.c_str(), first.path_.c_str());
+  for (size_t i = 0; i < files.size(); ++i)
+    if (had_old[i]) ::unlink(kept[i].c_str());
+}
+
+void commit_with(AtomicOutputFile& file, const std::string& companion_path,
+                 const std::function<std::string()>& companion_bytes, AtomicOutputFile* before) {
+  std::vector<AtomicOutputFile*> files;
+  if (before) files.push_back(before);
+  files.push_back(&file);
+  if (companion_path.empty()) {
+    if (files.size() == 1)
+      file.commit();
     else
-      ::unlink(first.path_.c_str());
-    MQ_THROW(Error, second.path_, ": cannot write: rename failed: ", std::strerror(err), " (",
-             first.path_, " left as it was)");
+      commit_together(files);
+    return;
   }
-  if (had_old) ::unlink(kept.c_str());
-  second.committed_ = true;
-  release_slot(second.slot_);
-  second.slot_ = -1;
+  // The companion's bytes are made once the others are written out (a --stats file holding
+  // the write's own time); it is renamed last.
+  for (AtomicOutputFile* f : files) f->finish();
+  AtomicOutputFile companion(companion_path);
+  companion.append(companion_bytes ? companion_bytes() : std::string());
+  files.push_back(&companion);
+  commit_together(files);
 }
 
 void AtomicOutputFile::commit() {

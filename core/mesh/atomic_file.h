@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,14 +28,14 @@ class AtomicOutputFile {
   void append(std::string_view s) { append(s.data(), s.size()); }
   // Flushes, syncs and renames the temporary file over `path`.
   void commit();
+  // Flushes, syncs and closes the temporary file (the part of commit() that can fail on a full
+  // disk), leaving the rename to commit() or commit_together(). Idempotent.
+  void finish();
 
   static constexpr size_t kSlack = 1024;
 
  private:
-  friend void commit_together(AtomicOutputFile& first, AtomicOutputFile& second);
-  // Flushes, syncs and closes the temporary file (the part of commit() that can fail on a full
-  // disk), leaving the rename.
-  void finish();
+  friend void commit_together(const std::vector<AtomicOutputFile*>& files);
   static constexpr size_t kChunk = size_t(1) << 22;
   void flush();
   void write_raw(const char* s, size_t n);
@@ -60,6 +61,18 @@ void install_temporary_file_cleanup();
 // do not interleave), first's then second's; if second's fails (an immutable old file), first's
 // old file is put back. Throws Error naming the file that failed.
 void commit_together(AtomicOutputFile& first, AtomicOutputFile& second);
+
+// commit_together for any number of files (in order; the directory locked is the last's): all
+// are written out before any is renamed; a failed rename puts back the files renamed before it.
+void commit_together(const std::vector<AtomicOutputFile*>& files);
+
+// Commits `file` (after `before`, when given: an OBJ's .mtl) together with a companion file at
+// `companion_path` (none when empty) whose bytes `companion_bytes` makes once the others are
+// written out, so that it can report their writing (issue 28: a --stats file that failed on a
+// full disk after the mesh was replaced). All new or all old.
+void commit_with(AtomicOutputFile& file, const std::string& companion_path,
+                 const std::function<std::string()>& companion_bytes,
+                 AtomicOutputFile* before = nullptr);
 
 // Writes `bytes` to `path` atomically (an AtomicOutputFile written at once).
 void write_file_atomically(const std::string& path, std::string_view bytes);

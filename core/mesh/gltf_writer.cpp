@@ -164,7 +164,9 @@ void write_glb(const std::string& path, const TriMesh& mesh, const WriteOptions&
   tinygltf::TinyGLTF writer;
   MQ_CHECK(writer.WriteGltfSceneToStream(&model, stream, false, true), Error, path,
            ": the glTF writer failed");
-  write_file_atomically(path, stream.str());
+  AtomicOutputFile out(path);
+  out.append(stream.str());
+  commit_with(out, options.companion_path, options.companion_bytes);
 }
 
 }  // namespace mq

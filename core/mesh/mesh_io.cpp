@@ -1254,7 +1254,7 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
         // file that is not there, or one of another run's kinds (issue 28).
         AtomicOutputFile materials(mtl);
         write_mtl(materials, labels.kinds);
-        commit_together(materials, out);
+        commit_with(out, options.companion_path, options.companion_bytes, &materials);
         return;
       }
       break;
@@ -1268,7 +1268,7 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const WriteOptions
     case MeshFormat::Glb:
       break;
   }
-  out.commit();
+  commit_with(out, options.companion_path, options.companion_bytes);
 }
 
 }  // namespace mq

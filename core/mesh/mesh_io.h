@@ -4,6 +4,7 @@
 // large buffer (std::to_chars), so meshes with millions of faces load and save in seconds.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "core/mesh/mesh.h"
@@ -66,6 +67,11 @@ struct WriteOptions {
   // Significant digits for coordinates in text formats; 17 round-trips doubles exactly.
   // A value <= 0 writes the shortest text that round-trips exactly.
   int precision = 9;
+  // A file committed together with the mesh (core/mesh/atomic_file's commit_with), none when
+  // the path is empty: its bytes are made by companion_bytes once the mesh is written out, and
+  // it is renamed after it (issue 28: the --stats file).
+  std::string companion_path;
+  std::function<std::string()> companion_bytes;
 };
 
 // Writes mesh to path in the format given by its extension (.glb: write_glb). Output bytes depend

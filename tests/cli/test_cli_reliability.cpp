@@ -356,13 +356,14 @@ TEST_F(Reliability, OutputNamesMustBeText) {
 TEST_F(Reliability, AFullDiskLeavesTheOldFileAndNoTemporary) {
   spit(dir_ + "/big.obj", "old\n");
   spit(dir_ + "/big.mtl", "old mtl\n");
+  spit(dir_ + "/big.json", "old stats\n");
   const std::vector<std::string> before = listing(dir_);
   const std::string err = dir_ + "/.err";
   // dash's ulimit -f counts 512-byte blocks: 64 KiB, far less than the layer's OBJ.
-  const std::string cmd = "cd '" + dir_ + "' && trap '' XFSZ && ulimit -f 128 && exec '" +
-                          std::string(MESHQUILT_CLI) +
-                          "' plane --swatch sw.obj --size 12 12 -o big.obj --quiet 2>'" + err +
-                          "' </dev/null >/dev/null";
+  const std::string cmd =
+      "cd '" + dir_ + "' && trap '' XFSZ && ulimit -f 128 && exec '" + std::string(MESHQUILT_CLI) +
+      "' plane --swatch sw.obj --size 12 12 -o big.obj --stats big.json --quiet 2>'" + err +
+      "' </dev/null >/dev/null";
   const int raw = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(raw)) << "killed by signal " << WTERMSIG(raw);
   EXPECT_EQ(WEXITSTATUS(raw), 1);
@@ -372,6 +373,7 @@ TEST_F(Reliability, AFullDiskLeavesTheOldFileAndNoTemporary) {
   EXPECT_NE(message.find("big."), std::string::npos) << message;
   EXPECT_EQ(slurp(dir_ + "/big.obj"), "old\n");
   EXPECT_EQ(slurp(dir_ + "/big.mtl"), "old mtl\n") << "the .mtl of the old OBJ was replaced";
+  EXPECT_EQ(slurp(dir_ + "/big.json"), "old stats\n") << "the stats of the old OBJ were replaced";
   EXPECT_EQ(listing(dir_), before);
 }
 

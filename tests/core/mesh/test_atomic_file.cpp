@@ -27,6 +27,11 @@ std::vector<std::string> names_in(const std::string& dir) {
   return names;
 }
 
+std::vector<std::string> sorted(std::vector<std::string> names) {
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
 // Forks a writer of dir/out.obj that stops half way (the temporary file exists), then sends it
 // `sig`. Returns once the child has ended.
 void kill_writer_mid_write(const std::string& dir, int sig) {
@@ -153,6 +158,69 @@ TEST(AtomicOutputFile, PairsCommitTogether) {
   EXPECT_EQ(test::slurp(dir + "/p.mtl"), "old mtl\n");
   fs::remove_all(dir + "/p.obj");
   EXPECT_EQ(names_in(dir), std::vector<std::string>{"p.mtl"});
+}
+
+// Issue 28: an OBJ, its .mtl and the --stats file land together. The companion's bytes are
+// made once the others are written out; when its rename fails the others are put back.
+TEST(AtomicOutputFile, ACompanionCommitsWithTheMeshOrNothingChanges) {
+  const std::string dir = test::temp_dir();
+  test::spit(dir + "/m.mtl", "old mtl\n");
+  test::spit(dir + "/m.obj", "old obj\n");
+  {
+    AtomicOutputFile mtl(dir + "/m.mtl");
+    AtomicOutputFile obj(dir + "/m.obj");
+    mtl.append(std::string_view("new mtl\n"));
+    obj.append(std::string_view("new obj\n"));
+    fs::create_directory(dir + "/m.json");
+    test::spit(dir + "/m.json/keep", "x");
+    EXPECT_ANY_THROW(commit_with(
+        obj, dir + "/m.json", [] { return std::string("{}"); }, &mtl));
+  }
+  EXPECT_EQ(test::slurp(dir + "/m.mtl"), "old mtl\n");
+  EXPECT_EQ(test::slurp(dir + "/m.obj"), "old obj\n");
+  fs::remove_all(dir + "/m.json");
+  EXPECT_EQ(sorted(names_in(dir)), (std::vector<std::string>{"m.mtl", "m.obj"}));
+  // And when every rename works, all three are new, the companion made after the others were
+  // written out (their temporary files complete beside it).
+  {
+    AtomicOutputFile mtl(dir + "/m.mtl");
+    AtomicOutputFile obj(dir + "/m.obj");
+    mtl.append(std::string_view("new mtl\n"));
+    obj.append(std::string_view("new obj\n"));
+    size_t files_then = 0;
+    commit_with(
+        obj, dir + "/m.json",
+        [&] {
+          files_then = names_in(dir).size();
+          return std::string("{}\n");
+        },
+        &mtl);
+    EXPECT_EQ(files_then, 5u);  // the two old files, the two new ones and its own, unrenamed
+  }
+  EXPECT_EQ(test::slurp(dir + "/m.mtl"), "new mtl\n");
+  EXPECT_EQ(test::slurp(dir + "/m.obj"), "new obj\n");
+  EXPECT_EQ(test::slurp(dir + "/m.json"), "{}\n");
+  EXPECT_EQ(sorted(names_in(dir)), (std::vector<std::string>{"m.json", "m.mtl", "m.obj"}));
+}
+
+// Three files where the last cannot be renamed: the two before it are put back (the first had
+// an old file, the second none).
+TEST(AtomicOutputFile, AFailedRenamePutsBackEveryFileBeforeIt) {
+  const std::string dir = test::temp_dir();
+  test::spit(dir + "/a", "old a\n");
+  {
+    AtomicOutputFile a(dir + "/a"), b(dir + "/b"), c(dir + "/c");
+    a.append(std::string_view("new a\n"));
+    b.append(std::string_view("new b\n"));
+    c.append(std::string_view("new c\n"));
+    fs::create_directory(dir + "/c");
+    test::spit(dir + "/c/keep", "x");
+    EXPECT_THROW(commit_together({&a, &b, &c}), Error);
+  }
+  EXPECT_EQ(test::slurp(dir + "/a"), "old a\n");
+  EXPECT_FALSE(fs::exists(dir + "/b"));
+  fs::remove_all(dir + "/c");
+  EXPECT_EQ(names_in(dir), std::vector<std::string>{"a"});
 }
 
 }  // namespace
