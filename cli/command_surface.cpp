@@ -230,12 +230,14 @@ int run_surface(int argc, char** argv, int first) {
             "the surface; adaptive: through the layout where that keeps the element's shape, an "
             "even copy elsewhere",
             "adaptive");
-  cl.flag("estimate",
-          "print the job's size and stop, writing nothing: one line 'estimate faces N bytes B "
-          "seconds T fits 0|1'. N is the global layout's count of copies (within 10% of the "
-          "faces written), the vines' stems at their spacing, or for the patches a bound of "
-          "whole swatch copies (up to 2x over); T is rough (4 us a face on 2 cores, plus 0.5 s); "
-          "fits: within --max-faces and --max-memory");
+  cl.flag(
+      "estimate",
+      "print the job's size and stop, writing nothing: one line 'estimate faces N bytes B "
+      "seconds T fits 0|1'. N is the global layout's count of copies (within 10% of the "
+      "faces written), the vines' stems at their spacing (within 10% on the sample ivy), or for "
+      "the patches a bound of whole swatch copies (up to 2x over); T is rough (4 us a face on 2 "
+      "cores, plus 0.5 s); "
+      "fits: within --max-faces and --max-memory");
   cl.option("save-quilt", "FILE",
             "also save the result in local coordinates over the base (elements, their kinds, "
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
@@ -339,7 +341,7 @@ int run_surface(int argc, char** argv, int first) {
     // The size before any synthesis (issue 26: the add-on shows it before Run): the method's
     // own count, as the run checks it against --max-faces (the global layout's lattice copies,
     // within 5% of the faces written on the gallery's chain mail; the vines' stems at their
-    // spacing, 1.2x over on the ivy wall; the preparation's for the patches).
+    // spacing, within 6% on the ivy wall, David and Spot; the preparation's for the patches).
     SurfaceQuiltingOptions counting = options;
     counting.max_faces = std::numeric_limits<double>::infinity();
     counting.global.count_only = true;

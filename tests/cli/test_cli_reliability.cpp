@@ -293,14 +293,19 @@ TEST_F(Reliability, FinsAreLeftOutAndTheSurfaceTheyStandOnIsCovered) {
 // nothing. Through the global layout (the sample 3 x 3 sheet, a lattice) it counts the copies
 // the run places: within 10% of the faces written. Through the patches (the fixture's 2 x 2
 // sheet is not a lattice) it is the preparation's bound, whole swatch copies over the area:
-// never under the faces written, at most twice them (1.74x here). `fits` follows --max-faces.
+// never under the faces written, at most twice them (1.74x here). The vines: within 10% (0.97
+// here). `fits` follows --max-faces.
 TEST_F(Reliability, EstimateIsOneLineAndHolds) {
   write_mesh(dir_ + "/sphere.obj", test::uv_sphere(1.0, 32, 16));
   ASSERT_EQ(
       meshquilt(dir_, "swatch chainmail --rows 3 --cols 3 --detail 16 -o sw3.obj --quiet").status,
       0);
-  for (const auto& [swatch, lo, hi] :
-       {std::tuple<std::string, double, double>{"sw3.obj", 0.9, 1.1}, {"sw.obj", 1.0, 2.0}}) {
+  // The vines (issue 28: 20% over): their stems at the spacing, times the share of the area
+  // evenly spaced streamlines fill.
+  ASSERT_EQ(meshquilt(dir_, "swatch ivy --count 2 --length 2 -o ivy.obj --quiet").status, 0);
+  for (const auto& [swatch, lo, hi] : {std::tuple<std::string, double, double>{"sw3.obj", 0.9, 1.1},
+                                       {"sw.obj", 1.0, 2.0},
+                                       {"ivy.obj", 0.9, 1.1}}) {
     SCOPED_TRACE(swatch);
     const std::string job =
         "surface --base sphere.obj --swatch " + swatch + " --scale 0.15 -o s.obj";
@@ -326,7 +331,7 @@ TEST_F(Reliability, EstimateIsOneLineAndHolds) {
     EXPECT_NE(small.out.find(" fits 0"), std::string::npos) << small.out;
     for (const char* f : {"s.obj", "s.mtl"}) fs::remove(dir_ + "/" + f);
   }
-  for (const char* f : {"sphere.obj", "sphere.mtl", "sw3.obj", "sw3.mtl"})
+  for (const char* f : {"sphere.obj", "sphere.mtl", "sw3.obj", "sw3.mtl", "ivy.obj", "ivy.mtl"})
     fs::remove(dir_ + "/" + f);
 }
 
