@@ -17,8 +17,10 @@
 #include <cstdio>
 #include <string>
 
+#include "core/mesh/fins.h"
 #include "core/mesh/longest_edge_bisection.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/mesh_topology.h"
 #include "core/mesh/weld_vertices.h"
 #include "core/shell/placement_check.h"
 #include "core/shell/surface_coverage.h"
@@ -92,8 +94,19 @@ TEST_P(HeldOutBases, NoTextureInsideTheBaseAndEveryFallbackSaid) {
   else
     EXPECT_NE(reason, "\"\"") << "a fallback without a reason";
 
-  // No vertex under the base, measured here over the base as given (welded, as the tool does).
-  const TriMesh base = weld_vertices(read_mesh(c.path));
+  // No vertex under the base, measured here over the base as given (welded, as the tool does),
+  // less its fins (core/mesh/fins.h), which the tool leaves out and says so: the texture covers
+  // the surface they stand on (the dragon has two such faces).
+  TriMesh base = weld_vertices(read_mesh(c.path));
+  if (const std::vector<int> fins = fin_faces(base); !fins.empty()) {
+    EXPECT_NE(r.out.find("faces in fins"), std::string::npos) << r.out;
+    std::vector<char> fin(static_cast<size_t>(base.num_faces()), 0);
+    for (const int f : fins) fin[static_cast<size_t>(f)] = 1;
+    std::vector<int> keep;
+    for (int f = 0; f < base.num_faces(); ++f)
+      if (!fin[static_cast<size_t>(f)]) keep.push_back(f);
+    base = extract_faces(base, keep);
+  }
   const TriMesh out = read_mesh(dir + "/out.obj");
   const SignedHeight height(base.V, base.F);
   PlacementCheckOptions o;
