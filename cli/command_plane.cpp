@@ -138,27 +138,11 @@ int run_plane(int argc, char** argv, int first) {
     structure = summarize_structure(result, swatch, nullptr, 1.0);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  double wall = 0;
-  {
-    ScopedStageProgress shown(run.progress(), "writing");
-    const auto write_start = std::chrono::steady_clock::now();
-    const auto finish_timing = [&] {
-      const auto now = std::chrono::steady_clock::now();
-      stats.times.add("write", std::chrono::duration<double>(now - write_start).count());
-      wall = std::chrono::duration<double>(now - start).count() - measuring;
-    };
-    WriteOptions with_stats = write_options;
-    if (!run.stats_path().empty()) {
-      with_stats.companion_path = run.stats_path();
-      with_stats.companion_bytes = [&] {
-        finish_timing();
-        return stats_json(stats, evaluator->name(), run.threads(), wall, cl.get("swatch"),
+  const double wall = write_output_and_stats(
+      run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
+        return stats_json(stats, evaluator->name(), run.threads(), w, cl.get("swatch"),
                           options.length, options.width, structure);
-      };
-    }
-    write_output(out_path, result, with_stats);
-    if (run.stats_path().empty()) finish_timing();
-  }
+      });
   run.progress()->finish();
   if (!run.quiet()) {
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());

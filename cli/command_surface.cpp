@@ -422,35 +422,18 @@ int run_surface(int argc, char** argv, int first) {
     structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  // The mesh and the --stats file are one commit (issue 28): the stats, made once the mesh is
-  // written out (they hold its writing time), land with it or not at all.
-  double wall = 0;
-  {
-    ScopedStageProgress shown(run.progress(), "writing");
-    const auto write_start = std::chrono::steady_clock::now();
-    const auto finish_timing = [&] {
-      const auto now = std::chrono::steady_clock::now();
-      stats.times.add("write", std::chrono::duration<double>(now - write_start).count());
-      wall = std::chrono::duration<double>(now - start).count() - measuring;
-    };
-    if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
-    WriteOptions with_stats = write_options;
-    if (!run.stats_path().empty()) {
-      with_stats.companion_path = run.stats_path();
-      with_stats.companion_bytes = [&] {
-        finish_timing();
+  // The mesh and the --stats file are one commit (issue 28).
+  if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
+  const double wall = write_output_and_stats(
+      run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
         return stats_json(stats, embedding_stats, embedding_name, evaluator->name(), run.threads(),
-                          wall, cl.get("base"), cl.get("swatch"),
+                          w, cl.get("base"), cl.get("swatch"),
                           global  ? "global"
                           : vines ? "vines"
                                   : "patches",
                           global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
                           own_coverage);
-      };
-    }
-    write_output(out_path, result, with_stats);
-    if (run.stats_path().empty()) finish_timing();
-  }
+      });
   run.progress()->finish();
   if (!run.quiet()) {
     std::printf(

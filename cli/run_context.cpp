@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "core/common/errors.h"
+#include "core/common/progress.h"
 
 namespace mq::cli {
 
@@ -64,6 +65,31 @@ std::vector<std::string> output_files(const std::string& path, const WriteOption
 void write_output(const std::string& path, TriMesh mesh, const WriteOptions& options) {
   mesh.N.resize(0, 3);
   write_mesh(path, mesh, options);
+}
+
+double write_output_and_stats(RunContext& run, const std::string& path, const TriMesh& mesh,
+                              const WriteOptions& options, StageTimes& times,
+                              std::chrono::steady_clock::time_point start, double excluded,
+                              const std::function<std::string(double wall)>& stats_json) {
+  ScopedStageProgress shown(run.progress(), "writing");
+  const auto write_start = std::chrono::steady_clock::now();
+  double wall = 0;
+  const auto finish_timing = [&] {
+    const auto now = std::chrono::steady_clock::now();
+    times.add("write", std::chrono::duration<double>(now - write_start).count());
+    wall = std::chrono::duration<double>(now - start).count() - excluded;
+  };
+  WriteOptions with_stats = options;
+  if (!run.stats_path().empty()) {
+    with_stats.companion_path = run.stats_path();
+    with_stats.companion_bytes = [&] {
+      finish_timing();
+      return stats_json(wall);
+    };
+  }
+  write_output(path, mesh, with_stats);
+  if (run.stats_path().empty()) finish_timing();
+  return wall;
 }
 
 double memory_limit(const CommandLine& cl) {

@@ -3,12 +3,15 @@
 
 #include <tbb/global_control.h>
 
+#include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
+#include "core/common/stage_timer.h"
 #include "core/mesh/mesh_io.h"
 #include "host/device.h"
 
@@ -79,5 +82,14 @@ class RunContext {
   std::unique_ptr<tbb::global_control> control_;
   ConsoleProgress progress_;
 };
+
+// Writes a result (write_output) and its --stats file, when the run asks for one, as one commit
+// (issue 28): stats_json(wall) makes the stats once the mesh is written out, so that they hold
+// the write's seconds (added to `times` as "write") and the run's wall time: since `start`,
+// less `excluded` (seconds spent on figures for the stats alone). Returns that wall time.
+double write_output_and_stats(RunContext& run, const std::string& path, const TriMesh& mesh,
+                              const WriteOptions& options, StageTimes& times,
+                              std::chrono::steady_clock::time_point start, double excluded,
+                              const std::function<std::string(double wall)>& stats_json);
 
 }  // namespace mq::cli
