@@ -24,6 +24,7 @@ bl_info = {
 import os
 import shutil
 import tempfile
+import time
 
 import bpy
 import numpy as np
@@ -76,6 +77,10 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     scale: bpy.props.FloatProperty(
         name="Scale", default=0.1, min=0.001, max=1.0, soft_min=0.01, soft_max=0.3,
         description="The swatch's longer side as a fraction of the base's bounding-box diagonal")
+    element_size: bpy.props.FloatProperty(
+        name="Element size", default=0.0, min=0.0, soft_max=10.0, subtype="DISTANCE",
+        unit="LENGTH", description="The swatch's longer side in scene units, whatever the "
+        "base's size (0: use Scale)")
     guidance: bpy.props.EnumProperty(
         name="Guidance", items=[("NONE", "None", "A smooth field the engine chooses"),
                                 ("AXIS", "Object axis", "An object's axis, projected on the "
@@ -113,7 +118,7 @@ def estimate_key(context, settings):
         parts += ["object", sw.name if sw else "", len(sw.data.polygons) if sw else 0]
     else:
         parts += ["sample", settings.sample]
-    parts += [round(settings.scale, 6), settings.seed, settings.stretch, settings.guidance]
+    parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed, settings.stretch, settings.guidance]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -131,6 +136,26 @@ def estimate_text(settings):
     t = settings.estimate_seconds
     time_text = "%d s" % max(1, round(t)) if t < 90 else "%d min" % round(t / 60)
     return "~%s faces, %.1f GiB, %s" % (faces, settings.estimate_gib, time_text)
+
+
+_diagonals = {}  # estimate_key's base part -> the evaluated base's world diagonal
+
+
+def base_diagonal(context, base):
+    """The bounding-box diagonal of the base as exported (evaluated, in world space), the
+    length Scale is a fraction of; cached while the base is unchanged (cheap for draw())."""
+    key = repr([base.name, len(base.data.vertices), len(base.data.polygons),
+                [(m.name, m.show_viewport) for m in base.modifiers],
+                [round(x, 5) for row in base.matrix_world for x in row]])
+    if key not in _diagonals:
+        evaluated = base.evaluated_get(context.evaluated_depsgraph_get())
+        V = np.empty(3 * len(evaluated.data.vertices))
+        evaluated.data.vertices.foreach_get("co", V)
+        W = np.array(base.matrix_world)
+        V = V.reshape(-1, 3) @ W[:3, :3].T + W[:3, 3]
+        _diagonals.clear()
+        _diagonals[key] = float(np.linalg.norm(V.max(0) - V.min(0))) if len(V) else 0.0
+    return _diagonals[key]
 
 
 def _preferences(context):
@@ -194,6 +219,15 @@ class Run:
         field = field_file = None
         self.topology = {}
         V, T = self._export(depsgraph, base, base_path, topology=self.topology)[:2]
+        # Element size (scene units; the base is exported in world space, so these are its
+        # units): the engine's --element-size; Scale stands for it where a scale is needed.
+        self.element_size = settings.element_size
+        if self.element_size > 0:
+            diagonal = float(np.linalg.norm(V.max(0) - V.min(0)))
+            if diagonal <= 0:
+                raise engine.EngineError("%s is flat to a point: no element size fits it"
+                                         % base.name)
+            self.scale = self.element_size / diagonal
         self.base_matrix = np.array(base.matrix_world)
         # The quilt saved for following the base (not over a base the engine would simplify).
         self.quilt_path = os.path.join(self.dir, "quilt.mqq") \
@@ -219,21 +253,24 @@ class Run:
         self.stats_path = os.path.join(self.dir, "stats.json")
         self.elements_path = os.path.join(self.dir, "elements.csv")
         self.options = dict(seed=settings.seed, stretch=settings.stretch, field=field,
-                            field_file=field_file, max_memory=self.max_memory)
+                            field_file=field_file, max_memory=self.max_memory,
+                            element_size=self.element_size)
         self.jobs.append(lambda: engine.surface_job(
-            self.engine, base_path, swatch_path, self.result_path, settings.scale,
+            self.engine, base_path, swatch_path, self.result_path, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
         # The structure measured against the swatch for the report (optional: a failure
         # there leaves the result and the rest of the report).
         self.jobs.append(lambda: engine.info_job(
             self.engine, self.result_path, swatch_path, base_path, self.elements_path,
-            settings.scale))
+            self.scale))
         self.optional_jobs = 1
         self.total = len(self.jobs)
         self.job = None
         self.state = "running"
         self.error = ""
         self.result = None
+        self.started = time.monotonic()
+        self.overall = 0.0
 
     @staticmethod
     def _export(depsgraph, obj, path, with_kinds=False, topology=None):
@@ -307,13 +344,32 @@ class Run:
         return engine.estimate(self.engine, self.paths[0], self.paths[1], self.result_path,
                                self.scale, **self.options)
 
+    # Shares of the whole run: the sample swatch before, the structure measure after.
+    PREPARATION_SHARE, INFO_SHARE = 0.03, 0.03
+
     def fraction(self):
-        done = self.total - len(self.jobs) - (1 if self.job else 0)
-        part = self.job.fraction if self.job else 0.0
-        return min(1.0, (done + part) / self.total)
+        """The run's overall fraction: monotone, 1 once done (the surface job's stages by
+        their typical shares, engine.Progress; the jobs around it a small share each)."""
+        if self.state == "done":
+            self.overall = 1.0
+            return 1.0
+        surface = self.total - self.optional_jobs - 1  # its index among the jobs
+        index = self.total - len(self.jobs) - (1 if self.job else 0)  # jobs finished
+        share = 1.0 - self.INFO_SHARE - (self.PREPARATION_SHARE if surface else 0.0)
+        before = self.PREPARATION_SHARE * min(index, surface) / surface if surface else 0.0
+        if index > surface:
+            value = before + share
+        elif index == surface and self.job is not None:
+            value = before + share * self.job.overall
+        else:
+            value = before
+        self.overall = max(self.overall, min(value, 0.99))
+        return self.overall
 
     def status_text(self):
-        return self.job.status_text() if self.job else "meshquilt: starting"
+        detail = self.job.stage if self.job is not None and self.job.stage != "starting" \
+            else "starting"
+        return engine.progress_text(self.fraction(), time.monotonic() - self.started, detail)
 
     def cancel(self):
         if self.job is not None:
@@ -383,6 +439,16 @@ def material_for(kind, look):
     return material
 
 
+def _redraw_panels(context):
+    """Redraws the 3D views' sidebars (where the panel is) in every window."""
+    for window in context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                for region in area.regions:
+                    if region.type == "UI":
+                        region.tag_redraw()
+
+
 class MESHQUILT_OT_run(bpy.types.Operator):
     """Quilt the swatch over the base in the background"""
     bl_idname = "meshquilt.run"
@@ -423,7 +489,6 @@ class MESHQUILT_OT_run(bpy.types.Operator):
 
     def execute(self, context):
         # Blocking, for scripts: bpy.ops.meshquilt.run().
-        import time
         run = self._start(context)
         if run is None:
             return {"CANCELLED"}
@@ -436,15 +501,25 @@ class MESHQUILT_OT_run(bpy.types.Operator):
         return self._finish(context, run)
 
     def invoke(self, context, event):
+        if self._begin(context) is None:
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def _begin(self, context):
+        """The run started for the modal operator (everything but its handler)."""
         run = self._start(context)
         if run is None:
-            return {"CANCELLED"}
+            return None
+        # Running from now on: the panel shows Cancel before the engine's first line.
         _running["run"] = run
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.progress_begin(0, 100)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
+        wm.progress_update(0)
+        context.workspace.status_text_set(run.status_text())
+        _redraw_panels(context)
+        return run
 
     def modal(self, context, event):
         run = _running.get("run")
@@ -461,6 +536,7 @@ class MESHQUILT_OT_run(bpy.types.Operator):
             state = "failed"
         context.window_manager.progress_update(int(100 * run.fraction()))
         context.workspace.status_text_set(run.status_text())
+        _redraw_panels(context)
         if state == "running":
             return {"PASS_THROUGH"}
         return self._end(context, run)
@@ -779,6 +855,22 @@ def _draw_report(layout, obj):
             box.operator("meshquilt.select_distorted", icon="RESTRICT_SELECT_OFF")
 
 
+def _draw_element_size(layout, context, s):
+    """What the swatch's longer side will be in scene units (Scale x the base's diagonal)."""
+    if s.element_size > 0:
+        layout.label(text="Element size used instead of Scale", icon="INFO")
+        return
+    if s.base is None or s.base.type != "MESH":
+        return
+    diagonal = base_diagonal(context, s.base)
+    if diagonal > 0:
+        unit = context.scene.unit_settings
+        text = bpy.utils.units.to_string(
+            unit.system, "LENGTH", s.scale * diagonal * unit.scale_length, precision=3) \
+            if unit.system != "NONE" else "%.4g" % (s.scale * diagonal)
+        layout.label(text="Element size at this Scale: %s" % text)
+
+
 class MESHQUILT_PT_panel(bpy.types.Panel):
     bl_label = "meshquilt"
     bl_idname = "MESHQUILT_PT_panel"
@@ -793,6 +885,8 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         layout.prop(s, "swatch_source", expand=True)
         layout.prop(s, "swatch" if s.swatch_source == "OBJECT" else "sample")
         layout.prop(s, "scale")
+        layout.prop(s, "element_size")
+        _draw_element_size(layout, context, s)
         layout.prop(s, "guidance")
         if s.guidance == "AXIS":
             row = layout.row()

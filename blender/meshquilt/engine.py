@@ -60,6 +60,90 @@ def killed_message(signal_number):
     return "the meshquilt engine was stopped from outside (%s)" % name
 
 
+# Typical shares of a surface job's stages, in the order the engine reports them (seconds of
+# runs on data/spot_6k.obj: chain mail at --scale 0.08 with the global layout and with the
+# patches, the sample ivy at --scale 0.05 with vines). A stage seen twice (embedding, placement
+# check) has one weight per time. The first stage names the method.
+_TAIL = [("shell map", .12), ("embedding", .04), ("stretch optimization", .33),
+         ("embedding", .49), ("placement check", .06), ("fold repair", .12),
+         ("ring separation", .68), ("element removal", .05), ("placement check", .01),
+         ("coverage", .21), ("writing", .06)]
+STAGE_WEIGHTS = {
+    "global": [("parameterization", .31), ("tiling", .01), ("placement", .05),
+               ("quilting", .24)] + _TAIL,
+    "patches": [("quilting", 1.33), ("shell map", .09), ("embedding", .02),
+                ("stretch optimization", .31), ("embedding", .21), ("placement check", .03),
+                ("fold repair", .01), ("ring separation", .01), ("element removal", .01),
+                ("placement check", .01), ("coverage", .09), ("writing", .05)],
+    "vines": [("streamlines", .98), ("leaves", .95), ("shell map", .29), ("embedding", .07),
+              ("stretch optimization", .40), ("embedding", .82), ("placement check", .12),
+              ("fold repair", .04), ("ring separation", .02), ("element removal", .02),
+              ("placement check", .01), ("coverage", .36), ("writing", .08)],
+}
+FIRST_STAGE = {"parameterization": "global", "tiling": "global", "quilting": "patches",
+               "streamlines": "vines", "stems": "vines", "leaves": "vines"}
+UNKNOWN_STAGE_SHARE = 0.03  # a stage not in the table: this share of the job
+
+
+class Progress:
+    """One overall fraction of a job from the engine's per-stage progress lines: the finished
+    stages' typical shares plus the current stage's share times its own fraction; it never
+    decreases, stays under 1 until the job is done (finish())."""
+
+    def __init__(self):
+        self.sequence = None
+        self.position = -1
+        self.stage = None
+        self.last_fraction = 0.0
+        self.done = 0.0  # the finished stages' weights
+        self.weight = 0.0  # the current stage's weight
+        self.overall = 0.0
+
+    def update(self, stage, fraction):
+        fraction = min(1.0, max(0.0, fraction))
+        if self.sequence is None:
+            self.sequence = STAGE_WEIGHTS[FIRST_STAGE.get(stage, "global")]
+            self.total = sum(w for _, w in self.sequence)
+        if stage != self.stage or fraction < self.last_fraction:
+            # A new stage (or the same one again: its fraction fell back).
+            names = [n for n, _ in self.sequence]
+            try:
+                j = names.index(stage, self.position + 1)
+                self.done = max(self.done + self.weight,
+                                sum(w for _, w in self.sequence[:j]))
+                self.position, self.weight = j, self.sequence[j][1]
+            except ValueError:
+                self.done += self.weight
+                self.weight = UNKNOWN_STAGE_SHARE * self.total
+            self.stage = stage
+        self.last_fraction = fraction
+        value = min(0.99, (self.done + self.weight * fraction) / self.total)
+        self.overall = max(self.overall, value)
+        return self.overall
+
+    def finish(self):
+        self.overall = 1.0
+
+
+def time_left(elapsed, overall):
+    """Seconds left from the time so far and the overall fraction (None below 3%)."""
+    if overall < 0.03 or overall >= 1.0:
+        return None
+    return elapsed * (1.0 - overall) / overall
+
+
+def progress_text(overall, elapsed, detail=""):
+    """'meshquilt: 42% (ring separation), about 0:05 left'."""
+    text = "meshquilt: %d%%" % int(100 * overall)
+    if detail:
+        text += " (%s)" % detail
+    left = time_left(elapsed, overall)
+    if left is not None:
+        s = int(round(left))
+        text += ", about %d:%02d left" % (s // 60, s % 60)
+    return text
+
+
 class Job:
     """One engine run in the background.
 
@@ -77,6 +161,7 @@ class Job:
         self.remaining = -1.0
         self.error = ""
         self.state = "running"
+        self.progress = Progress()
         self._lines = queue.Queue()
         self._stderr_tail = []
         self._started = time.monotonic()
@@ -103,17 +188,24 @@ class Job:
                 return
             if line is None:
                 continue
-            parts = line.split()
-            if len(parts) == 5 and parts[0] == "progress":
-                try:
-                    self.stage = parts[1]
-                    self.fraction = float(parts[2])
-                    self.elapsed = float(parts[3])
-                    self.remaining = float(parts[4])
-                except ValueError:
-                    self._stderr_tail.append(line)
-            elif line.strip():
-                self._stderr_tail = (self._stderr_tail + [line])[-20:]
+            self._line(line)
+
+    def _line(self, line):
+        """One stderr line: a progress line ('progress STAGE FRACTION ELAPSED REMAINING'; the
+        stage may be several words, e.g. 'ring separation') or kept for the error message."""
+        parts = line.split()
+        if len(parts) >= 5 and parts[0] == "progress":
+            try:
+                fraction, elapsed, remaining = (float(x) for x in parts[-3:])
+            except ValueError:
+                pass
+            else:
+                self.stage = " ".join(parts[1:-3])
+                self.fraction, self.elapsed, self.remaining = fraction, elapsed, remaining
+                self.progress.update(self.stage, fraction)
+                return
+        if line.strip():
+            self._stderr_tail = (self._stderr_tail + [line])[-20:]
 
     def poll(self):
         if self.state != "running":
@@ -126,6 +218,7 @@ class Job:
         self._drain()
         if code == 0:
             self.state = "done"
+            self.progress.finish()
         else:
             self.state = "failed"
             if code < 0:
@@ -160,13 +253,14 @@ class Job:
         self._reader.join(timeout=5)
         self.state = "cancelled"
 
+    @property
+    def overall(self):
+        """The job's overall fraction (Progress): monotone, 1 once done."""
+        return self.progress.overall
+
     def status_text(self):
-        """'quilting 42%, about 0:05 left' for Blender's status bar."""
-        text = "meshquilt: %s %d%%" % (self.stage, int(100 * self.fraction))
-        if self.remaining >= 0 and 0 < self.fraction < 1:
-            s = int(round(self.remaining))
-            text += ", about %d:%02d left" % (s // 60, s % 60)
-        return text
+        """'meshquilt: 42% (ring separation), about 0:05 left' for Blender's status bar."""
+        return progress_text(self.overall, time.monotonic() - self._started, self.stage)
 
 
 def swatch_job(engine, kind, output, seed=1):
@@ -176,11 +270,14 @@ def swatch_job(engine, kind, output, seed=1):
 
 
 def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
-                 field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None):
-    """The arguments of a surface job (surface_job; estimate with the same settings)."""
-    args = ["surface", "--base", base, "--swatch", swatch, "-o", output,
-            "--scale", repr(float(scale)), "--seed", str(int(seed)),
-            "--threads", str(int(threads))]
+                 field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None,
+                 element_size=0.0):
+    """The arguments of a surface job (surface_job; estimate with the same settings); an
+    element_size > 0 (the swatch's longer side in the base's units) replaces the scale."""
+    size = ["--element-size", repr(float(element_size))] if element_size and \
+        element_size > 0 else ["--scale", repr(float(scale))]
+    args = ["surface", "--base", base, "--swatch", swatch, "-o", output] + size + \
+        ["--seed", str(int(seed)), "--threads", str(int(threads))]
     if save_quilt:
         args += ["--save-quilt", save_quilt]
     if max_memory:

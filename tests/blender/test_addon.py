@@ -729,6 +729,99 @@ def test_remove_selected_elements_removes_them_from_the_quilt():
     bpy.ops.object.mode_set(mode="OBJECT")
 
 
+@test
+def test_overall_progress_never_decreases_and_reaches_one():
+    from meshquilt import engine
+    # Per-stage fractions that fall back to 0 at every new stage, a stage seen twice, one the
+    # table does not know and a stage skipped (no stretch optimisation).
+    lines = []
+    for stage in ("parameterization", "tiling", "placement", "quilting", "shell map",
+                  "embedding", "embedding", "new stage", "placement check", "ring separation",
+                  "coverage", "writing"):
+        lines += ["progress %s %.4f 1.00 -1.00" % (stage, f) for f in (0.0, 0.3, 0.7, 1.0)]
+    p, last = engine.Progress(), 0.0
+    for line in lines:
+        w = line.split()
+        value = p.update(" ".join(w[1:-3]), float(w[-3]))
+        check(value >= last, "overall fell from %.3f to %.3f at %r" % (last, value, line))
+        check(value < 1.0, "1 before the job ended")
+        last = value
+    check(last > 0.9, "only %.2f at the last stage's end" % last)
+    check(engine.time_left(10.0, 0.01) is None, "time left guessed below 3%")
+    check(abs(engine.time_left(10.0, 0.25) - 30.0) < 1e-9, "time left")
+    # A Job reading the same lines from a process: multi-word stages parsed, 1 once done.
+    script = "; ".join("echo '%s' >&2" % line for line in lines)
+    job = engine.Job("/bin/sh", ["-c", script])
+    check(job.wait(10) == "done", "job %s: %s" % (job.state, job.error))
+    check(job.stage == "writing" and job.overall == 1.0, "%s %.3f" % (job.stage, job.overall))
+    check(job._stderr_tail == [], "progress lines taken as messages: %s" % job._stderr_tail[:2])
+    check(job.status_text().startswith("meshquilt: 100%"), job.status_text())
+
+
+@test
+def test_run_shows_cancel_at_once_before_any_progress():
+    scene = new_scene()
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.5
+    import meshquilt
+    check("op:meshquilt.run" in drawn_panel(), "no Run before starting")
+    # Headless Blender runs INVOKE_DEFAULT as execute (blocking): the modal operator's start
+    # is called as invoke calls it, without the modal handler (which needs the event loop).
+    op = meshquilt.MESHQUILT_OT_run
+    fake = type("Op", (), {"report": lambda self, *a: None, "_start": op._start,
+                           "_begin": op._begin, "_end": op._end, "_finish": op._finish})()
+    started = fake._begin(bpy.context)
+    run = meshquilt._running.get("run")
+    try:
+        check(started is not None and run is started, "not running after invoke")
+        check(run.job is None or run.job.stage == "starting", "a progress line came first")
+        texts = drawn_panel()
+        check("op:meshquilt.cancel" in texts and "op:meshquilt.run" not in texts,
+              "panel shows %s" % texts)
+        check(any(t.startswith("meshquilt: 0%") for t in texts), "no progress: %s" % texts)
+    finally:
+        if run is not None:
+            run.cancel()
+            fake._end(bpy.context, run)
+        meshquilt._running.clear()
+    check("op:meshquilt.run" in drawn_panel(), "no Run after the end")
+
+
+@test
+def test_element_size_in_scene_units_is_passed_to_the_engine():
+    scene = new_scene()
+    s = scene.meshquilt
+    base = small_sphere()
+    base.scale = (2.0, 2.0, 2.0)  # world units: the exported base has radius 2
+    s.base, s.sample, s.scale = base, "chainmail", 0.25
+    bpy.context.view_layer.update()
+    texts = drawn_panel()
+    diagonal = 2.0 * 2.0 * math.sqrt(3.0)  # the 16 x 8 sphere's box is [-1, 1]^3, scaled 2x
+    shown = [t for t in texts if t.startswith("Element size at this Scale")]
+    import re
+    value = re.search(r"([0-9.]+) ?m?$", shown[0]) if shown else None
+    check(value and abs(float(value.group(1)) - 0.25 * diagonal) < 0.01,
+          "shown %s for %.3f" % (shown, 0.25 * diagonal))
+    s.element_size = 2.0
+    check("Element size used instead of Scale" in drawn_panel(), "element size not shown")
+    import meshquilt
+    run = meshquilt.Run(bpy.context, s)
+    args = []
+    while run.step() == "running":
+        if run.job is not None and run.job.args[1] == "surface":
+            args = run.job.args
+        time.sleep(0.05)
+    try:
+        check(run.state == "done", "run %s: %s" % (run.state, run.error))
+        i = args.index("--element-size")
+        check(float(args[i + 1]) == 2.0 and "--scale" not in args, "args %s" % args)
+        check(abs(run.scale - 2.0 / diagonal) < 0.01, "scale %.3f" % run.scale)
+        obj = run.import_result(bpy.context)
+        check(len(obj.data.polygons) > 100, "only %d faces" % len(obj.data.polygons))
+    finally:
+        run.cleanup()
+
+
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
 if failures:
     sys.exit(1)
