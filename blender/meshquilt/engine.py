@@ -345,14 +345,17 @@ def refusal_message(error, scale, limit_gib):
         return None  # not a refusal (e.g. a value out of range)
     import re
     faces = re.search(r"about ([0-9.e+]+) faces", error)
-    need = ""
-    if faces:
-        n = float(faces.group(1))
-        # The engine's own rule: about 400 bytes a face.
-        need = " would make about %s faces (about %.2g GiB)" % (format(int(n), ","),
-                                                              n * 400 / 2.0 ** 30)
-    else:
-        need = " is too large"
+    limit = re.search(r"limit of ([0-9.e+]+)", error)
+    n = float(faces.group(1)) if faces else None
+    # The engine's own rule: about 400 bytes a face. Its face limit (--max-faces, 2e7 by
+    # default) can bind before the memory limit: then the memory limit is not what to raise.
+    need_gib = n * 400 / 2.0 ** 30 if n is not None else None
+    need = (" would make about %s faces (about %.2g GiB)" % (format(int(n), ","), need_gib)
+            if n is not None else " is too large")
+    if need_gib is not None and limit and need_gib <= limit_gib:
+        return ("meshquilt: at Scale %g the texture%s, more than the engine's limit of %s "
+                "faces: raise Scale in the panel (fewer, larger elements)"
+                % (scale, need, format(int(float(limit.group(1))), ",")))
     return ("meshquilt: at Scale %g the texture%s, over the memory limit of %.3g GiB: raise "
             "Scale in the panel (fewer, larger elements), or raise Memory limit in Edit > "
             "Preferences > Add-ons > meshquilt" % (scale, need, limit_gib))
