@@ -236,8 +236,7 @@ int run_surface(int argc, char** argv, int first) {
       "seconds T fits 0|1'. N is the global layout's count of copies (within 10% of the "
       "faces written), the vines' stems at their spacing (within 10% on the sample ivy), or for "
       "the patches a bound of whole swatch copies (up to 2x over); T is rough (4 us a face on 2 "
-      "cores, plus 0.5 s); "
-      "fits: within --max-faces and --max-memory");
+      "cores, plus 0.5 s); fits: within --max-faces and --max-memory");
   cl.option("save-quilt", "FILE",
             "also save the result in local coordinates over the base (elements, their kinds, "
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
@@ -422,8 +421,8 @@ int run_surface(int argc, char** argv, int first) {
     structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  // The mesh and the --stats file are one commit (issue 28).
   if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
+  // The mesh and the --stats file are one commit (issue 28).
   const double wall = write_output_and_stats(
       run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
         return stats_json(stats, embedding_stats, embedding_name, evaluator->name(), run.threads(),

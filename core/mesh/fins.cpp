@@ -16,9 +16,10 @@ int find_root(std::vector<int>& parent, int x) {
 
 }  // namespace
 
-std::vector<int> fin_faces(const TriMesh& mesh, double min_area_ratio) {
+std::vector<int> fin_faces(const TriMesh& mesh, double min_area_ratio, int* non_manifold_left) {
   const int nf = mesh.num_faces();
   const EdgeTopology topo = edge_topology(mesh.F, mesh.num_vertices());
+  if (non_manifold_left) *non_manifold_left = 0;
   bool any = false;
   for (int e = 0; e < topo.num_edges() && !any; ++e) any = topo.is_non_manifold(e);
   if (!any) return {};
@@ -66,6 +67,14 @@ std::vector<int> fin_faces(const TriMesh& mesh, double min_area_ratio) {
   std::vector<int> result;
   for (int f = 0; f < nf; ++f)
     if (state[piece[f]] == 1) result.push_back(f);
+  if (non_manifold_left)
+    for (int e = 0; e < topo.num_edges(); ++e) {
+      if (!topo.is_non_manifold(e)) continue;
+      int kept = 0;
+      for (const int* f = topo.edge_faces.begin(e); f != topo.edge_faces.end(e); ++f)
+        kept += state[piece[*f]] != 1;
+      *non_manifold_left += kept > 2;
+    }
   return result;
 }
 

@@ -353,7 +353,7 @@ TriMesh without_duplicate_faces(const TriMesh& mesh, std::vector<int>& input_fac
 // change. Unchanged (same vertex order) when there are none.
 TriMesh without_fins(const TriMesh& mesh, std::vector<int>& input_face,
                      std::vector<int>& input_vertex, SurfaceQuiltingStats& stats) {
-  const std::vector<int> fins = fin_faces(mesh);
+  const std::vector<int> fins = fin_faces(mesh, 10.0, &stats.non_manifold_edges);
   if (fins.empty()) return mesh;
   std::vector<char> fin(static_cast<size_t>(mesh.num_faces()), 0);
   for (const int f : fins) fin[static_cast<size_t>(f)] = 1;
@@ -468,7 +468,6 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   std::vector<int> input_face;  // job.cleaned's faces -> base_in's
   job.cleaned = without_duplicate_faces(job.cleaned, input_face, &stats.duplicate_faces);
   job.cleaned = without_fins(job.cleaned, input_face, job.input_vertex, stats);
-  stats.non_manifold_edges = topology_report(job.cleaned).num_non_manifold_edges;
   // The shell grows along the normal: components turned inside out would hide the texture
   // inside the object.
   if (options.orient_outward) stats.flipped_components = orient_outward(job.cleaned);

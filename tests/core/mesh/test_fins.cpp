@@ -49,7 +49,10 @@ TEST(Fins, TrianglesStandingOnAGridAreFinsAndTheGridIsNot) {
     add_fin(m, a, b, 0.3);
   }
   EXPECT_EQ(topology_report(m).num_non_manifold_edges, 3);
-  EXPECT_EQ(fin_faces(m), (std::vector<int>{grid_faces, grid_faces + 1, grid_faces + 2}));
+  int left = -1;
+  EXPECT_EQ(fin_faces(m, 10.0, &left),
+            (std::vector<int>{grid_faces, grid_faces + 1, grid_faces + 2}));
+  EXPECT_EQ(left, 0);
 }
 
 TEST(Fins, AFinOfSeveralFacesIsOnePiece) {
@@ -73,7 +76,9 @@ TEST(Fins, PiecesOfComparableSizeAreNotFins) {
   m.F.resize(6, 3);
   m.F << 0, 2, 3, 0, 3, 1, 0, 1, 5, 0, 5, 4, 0, 6, 7, 0, 7, 1;
   EXPECT_EQ(topology_report(m).num_non_manifold_edges, 1);
-  EXPECT_TRUE(fin_faces(m).empty());
+  int left = -1;
+  EXPECT_TRUE(fin_faces(m, 10.0, &left).empty());
+  EXPECT_EQ(left, 1);
   // A fin on a piece less than ten times its area is kept too.
   TriMesh small = test::plane_grid(1, 1, 2, 2);
   const auto [a, b] = interior_edge(small, 0);
