@@ -37,6 +37,15 @@ def check(condition, message):
         raise AssertionError(message)
 
 
+def reported(operator, **properties):
+    """The error an operator reports (its RuntimeError's text); fails when it reports none."""
+    try:
+        operator(**properties)
+    except RuntimeError as e:
+        return str(e)
+    raise AssertionError("%s reported nothing" % operator.idname_py())
+
+
 def test(fn):
     start = time.monotonic()
     try:
@@ -232,11 +241,8 @@ def test_guidance_by_an_objects_axis_and_by_a_vertex_attribute():
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "attribute guidance run failed")
     check("Sphere_quilt" in bpy.data.objects, "no result")
     s.guide_attribute = "missing"
-    try:
-        bpy.ops.meshquilt.run()
-        check(False, "a missing attribute was not reported")
-    except RuntimeError as e:
-        check("no vertex vector attribute" in str(e), "reported: %s" % e)
+    message = reported(bpy.ops.meshquilt.run)
+    check("no vertex vector attribute" in message, "reported: %s" % message)
 
 
 @test
@@ -293,11 +299,8 @@ def test_engine_error_is_reported():
     run.cleanup()
     before = set(bpy.data.objects)
     # The operator reports the engine's message as an error (a RuntimeError for a script).
-    try:
-        bpy.ops.meshquilt.run()
-        check(False, "operator did not report the failure")
-    except RuntimeError as e:
-        check("zero size" in str(e), "reported: %s" % e)
+    message = reported(bpy.ops.meshquilt.run)
+    check("zero size" in message, "reported: %s" % message)
     check(set(bpy.data.objects) == before, "a failed run added an object")
     # A missing engine is an error too, not a crash.
     bpy.context.preferences.addons["meshquilt"].preferences.engine_path = "/nonexistent/meshquilt"
@@ -305,11 +308,8 @@ def test_engine_error_is_reported():
     path = os.environ.get("PATH", "")
     os.environ["PATH"] = "/nonexistent"
     try:
-        try:
-            bpy.ops.meshquilt.run()
-            check(False, "missing engine not reported")
-        except RuntimeError as e:
-            check("engine not found" in str(e), "reported: %s" % e)
+        message = reported(bpy.ops.meshquilt.run)
+        check("engine not found" in message, "reported: %s" % message)
     finally:
         os.environ["PATH"] = path
         enable_addon()
@@ -364,11 +364,8 @@ def test_import_a_command_line_result_with_element_ids_and_materials():
     # Not a PLY: an error in words, no object.
     bad = os.path.join(WORK, "not_a_result.ply")
     open(bad, "w").write("hello\n")
-    try:
-        bpy.ops.import_mesh.meshquilt_ply(filepath=bad)
-        check(False, "a bad file was not reported")
-    except RuntimeError as e:
-        check("cannot read not_a_result.ply" in str(e), "reported: %s" % e)
+    message = reported(bpy.ops.import_mesh.meshquilt_ply, filepath=bad)
+    check("cannot read not_a_result.ply" in message, "reported: %s" % message)
 
 
 @test
@@ -409,11 +406,7 @@ def test_memory_limit_refuses_the_job_in_the_artists_words():
         check(not s.estimate_fits, "the estimate fits a limit of 10 MiB")
         before = set(bpy.data.objects)
         start = time.monotonic()
-        try:
-            bpy.ops.meshquilt.run()
-            check(False, "a job over the limit was not refused")
-        except RuntimeError as e:
-            message = str(e)
+        message = reported(bpy.ops.meshquilt.run)
         check("memory limit of" in message and "raise Scale" in message and
               "Memory limit" in message and "--max" not in message, "reported: %s" % message)
         check(time.monotonic() - start < 15, "refused after %.1f s" % (time.monotonic() - start))
@@ -729,11 +722,8 @@ def test_remove_selected_elements_removes_them_from_the_quilt():
     bpy.ops.object.select_all(action="DESELECT")
     bpy.ops.object.mode_set(mode="EDIT")
     bpy.ops.mesh.select_all(action="DESELECT")
-    try:
-        bpy.ops.meshquilt.remove_selected()
-        check(False, "an empty selection was not reported")
-    except RuntimeError as e:
-        check("select faces" in str(e), "reported: %s" % e)
+    message = reported(bpy.ops.meshquilt.remove_selected)
+    check("select faces" in message, "reported: %s" % message)
     bpy.ops.object.mode_set(mode="OBJECT")
 
 

@@ -27,6 +27,12 @@ std::vector<std::string> names_in(const std::string& dir) {
   return names;
 }
 
+// Makes `path` a non-empty directory: a rename onto it fails.
+void block_rename(const std::string& path) {
+  fs::create_directory(path);
+  test::spit(path + "/keep", "x");
+}
+
 std::vector<std::string> sorted(std::vector<std::string> names) {
   std::sort(names.begin(), names.end());
   return names;
@@ -151,8 +157,7 @@ TEST(AtomicOutputFile, PairsCommitTogether) {
     AtomicOutputFile obj(dir + "/p.obj");
     mtl.append(std::string_view("new mtl\n"));
     obj.append(std::string_view("new obj\n"));
-    fs::create_directory(dir + "/p.obj");
-    test::spit(dir + "/p.obj/keep", "x");
+    block_rename(dir + "/p.obj");
     EXPECT_THROW(commit_together(mtl, obj), Error);
   }
   EXPECT_EQ(test::slurp(dir + "/p.mtl"), "old mtl\n");
@@ -171,8 +176,7 @@ TEST(AtomicOutputFile, ACompanionCommitsWithTheMeshOrNothingChanges) {
     AtomicOutputFile obj(dir + "/m.obj");
     mtl.append(std::string_view("new mtl\n"));
     obj.append(std::string_view("new obj\n"));
-    fs::create_directory(dir + "/m.json");
-    test::spit(dir + "/m.json/keep", "x");
+    block_rename(dir + "/m.json");
     EXPECT_ANY_THROW(commit_with(
         obj, dir + "/m.json", [] { return std::string("{}"); }, &mtl));
   }
@@ -213,8 +217,7 @@ TEST(AtomicOutputFile, AFailedRenamePutsBackEveryFileBeforeIt) {
     a.append(std::string_view("new a\n"));
     b.append(std::string_view("new b\n"));
     c.append(std::string_view("new c\n"));
-    fs::create_directory(dir + "/c");
-    test::spit(dir + "/c/keep", "x");
+    block_rename(dir + "/c");
     EXPECT_THROW(commit_together({&a, &b, &c}), Error);
   }
   EXPECT_EQ(test::slurp(dir + "/a"), "old a\n");
