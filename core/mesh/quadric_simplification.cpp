@@ -131,13 +131,15 @@ class QuadricCollapser {
     locked_ = multi_fan_vertices(mesh_.F, nv, topo);
     for (int e = 0; e < topo.num_edges(); ++e)
       if (topo.edge_faces.degree(e) != 2) locked_[topo.E(e, 0)] = locked_[topo.E(e, 1)] = 1;
+    for (const int v : options_.kept_vertices) locked_[v] = 1;
     for (int e = 0; e < topo.num_edges(); ++e) push(topo.E(e, 0), topo.E(e, 1));
   }
 
   // Collapses candidates cheapest first while the error stays within bounds.
   void run(QuadricSimplification& out) {
     Candidate c;
-    while (queue_.pop(c)) {
+    int faces = mesh_.num_faces();
+    while (faces > options_.target_faces && queue_.pop(c)) {
       if (!vertex_alive_[c.a] || !vertex_alive_[c.b]) continue;
       if (c.stamp_a != stamp_[c.a] || c.stamp_b != stamp_[c.b]) continue;
       // The cheaper direction first (ties: the lower index goes), then the other.
@@ -157,6 +159,7 @@ class QuadricCollapser {
       }
       if (from < 0) continue;
       collapse(from, to, shared);
+      faces -= 2;
       ++out.collapses;
       out.max_error = std::max(out.max_error, std::sqrt(cost));
     }
@@ -320,6 +323,8 @@ void QuadricSimplificationOptions::validate() const {
   MQ_CHECK(max_normal_turn_degrees > 0 && max_normal_turn_degrees < 180, InvalidInput,
            "simplification: the largest normal turn must be in (0, 180) degrees, got ",
            max_normal_turn_degrees);
+  MQ_CHECK(target_faces >= 0, InvalidInput,
+           "simplification: the target face count must not be negative, got ", target_faces);
 }
 
 QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
@@ -329,6 +334,9 @@ QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
   MQ_CHECK(nf == 0 || (mesh.F.minCoeff() >= 0 && mesh.F.maxCoeff() < nv), InvalidInput,
            "simplification: face index out of range [0, ", nv, ")");
   MQ_CHECK(mesh.V.allFinite(), InvalidInput, "simplification: vertex positions are not finite");
+  for (const int v : options.kept_vertices)
+    MQ_CHECK(v >= 0 && v < nv, InvalidInput, "simplification: kept vertex ", v,
+             " out of range [0, ", nv, ")");
   QuadricCollapser collapser(mesh, options);
   collapser.prepare();
   QuadricSimplification out;

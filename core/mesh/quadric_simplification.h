@@ -28,6 +28,12 @@ struct QuadricSimplificationOptions {
   // 1 equilateral, 0 degenerate) than this, unless the face was already worse (then none worse
   // than it was). In [0, 1].
   double min_quality = 0.3;
+  // Collapsing stops once the mesh has at most this many faces (0: no target; the error bound
+  // still stops it first where it is tighter). >= 0.
+  int target_faces = 0;
+  // Vertices never removed, besides those on boundaries and non-manifold edges (each in
+  // [0, #V)): for example the extremes that keep a bounding box.
+  std::vector<int> kept_vertices;
 
   // Throws InvalidInput for a value outside its range (above).
   void validate() const;
@@ -42,14 +48,15 @@ struct QuadricSimplification {
 };
 
 // Simplifies `mesh` by collapsing edges in order of quadric error while the error stays within
-// max_error. Vertices on boundary or non-manifold edges are never removed; a collapse is made
+// max_error (and the faces stay above target_faces). Vertices on boundary or non-manifold edges
+// and kept_vertices are never removed; a collapse is made
 // only where the surface stays a manifold (the link condition), no face flips or turns by more
 // than max_normal_turn_degrees, no face falls below min_quality, and no face repeats another.
 // Collapses are made cheapest first, up to a factor sqrt(2) in error (bucketed), in the order
 // they are found within that: deterministic, O(F) work for the queue.
 //   mesh  #V by 3, #F by 3, consistently oriented
-// Throws InvalidInput for out-of-range indices, non-finite coordinates or options outside their
-// ranges (options.validate()).
+// Throws InvalidInput for out-of-range indices (faces or kept_vertices), non-finite coordinates or
+// options outside their ranges (options.validate()).
 QuadricSimplification simplify_by_quadrics(const TriMesh& mesh,
                                            const QuadricSimplificationOptions& options);
 
