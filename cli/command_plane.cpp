@@ -21,7 +21,8 @@ namespace {
 // The --stats file's JSON (written with the mesh, as one commit).
 std::string stats_json(const PlanarQuiltingStats& s, const std::string& device, int threads,
                        double wall, const std::string& swatch, double length, double width,
-                       const StructureSummary& structure) {
+                       const StructureSummary& structure, const ElementDetail& detail,
+                       double detail_share) {
   JsonWriter j;
   j.begin_object()
       .value("command", "plane")
@@ -46,6 +47,7 @@ std::string stats_json(const PlanarQuiltingStats& s, const std::string& device, 
   write_match_counts(j, s.counts);
   j.value("matched_point_offsets", s.matched_point_offsets);
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
+  write_detail(j, detail, detail_share);
   j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
@@ -64,6 +66,7 @@ void declare_plane_options(CommandLine& cl) {
             "where large translation-cost evaluations run (small ones stay on the CPU)", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
   cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
+  add_detail_option(cl);
   add_output_options(cl);
   add_run_options(cl);
 }
@@ -116,11 +119,13 @@ int run_plane(int argc, char** argv, int first) {
   check_paths(outputs, {cl.get("swatch")});
 
   const PlanarQuiltingOptions options = plane_options(cl);
+  const double detail = detail_share(cl);
   const Device device = parse_device(cl.get("device"));
 
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
-  const TriMesh swatch = read_mesh(cl.get("swatch"));
+  const ElementDetail swatch_detail = read_swatch(cl.get("swatch"), detail);
+  const TriMesh& swatch = swatch_detail.mesh;
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   PlanarQuiltingStats stats;
   const TriMesh result = quilt_plane(swatch, options, *evaluator, &stats, run.progress());
@@ -141,10 +146,11 @@ int run_plane(int argc, char** argv, int first) {
   const double wall = write_output_and_stats(
       run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
         return stats_json(stats, evaluator->name(), run.threads(), w, cl.get("swatch"),
-                          options.length, options.width, structure);
+                          options.length, options.width, structure, swatch_detail, detail);
       });
   run.progress()->finish();
   if (!run.quiet()) {
+    print_detail(swatch_detail, detail);
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);

@@ -39,7 +39,8 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
                        double wall, const std::string& base, const std::string& swatch,
                        const std::string& method, const GlobalQuiltingStats* global,
                        const StructureSummary& structure, double memory_limit_bytes,
-                       double min_coverage, double swatch_cover) {
+                       double min_coverage, double swatch_cover, const ElementDetail& detail,
+                       double detail_share) {
   // The global layout counts its output exactly before building it; else the estimate made
   // before any work.
   const double estimated_faces =
@@ -167,6 +168,7 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
         .value("short_threads", global->short_threads)
         .end_object();
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
+  write_detail(j, detail, detail_share);
   j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   for (const auto& [stage, seconds] : em.times.stages()) j.value(stage, seconds);
@@ -241,6 +243,7 @@ int run_surface(int argc, char** argv, int first) {
             "also save the result in local coordinates over the base (elements, their kinds, "
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
             "again on the base moved (posed, animated) without a new synthesis");
+  add_detail_option(cl);
   add_output_options(cl);
   add_run_options(cl);
   if (!cl.parse(argc, argv, first)) return 0;
@@ -277,6 +280,7 @@ int run_surface(int argc, char** argv, int first) {
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
   const double min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
+  const double detail = detail_share(cl);
   options.global.drop_folded_pieces = !embedding.shell_map;
   options.max_faces = face_limit(cl);
   const Device device = parse_device(cl.get("device"));
@@ -295,7 +299,10 @@ int run_surface(int argc, char** argv, int first) {
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
   const TriMesh base = read_mesh(cl.get("base"));
-  const TriMesh swatch = read_mesh(cl.get("swatch"));
+  TriMesh full_swatch;
+  const ElementDetail swatch_detail = read_swatch(cl.get("swatch"), detail, &full_swatch);
+  const TriMesh& swatch = swatch_detail.mesh;
+  if (detail < 1) options.full_detail_swatch = &full_swatch;
   // Finite coordinates whose extent overflows (1e300) would make every size estimate NaN.
   for (const auto& [mesh, name] :
        {std::pair<const TriMesh*, std::string>{&base, cl.get("base")}, {&swatch, cl.get("swatch")}})
@@ -407,7 +414,8 @@ int run_surface(int argc, char** argv, int first) {
     header.origin = "surface --swatch " + cl.get("swatch") + " --method " + method +
                     (cl.has("element-size") ? " --element-size " + cl.get("element-size")
                                             : " --scale " + cl.get("scale")) +
-                    (cl.has("mask") ? " --mask " + cl.get("mask") : std::string()) + " --seed " +
+                    (cl.has("mask") ? " --mask " + cl.get("mask") : std::string()) +
+                    (detail < 1 ? " --detail " + cl.get("detail") : std::string()) + " --seed " +
                     cl.get("seed");
     saved = make_saved_quilt(quilt, result, header);
   }
@@ -431,10 +439,11 @@ int run_surface(int argc, char** argv, int first) {
                           : vines ? "vines"
                                   : "patches",
                           global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
-                          own_coverage);
+                          own_coverage, swatch_detail, detail);
       });
   run.progress()->finish();
   if (!run.quiet()) {
+    print_detail(swatch_detail, detail);
     std::printf(
         "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
         "covered\n",

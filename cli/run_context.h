@@ -11,7 +11,9 @@
 
 #include "cli/command_line.h"
 #include "cli/console_progress.h"
+#include "cli/json_writer.h"
 #include "core/common/stage_timer.h"
+#include "core/mesh/element_detail.h"
 #include "core/mesh/mesh_io.h"
 #include "host/device.h"
 
@@ -64,6 +66,22 @@ std::vector<std::string> output_files(const std::string& path, const WriteOption
 // Writes a result mesh: its normals are computed per corner by the writer (write_mesh) rather
 // than carried from the quilting (element normals would smooth over sharp edges).
 void write_output(const std::string& path, TriMesh mesh, const WriteOptions& options);
+
+// --detail F for the commands that grow a swatch: each element simplified to a share F of its
+// faces (a fast Preview, or a lighter result; issue 26).
+void add_detail_option(CommandLine& cl);
+
+// --detail's value; throws UsageError outside (0, 1] (before any work).
+double detail_share(const CommandLine& cl);
+
+// The swatch at `path` at a share of its detail (core/mesh/element_detail.h), with the element
+// counts before and after; `full` (optional) receives the swatch as read. Throws as read_mesh
+// and reduce_element_detail do.
+ElementDetail read_swatch(const std::string& path, double share, TriMesh* full = nullptr);
+
+// The detail's line of a run's summary (nothing at full detail) and its --stats entry.
+void print_detail(const ElementDetail& detail, double share);
+void write_detail(JsonWriter& j, const ElementDetail& detail, double share);
 
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {

@@ -502,8 +502,9 @@ namespace {
 // parameterised surface, placed from the face holding its centre. The output is counted before
 // anything is built, and refused over max_faces.
 std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, const SurfaceJob& job,
-                                          const PreparedSwatch& swatch, const SwatchSymmetry& sym,
-                                          const Vector2d& lo, const SurfaceQuiltingOptions& options,
+                                          const PreparedSwatch& swatch, const PreparedSwatch& full,
+                                          const SwatchSymmetry& sym, const Vector2d& lo,
+                                          const SurfaceQuiltingOptions& options,
                                           GlobalQuiltingStats& gstats, StageTimes& times,
                                           ProgressSink* progress) {
   const double max_faces = options.max_faces;
@@ -513,9 +514,10 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
   {
     ScopedStageTimer timer(times, "tiling");
     ScopedStageProgress shown(progress, "tiling");
-    reps = orbit_representatives(swatch, sym);
+    // The orbits and their centres at full detail: a Preview places the same copies.
+    reps = orbit_representatives(full, sym);
     gstats.orbits = static_cast<int>(reps.size());
-    for (const int r : reps) centres.push_back(element_centre(swatch.elements[r]) + lo);
+    for (const int r : reps) centres.push_back(element_centre(full.elements[r]) + lo);
     copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
     double faces = 0;
     for (const LatticeCopy& c : copies)
@@ -871,14 +873,23 @@ DirectionField layout_line_field(const MatrixX3d& V, const SurfaceJob& job,
   return df;
 }
 
-// The global method from a prepared job and the swatch's symmetry (found on job.swatch).
-// threads: the swatch's thread tiling when known (empty: found here when the swatch is no
+// The thread pieces cut at full detail, then simplified to the swatch's (reduce_piece_detail).
+ThreadTiling detailed_thread_tiling(const PreparedSwatch& swatch, const PreparedSwatch& full,
+                                    const SwatchSymmetry& symmetry) {
+  ThreadTiling tiling = thread_tiling(full, symmetry);
+  if (&full != &swatch) reduce_piece_detail(tiling, full, swatch);
+  return tiling;
+}
+
+// The global method from a prepared job and the swatch's symmetry (found on `full`: the swatch
+// at full detail, `swatch` itself unless job.full_swatch was given). threads: the swatch's
+// thread tiling at swatch's detail when known (empty: found here when the swatch is no
 // lattice of compact elements). unfit (optional): set, and nothing placed or returned, when the
 // swatch is a lattice of threads and the layout cannot carry its tiling
 // (layout_fit_for_tiling); the caller quilts otherwise.
 SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch,
-                                   const SwatchSymmetry& symmetry, ThreadTiling threads,
-                                   const SurfaceQuiltingOptions& options,
+                                   const PreparedSwatch& full, const SwatchSymmetry& symmetry,
+                                   ThreadTiling threads, const SurfaceQuiltingOptions& options,
                                    TranslationCostEvaluator& evaluator, SurfaceQuiltingStats stats,
                                    SurfaceQuiltingStats* stats_out, GlobalQuiltingStats* global_out,
                                    ProgressSink* progress, bool* unfit = nullptr) {
@@ -960,13 +971,15 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     lo = anchor - shift;
   }
   std::vector<SurfaceElement> placed;
-  if (options.global.tile && tileable(swatch, symmetry)) {
+  if (options.global.tile && tileable(full, symmetry)) {
     gstats.tiled = true;
     stats.iterations = 1;
     stats.cell_size = matching_cell_size(swatch);
-    placed = place_lattice(gp, job, swatch, symmetry, lo, options, gstats, times, progress);
+    placed = place_lattice(gp, job, swatch, full, symmetry, lo, options, gstats, times, progress);
   } else if (options.global.tile &&
-             !(threads.empty() ? (threads = thread_tiling(swatch, symmetry)) : threads).empty()) {
+             !(threads.empty() ? (threads = detailed_thread_tiling(swatch, full, symmetry))
+                               : threads)
+                  .empty()) {
     if (unfit && !layout_fit_for_tiling(gp, base)) {
       *unfit = true;
       return {};
@@ -1049,9 +1062,12 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
-  const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
-  return quilt_prepared_global(job, swatch, symmetry, {}, options, evaluator, std::move(stats),
-                               stats_out, global_out, progress);
+  const PreparedSwatch full =
+      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
+  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+  const SwatchSymmetry symmetry = timed_symmetry(deciding, stats.times);
+  return quilt_prepared_global(job, swatch, deciding, symmetry, {}, options, evaluator,
+                               std::move(stats), stats_out, global_out, progress);
 }
 
 SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_mesh,
@@ -1063,26 +1079,30 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
+  // The method and the lattice are decided at full detail (a Preview is the same layout).
+  const PreparedSwatch full =
+      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
+  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
   bool repeating = false, threads = false;
   {
     ScopedStageTimer timer(stats.times, "method choice");
-    repeating = repeating_elements(swatch);
-    threads = !repeating && long_elements(swatch);
+    repeating = repeating_elements(deciding);
+    threads = !repeating && long_elements(deciding);
   }
   if (repeating || threads) {
     // The symmetry decides and, for a lattice, is the one the layout uses: found once.
-    const SwatchSymmetry symmetry = timed_symmetry(swatch, stats.times);
+    const SwatchSymmetry symmetry = timed_symmetry(deciding, stats.times);
     ThreadTiling tiling;
     bool global = false;
     {
       ScopedStageTimer timer(stats.times, "method choice");
-      global = repeating ? tileable(swatch, symmetry)
-                         : !(tiling = thread_tiling(swatch, symmetry)).empty();
+      global = repeating ? tileable(deciding, symmetry)
+                         : !(tiling = detailed_thread_tiling(swatch, deciding, symmetry)).empty();
     }
     if (global && repeating) {
       if (used_global) *used_global = true;
-      return quilt_prepared_global(job, swatch, symmetry, std::move(tiling), options, evaluator,
-                                   std::move(stats), stats_out, global_out, progress);
+      return quilt_prepared_global(job, swatch, deciding, symmetry, std::move(tiling), options,
+                                   evaluator, std::move(stats), stats_out, global_out, progress);
     }
     if (global) {
       // Threads: the layout is made first, and where it cannot carry the tiling (a base of
@@ -1090,8 +1110,8 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
       const auto start = std::chrono::steady_clock::now();
       bool unfit = false;
       SurfaceQuilt quilt =
-          quilt_prepared_global(job, swatch, symmetry, std::move(tiling), options, evaluator, stats,
-                                stats_out, global_out, progress, &unfit);
+          quilt_prepared_global(job, swatch, deciding, symmetry, std::move(tiling), options,
+                                evaluator, stats, stats_out, global_out, progress, &unfit);
       if (!unfit) {
         if (used_global) *used_global = true;
         return quilt;
@@ -1106,7 +1126,7 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   bool vines = false;
   {
     ScopedStageTimer timer(stats.times, "method choice");
-    vines = is_vine_swatch(swatch);
+    vines = is_vine_swatch(deciding);
   }
   if (vines) {
     if (used_vines) *used_vines = true;

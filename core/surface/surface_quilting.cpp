@@ -535,6 +535,10 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   // The swatch at its size on the surface (section 3.1's relative size s).
   job.swatch = swatch_mesh;
   job.swatch.V *= job.swatch_scale;
+  if (options.full_detail_swatch) {
+    job.full_swatch = *options.full_detail_swatch;
+    job.full_swatch.V *= job.swatch_scale;
+  }
   stats.swatch_scale = job.swatch_scale;
   return job;
 }

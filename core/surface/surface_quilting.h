@@ -67,6 +67,11 @@ struct SurfaceQuiltingOptions {
   double element_size = 0;
   // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
   MatrixX3d field;
+  // When the swatch given is one at lower detail (core/mesh/element_detail.h), the swatch it was
+  // made from: its symmetry decides the method and the global layout's lattice, which the
+  // simplified copies keep only approximately (no exact half turn), so that a Preview and the
+  // full run are the same layout. Not owned; null: the swatch given decides.
+  const TriMesh* full_detail_swatch = nullptr;
   // Local patches grow to this many times the swatch's footprint area (paper: "up to an area
   // threshold"); 0: a disk reaching the farthest swatch corner of any admissible placement. A
   // patch whose area distortion exceeds max_distortion is shrunk (paper: 4), judged by the 95th
@@ -184,6 +189,7 @@ struct SurfaceJob {
   MatrixX3i TT;
   double swatch_scale = 0;  // factor applied to the swatch
   TriMesh swatch;           // the swatch scaled by it
+  TriMesh full_swatch;      // options.full_detail_swatch scaled by it (empty: none given)
 };
 
 // The factor taking swatch units to base units for SurfaceQuiltingOptions::scale = `scale`: the

@@ -10,6 +10,9 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "core/common/errors.h"
+#include "core/mesh/element_detail.h"
+
 namespace mq {
 
 namespace {
@@ -690,6 +693,40 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
     st.welds += is_dropped(x.a) || is_dropped(x.b) || !kept[static_cast<size_t>(x.a)] ? 0 : 1;
   if (stats) *stats = st;
   return out;
+}
+
+void reduce_piece_detail(ThreadTiling& tiling, const PreparedSwatch& full,
+                         const PreparedSwatch& detailed) {
+  tbb::parallel_for(size_t(0), tiling.pieces.size(), [&](size_t i) {
+    ThreadPiece& p = tiling.pieces[i];
+    const double share = static_cast<double>(detailed.elements[p.source].F.rows()) /
+                         static_cast<double>(full.elements[p.source].F.rows());
+    if (!(share < 1)) return;
+    TriMesh tube;
+    tube.V = p.V;
+    tube.F = p.F;
+    QuadricSimplification s = simplify_to_share(tube, share, ElementDetailOptions().min_faces);
+    // The loops are on the tube's boundary, which stays; the centres (on no face) go back on.
+    std::vector<int> index(static_cast<size_t>(p.V.rows()), -1);
+    for (size_t v = 0; v < s.origin_vertex.size(); ++v)
+      index[s.origin_vertex[v]] = static_cast<int>(v);
+    MatrixX3d V = s.mesh.V;
+    for (int* centre : {&p.start_centre, &p.end_centre}) {
+      if (index[*centre] < 0) {
+        V.conservativeResize(V.rows() + 1, 3);
+        V.row(V.rows() - 1) = p.V.row(*centre);
+        index[*centre] = static_cast<int>(V.rows() - 1);
+      }
+      *centre = index[*centre];
+    }
+    for (std::vector<int>* loop : {&p.start, &p.end})
+      for (int& v : *loop) {
+        MQ_ASSERT(index[v] >= 0);  // a cut loop is on the boundary, which stays
+        v = index[v];
+      }
+    p.V = std::move(V);
+    p.F = std::move(s.mesh.F);
+  });
 }
 
 }  // namespace mq

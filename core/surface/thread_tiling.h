@@ -62,6 +62,14 @@ bool long_elements(const PreparedSwatch& swatch);
 // distance to the swatch's other vertices.
 ThreadTiling thread_tiling(const PreparedSwatch& swatch, const SwatchSymmetry& symmetry);
 
+// The pieces at the detail of `detailed` (the swatch `full` they were cut from after
+// reduce_element_detail, core/mesh/element_detail.h, elements in the same order): each piece's
+// tube simplified to the share of faces its source element kept, its cut loops and their
+// centres staying as they are, so the pieces still weld into threads. Pieces are cut at full
+// detail because a simplified thread has no clean cross-section one period from another.
+void reduce_piece_detail(ThreadTiling& tiling, const PreparedSwatch& full,
+                         const PreparedSwatch& detailed);
+
 // A piece placed over the surface: the copy of tiling.pieces[piece] in local coordinates (its
 // vertices in the piece's order).
 struct PlacedPiece {

@@ -160,7 +160,12 @@ int find_vine(const PreparedSwatch& swatch, std::vector<ElementLength>* lengths)
   return long_count == 1 ? vine : -1;
 }
 
-VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index) {
+// The vine of `swatch` (at full detail: its centreline and leaf positions are measured there).
+// detailed (optional): the swatch at lower detail (core/mesh/element_detail.h, same element
+// order): the leaves take its geometry, placed as the full ones, and the stem's tube its share
+// of faces (as many fewer sides as cross-sections).
+VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
+                       const PreparedSwatch* detailed = nullptr) {
   const Element& vine = swatch.elements[static_cast<size_t>(vine_index)];
   VineModel m;
   m.kind = vine.kind;
@@ -280,37 +285,48 @@ VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index) {
     return (centre_v(u + width) - centre_v(u - width)) /
            (std::min(u + width, u1) - std::max(u - width, u0));
   };
+  // A leaf's vertices in the vine's straight frame at its attach point, as in the swatch.
+  const auto pose_leaf = [&](const Element& el, SwatchLeaf& leaf) {
+    leaf.F = el.F;
+    leaf.P.resize(el.V.rows(), 3);
+    const double ua = u0 + leaf.attach, va = centre_v(ua), t = std::atan(centre_slope(ua));
+    const double c = std::cos(t), s = std::sin(t);
+    for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
+      const Vector3d q = frame(el.V.row(i).transpose());
+      const double du = q.x() - ua, dv = q.y() - va;
+      // Heights follow the blended centreline's (the vine's lift changes little along it).
+      leaf.P.row(i) << c * du + s * dv, -s * du + c * dv, std::max(0.0, q.z() + hz(leaf.attach));
+    }
+  };
   for (size_t e = 0; e < swatch.elements.size(); ++e) {
     if (static_cast<int>(e) == vine_index) continue;
     const Element& el = swatch.elements[e];
     SwatchLeaf leaf;
     leaf.kind = el.kind;
-    leaf.F = el.F;
-    leaf.P.resize(el.V.rows(), 3);
     double nearest = kInf;
     for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
       const Vector3d q = frame(el.V.row(i).transpose());
-      leaf.P.row(i) = q.transpose();
       const double d = std::abs(q.y() - centre_v(q.x()));
       if (d < nearest) {
         nearest = d;
         leaf.attach = std::clamp(q.x(), u0, u1) - u0;
       }
     }
-    const double ua = u0 + leaf.attach, va = centre_v(ua), t = std::atan(centre_slope(ua));
-    const double c = std::cos(t), s = std::sin(t);
-    for (Eigen::Index i = 0; i < leaf.P.rows(); ++i) {
-      const double du = leaf.P(i, 0) - ua, dv = leaf.P(i, 1) - va;
-      leaf.P(i, 0) = c * du + s * dv;
-      leaf.P(i, 1) = -s * du + c * dv;
-    }
-    // Heights follow the blended centreline's (the vine's lift changes little along it).
-    leaf.P.col(2).array() += hz(leaf.attach);
-    leaf.P.col(2) = leaf.P.col(2).cwiseMax(0.0);
+    pose_leaf(el, leaf);
+    m.reach = std::max(m.reach, m.pose(leaf, leaf.attach).col(1).cwiseAbs().maxCoeff());
+    // At lower detail: the simplified leaf where the full one sits (the reach and the spacing
+    // stay the full run's).
+    if (detailed) pose_leaf(detailed->elements[e], leaf);
     m.leaves.push_back(std::move(leaf));
   }
-  for (const SwatchLeaf& leaf : m.leaves)
-    m.reach = std::max(m.reach, m.pose(leaf, leaf.attach).col(1).cwiseAbs().maxCoeff());
+  if (detailed) {
+    // The stem's faces go as segments / ring_spacing: both by the square root of the share.
+    const double share = static_cast<double>(detailed->elements[vine_index].F.rows()) /
+                         static_cast<double>(vine.F.rows());
+    const double k = std::sqrt(std::min(1.0, share));
+    m.segments = std::max(6, static_cast<int>(std::lround(m.segments * k)));
+    m.ring_spacing = std::min(m.period / 4, m.ring_spacing / k);
+  }
   return m;
 }
 
@@ -1056,13 +1072,21 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   VineGrowthStats vs;
   PreparedSwatch swatch;
   VineModel model;
+  double spacing = 0;  // between stems, for the vine at full detail (the Preview's is the same)
   {
     ScopedStageTimer timer(times, "prepare");
     swatch = prepare_swatch(job.swatch);
-    MQ_CHECK(is_vine_swatch(swatch), InvalidInput,
+    // Measured at full detail, so that a Preview grows the full run's stems.
+    const PreparedSwatch full =
+        job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
+    const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+    MQ_CHECK(is_vine_swatch(deciding), InvalidInput,
              "the vine method needs a swatch of one long element (a vine) with compact elements "
              "attached along it");
-    model = analyse_vine(swatch, find_vine(swatch, nullptr));
+    const int vine = find_vine(deciding, nullptr);
+    model = analyse_vine(deciding, vine);
+    spacing = parallel_spacing(model);
+    if (!job.full_swatch.empty()) model = analyse_vine(deciding, vine, &swatch);
   }
   const TriMesh& base = job.base;
   const int nf = base.num_faces();
@@ -1090,7 +1114,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   }
 
   StreamlineOptions so;
-  so.separation = vo.spacing * parallel_spacing(model);
+  so.separation = vo.spacing * spacing;
   so.stop = std::max(vo.stop_fraction * so.separation, 2 * model.extent + model.radius);
   // Lower than Jobard and Lefer's d_sep: distances are taken straight through space, which is
   // shorter than along the surface around a box's edge, where seeds at the spacing beside a

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/mesh/element_detail.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/planar/planar_quilting.h"
@@ -179,10 +180,8 @@ TEST(ThreadTiling, ChainMailApplesAndIvyAreNoThreads) {
 // Pieces placed by hand over a flat base, two meeting end to end and one apart: the two are
 // welded into one thread (the shared loop once, caps at its two ends), the third capped alone;
 // each a closed, manifold tube enclosing positive volume.
-TEST(ThreadTiling, WeldedPiecesAreOneClosedManifoldThread) {
-  const Detected d = detect(weave());
-  const ThreadTiling tiling = thread_tiling(d.swatch, d.symmetry);
-  ASSERT_FALSE(tiling.empty());
+// Three copies of the first piece, two of them one period apart, welded: two closed threads.
+void expect_pieces_weld(const ThreadTiling& tiling) {
   const ThreadPiece& p = tiling.pieces[0];
   // One large triangle under everything: local coordinates are its barycentric weights.
   TriMesh base;
@@ -254,6 +253,41 @@ TEST(ThreadTiling, WeldedPiecesAreOneClosedManifoldThread) {
   EXPECT_EQ(stats.caps, 4);
   EXPECT_EQ(weld_threads(placed, tiling, welds, {}, &stats, nullptr, 2).size(), 1u);
   EXPECT_EQ(stats.short_threads, 1);
+}
+
+TEST(ThreadTiling, WeldedPiecesAreOneClosedManifoldThread) {
+  const Detected d = detect(weave());
+  const ThreadTiling tiling = thread_tiling(d.swatch, d.symmetry);
+  ASSERT_FALSE(tiling.empty());
+  expect_pieces_weld(tiling);
+}
+
+// At lower detail (--detail, issue 26's Preview) the pieces are cut at full detail and then
+// simplified with their cut loops kept: they weld as before, into closed threads that do not
+// intersect themselves.
+TEST(ThreadTiling, PiecesAtLowerDetailStillWeld) {
+  const TriMesh mesh = weave();
+  const Detected d = detect(mesh);
+  ElementDetailOptions o;
+  o.detail = 0.3;
+  const PreparedSwatch low = prepare_swatch(reduce_element_detail(mesh, o).mesh);
+  ThreadTiling tiling = thread_tiling(d.swatch, d.symmetry);
+  ASSERT_FALSE(tiling.empty());
+  const ThreadTiling full = tiling;
+  reduce_piece_detail(tiling, d.swatch, low);
+  ASSERT_EQ(tiling.pieces.size(), full.pieces.size());
+  for (size_t i = 0; i < tiling.pieces.size(); ++i) {
+    const ThreadPiece &a = full.pieces[i], &b = tiling.pieces[i];
+    EXPECT_LT(b.F.rows(), 0.45 * static_cast<double>(a.F.rows())) << i;
+    ASSERT_EQ(b.start.size(), a.start.size());
+    for (size_t k = 0; k < a.start.size(); ++k) {  // the cut loops where they were
+      EXPECT_EQ(b.V.row(b.start[k]), a.V.row(a.start[k]));
+      EXPECT_EQ(b.V.row(b.end[k]), a.V.row(a.end[k]));
+    }
+    EXPECT_EQ(b.V.row(b.start_centre), a.V.row(a.start_centre));
+    EXPECT_EQ(b.V.row(b.end_centre), a.V.row(a.end_centre));
+  }
+  expect_pieces_weld(tiling);
 }
 
 struct WeaveRun {
