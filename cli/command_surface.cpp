@@ -176,13 +176,8 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
   return j.str();
 }
 
-}  // namespace
-
-int run_surface(int argc, char** argv, int first) {
-  CommandLine cl("surface", "--base BASE --swatch SW -o OUT [options]",
-                 "Covers a base mesh (closed or with boundary, any genus, several components)\n"
-                 "with the swatch's geometry inside a thin shell over its surface, by mesh\n"
-                 "quilting over local conformal patches (paper section 3.1).");
+// The command's options (declared once, read by parse_surface_request).
+void declare_surface_options(CommandLine& cl) {
   cl.option("base", "FILE", "base mesh (OBJ, PLY or OFF)");
   cl.option("swatch", "FILE", "swatch mesh; its smallest bounding-box side is the shell height");
   cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
@@ -246,16 +241,33 @@ int run_surface(int argc, char** argv, int first) {
   add_detail_option(cl);
   add_output_options(cl);
   add_run_options(cl);
-  if (!cl.parse(argc, argv, first)) return 0;
+}
+
+// What the command line asks, checked before any work: usage errors (exit 2) and unwritable
+// output paths (exit 1) come before a file is read.
+struct SurfaceRequest {
+  std::string out_path;
+  WriteOptions write_options;
+  SurfaceQuiltingOptions options;
+  QuiltEmbeddingOptions embedding;
+  std::string embedding_name;  // shell | normal
+  std::string method;          // auto | global | patches | vines
+  double min_coverage = 0;
+  double detail = 1;
+  Device device = Device::Auto;
+};
+
+SurfaceRequest parse_surface_request(const CommandLine& cl) {
   if (!cl.has("base")) throw UsageError("--base FILE is required");
   if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
   if (!cl.has("output")) throw UsageError("-o OUT is required");
   if (cl.has("field") + cl.has("field-file") + cl.has("keys") > 1)
     throw UsageError("give at most one of --field, --field-file and --keys");
-  const std::string out_path = cl.get("output");
-  mesh_format_from_path(out_path);
-  const WriteOptions write_options = output_options(cl);
-  std::vector<std::string> outputs = output_files(out_path, write_options);
+  SurfaceRequest r;
+  r.out_path = cl.get("output");
+  mesh_format_from_path(r.out_path);
+  r.write_options = output_options(cl);
+  std::vector<std::string> outputs = output_files(r.out_path, r.write_options);
   outputs.push_back(cl.get("stats"));
   outputs.push_back(cl.get("save-quilt"));
   check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys"),
@@ -263,7 +275,7 @@ int run_surface(int argc, char** argv, int first) {
   if (cl.has("scale") && cl.has("element-size"))
     throw UsageError("give --scale or --element-size, not both");
 
-  SurfaceQuiltingOptions options;
+  SurfaceQuiltingOptions& options = r.options;
   options.scale = cl.get_double("scale", 0, 1e-6, 10.0);
   if (cl.has("element-size")) options.element_size = cl.get_double("element-size", 0, 1e-300);
   options.seed = static_cast<uint64_t>(cl.get_int("seed", 0, (1LL << 62)));
@@ -271,19 +283,19 @@ int run_surface(int argc, char** argv, int first) {
   options.patch.deform = !cl.has("no-deform");
   options.orient_outward = !cl.has("keep-orientation");
   if (cl.has("no-proxy")) options.proxy_min_faces = 0;
-  QuiltEmbeddingOptions embedding;
-  const std::string embedding_name = cl.get("embedding");
-  if (embedding_name != "shell" && embedding_name != "normal")
-    throw UsageError("--embedding expects shell or normal, got '" + embedding_name + "'");
-  embedding.shell_map = embedding_name == "shell";
+  QuiltEmbeddingOptions& embedding = r.embedding;
+  r.embedding_name = cl.get("embedding");
+  if (r.embedding_name != "shell" && r.embedding_name != "normal")
+    throw UsageError("--embedding expects shell or normal, got '" + r.embedding_name + "'");
+  embedding.shell_map = r.embedding_name == "shell";
   embedding.optimize_stretch = !cl.has("no-stretch-opt");
   embedding.remove_intersecting = !cl.has("keep-intersecting");
   embedding.seed = options.seed;
-  const double min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
-  const double detail = detail_share(cl);
+  r.min_coverage = cl.get_double("min-coverage", 0, 0.0, 1.0);
+  r.detail = detail_share(cl);
   options.global.drop_folded_pieces = !embedding.shell_map;
   options.max_faces = face_limit(cl);
-  const Device device = parse_device(cl.get("device"));
+  r.device = parse_device(cl.get("device"));
   const std::string placement = cl.get("element-placement");
   if (placement == "layout")
     options.global.placement = SurfaceQuiltingOptions::Global::Placement::kLayout;
@@ -292,17 +304,26 @@ int run_surface(int argc, char** argv, int first) {
   else if (placement != "adaptive")
     throw UsageError("--element-placement expects adaptive, layout or rigid, got '" + placement +
                      "'");
-  const std::string method = cl.get("method");
-  if (method != "auto" && method != "global" && method != "patches" && method != "vines")
-    throw UsageError("--method expects auto, global, patches or vines, got '" + method + "'");
+  r.method = cl.get("method");
+  if (r.method != "auto" && r.method != "global" && r.method != "patches" && r.method != "vines")
+    throw UsageError("--method expects auto, global, patches or vines, got '" + r.method + "'");
+  return r;
+}
 
-  RunContext run(cl);
-  const auto start = std::chrono::steady_clock::now();
-  const TriMesh base = read_mesh(cl.get("base"));
-  TriMesh full_swatch;
-  const ElementDetail swatch_detail = read_swatch(cl.get("swatch"), detail, &full_swatch);
-  const TriMesh& swatch = swatch_detail.mesh;
-  if (detail < 1) options.full_detail_swatch = &full_swatch;
+// The inputs, read and checked against the request (sizes relative to the base); the guidance
+// field goes into r.options.
+struct SurfaceInputs {
+  TriMesh base;
+  ElementDetail swatch;  // at --detail (its mesh is the swatch quilted)
+  TriMesh full_swatch;   // as read
+  SurfaceMask mask;      // empty without --mask
+};
+
+void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs& in) {
+  SurfaceQuiltingOptions& options = r.options;
+  in.base = read_mesh(cl.get("base"));
+  in.swatch = read_swatch(cl.get("swatch"), r.detail, &in.full_swatch);
+  const TriMesh &base = in.base, &swatch = in.swatch.mesh;
   // Finite coordinates whose extent overflows (1e300) would make every size estimate NaN.
   for (const auto& [mesh, name] :
        {std::pair<const TriMesh*, std::string>{&base, cl.get("base")}, {&swatch, cl.get("swatch")}})
@@ -330,7 +351,7 @@ int run_surface(int argc, char** argv, int first) {
       !(options.element_size >= 1e-6 * diagonal && options.element_size <= 10 * diagonal))
     throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
                      std::to_string(diagonal));
-  const SurfaceMask mask = cl.has("mask") ? read_surface_mask(cl.get("mask"), base) : SurfaceMask();
+  if (cl.has("mask")) in.mask = read_surface_mask(cl.get("mask"), base);
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));
@@ -343,184 +364,234 @@ int run_surface(int argc, char** argv, int first) {
     options.field = tangent_field_from_key_vectors(
         base.V, base.F, read_key_vectors(cl.get("keys"), base.num_vertices()));
   }
+}
+
+// --estimate: the job's size before any synthesis, one line (issue 26: the add-on shows it
+// before Run).
+void print_estimate(const CommandLine& cl, const SurfaceRequest& r, const SurfaceInputs& in) {
+  const TriMesh &base = in.base, &swatch = in.swatch.mesh;
+  // The size before any synthesis (issue 26: the add-on shows it before Run): the method's
+  // own count, as the run checks it against --max-faces (the global layout's lattice copies,
+  // within 5% of the faces written on the gallery's chain mail; the vines' stems at their
+  // spacing, within 6% on the ivy wall, David and Spot; the preparation's for the patches).
+  SurfaceQuiltingOptions counting = r.options;
+  counting.max_faces = std::numeric_limits<double>::infinity();
+  counting.global.count_only = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats estimate;
+  GlobalQuiltingStats layout;
+  bool global = r.method == "global", vines = r.method == "vines";
+  if (r.method == "auto")
+    quilt_surface_auto(base, swatch, counting, cpu, &estimate, &layout, nullptr, &global, &vines);
+  else if (global)
+    quilt_surface_global(base, swatch, counting, cpu, &estimate, &layout);
+  else if (vines)
+    quilt_surface_vines(base, swatch, counting, {}, &estimate);
+  else
+    prepare_surface_job(base, swatch, counting, estimate);
+  // Under a mask only the masked part is kept (whole elements, about as many as its area).
+  const double faces =
+      (global && layout.layout_faces > 0 ? layout.layout_faces : estimate.estimated_faces) *
+      (cl.has("mask") ? masked_area_share(in.mask, base) : 1.0);
+  const double bytes = faces * kBytesPerOutputFace + kBaseBytes;
+  const double limit = memory_limit(cl);
+  const bool fits = faces <= r.options.max_faces && (!(limit > 0) || bytes <= limit);
+  std::printf("estimate faces %.0f bytes %.0f seconds %.1f fits %d\n", faces, bytes,
+              0.5 + 4e-6 * faces, fits ? 1 : 0);
+}
+
+// What a run made, for the summary and the --stats file.
+struct SurfaceOutcome {
+  SurfaceQuiltingStats stats;
+  GlobalQuiltingStats global_stats;
+  VineGrowthStats vine_stats;
+  QuiltEmbeddingStats embedding;
+  bool global = false, vines = false;  // the method run (auto decides)
+  StructureSummary structure;
+  double wall = 0;
+};
+
+// The synthesis by the method asked (auto decides, and says which in `o`).
+SurfaceQuilt quilt_by_method(const SurfaceRequest& r, const SurfaceInputs& in,
+                             TranslationCostEvaluator& evaluator, ProgressSink* progress,
+                             SurfaceOutcome& o) {
+  const TriMesh &base = in.base, &swatch = in.swatch.mesh;
+  o.global = r.method == "global";
+  o.vines = r.method == "vines";
+  if (r.method == "auto")
+    return quilt_surface_auto(base, swatch, r.options, evaluator, &o.stats, &o.global_stats,
+                              progress, &o.global, &o.vines, &o.vine_stats);
+  if (o.global)
+    return quilt_surface_global(base, swatch, r.options, evaluator, &o.stats, &o.global_stats,
+                                progress);
+  if (o.vines)
+    return quilt_surface_vines(base, swatch, r.options, {}, &o.stats, &o.vine_stats, progress);
+  return quilt_surface(base, swatch, r.options, evaluator, &o.stats, progress);
+}
+
+// The saved quilt (issue 25): the output in prism coordinates over the base.
+SavedQuilt make_saved(const CommandLine& cl, const SurfaceRequest& r, const SurfaceInputs& in,
+                      const SurfaceQuilt& quilt, const TriMesh& result) {
+  SavedQuiltHeader header;
+  header.base = fingerprint(in.base);
+  header.origin = "surface --swatch " + cl.get("swatch") + " --method " + r.method +
+                  (cl.has("element-size") ? " --element-size " + cl.get("element-size")
+                                          : " --scale " + cl.get("scale")) +
+                  (cl.has("mask") ? " --mask " + cl.get("mask") : std::string()) +
+                  (r.detail < 1 ? " --detail " + cl.get("detail") : std::string()) + " --seed " +
+                  cl.get("seed");
+  return make_saved_quilt(quilt, result, header);
+}
+
+// The summary a run prints unless --quiet (the structure follows with --stats).
+void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
+                           const SurfaceOutcome& o, const std::string& device, int threads) {
+  const SurfaceQuiltingStats& stats = o.stats;
+  const GlobalQuiltingStats& gstats = o.global_stats;
+  const VineGrowthStats& vstats = o.vine_stats;
+  const QuiltEmbeddingStats& e = o.embedding;
+  const bool global = o.global, vines = o.vines;
+  print_detail(in.swatch, r.detail);
+  std::printf(
+      "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
+      "covered\n",
+      r.out_path.c_str(), e.faces, e.vertices, e.elements, stats.shell_height, 100.0 * e.coverage);
+  // Faces meeting three or more at an edge (fins, flaps): the layout ends there as at a
+  // border, which the user should know of rather than find (issue 28, item 7).
+  if (stats.fin_faces > 0)
+    std::printf(
+        "base: %d faces in fins (pieces sticking out at non-manifold edges, %.2g%% of the "
+        "area) were left out: the texture covers the surface they stand on\n",
+        stats.fin_faces, 100.0 * stats.fin_area_share);
+  if (stats.non_manifold_edges > 0)
+    std::printf(
+        "base: %d non-manifold edges (three or more faces meeting) are borders: the "
+        "texture ends at them on every side\n",
+        stats.non_manifold_edges);
+  if (stats.flipped_components > 0)
+    std::printf(
+        "base: %d components faced inward and were turned outward "
+        "(--keep-orientation keeps them)\n",
+        stats.flipped_components);
+  if (stats.proxy_faces > 0)
+    std::printf(
+        "base: simplified to %d faces, within %.3g of the surface given "
+        "(--no-proxy keeps it)\n",
+        stats.proxy_faces, stats.proxy_error);
+  if (!e.shell_map_failure.empty())
+    std::printf("shell map unavailable (%s): placed by normal displacement\n",
+                e.shell_map_failure.c_str());
+  else if (r.embedding.shell_map)
+    std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n", e.stretch_before,
+                e.stretch_after, e.atlas_charts);
+  if (e.shell_map_failure.empty() && e.fallback_faces > 0)
+    std::printf(
+        "shell map left out %d base faces (%.1f%% of the area; %s): %d elements "
+        "placed over them by normal displacement\n",
+        e.fallback_faces, 100 * e.fallback_area_share, e.fallback_reason.c_str(),
+        e.fallback_elements);
+  std::printf(
+      "placement: %.2f%% of vertices under the base (%.2f%% as embedded; elements "
+      "under it: %d placed again by normal displacement, %d lifted, %d removed), "
+      "%.2f%% above the shell\n",
+      100 * e.below_base, 100 * e.below_base_embedded, e.replaced_below, e.lifted_below,
+      e.removed_below, 100 * e.above_shell);
+  if (global)
+    std::printf(
+        "global parameterisation: %d cones, %d cut edges%s; %s plane texture, %d elements "
+        "placed (%d off the surface)\n",
+        gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
+        gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
+  if (vines)
+    std::printf(
+        "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "
+        "intersect, %d pieces and %d short lines left out), %d of %d leaves placed (%d moved "
+        "along the stem), %.2f s on %d threads; %d removed (%d folded)\n",
+        vstats.stems, vstats.spacing, vstats.median_length, vstats.stems_cut, vstats.stems_dropped,
+        vstats.streamlines_short, vstats.leaves, vstats.leaf_slots, vstats.leaves_shifted, o.wall,
+        threads, e.removed_intersecting + e.removed_self_intersecting, e.removed_self_intersecting);
+  else if (global && gstats.tiled)
+    std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", o.wall,
+                device.c_str(), threads, e.rigid_repairs,
+                e.removed_intersecting + e.removed_self_intersecting);
+  else
+    std::printf(
+        "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
+        "%d added, %d matched, %d removed (%d folded)\n",
+        stats.iterations, global ? "plane iterations" : "patches", o.wall, device.c_str(), threads,
+        stats.counts.stitched, stats.counts.replaced, stats.counts.added, stats.counts.matched,
+        e.removed_intersecting + e.removed_self_intersecting, e.removed_self_intersecting);
+}
+
+}  // namespace
+
+int run_surface(int argc, char** argv, int first) {
+  CommandLine cl("surface", "--base BASE --swatch SW -o OUT [options]",
+                 "Covers a base mesh (closed or with boundary, any genus, several components)\n"
+                 "with the swatch's geometry inside a thin shell over its surface, by mesh\n"
+                 "quilting over local conformal patches (paper section 3.1).");
+  declare_surface_options(cl);
+  if (!cl.parse(argc, argv, first)) return 0;
+  SurfaceRequest r = parse_surface_request(cl);
+  RunContext run(cl);
+  const auto start = std::chrono::steady_clock::now();
+  SurfaceInputs in;
+  read_surface_inputs(cl, r, in);
+  if (r.detail < 1) r.options.full_detail_swatch = &in.full_swatch;
   if (cl.has("estimate")) {
-    // The size before any synthesis (issue 26: the add-on shows it before Run): the method's
-    // own count, as the run checks it against --max-faces (the global layout's lattice copies,
-    // within 5% of the faces written on the gallery's chain mail; the vines' stems at their
-    // spacing, within 6% on the ivy wall, David and Spot; the preparation's for the patches).
-    SurfaceQuiltingOptions counting = options;
-    counting.max_faces = std::numeric_limits<double>::infinity();
-    counting.global.count_only = true;
-    TranslationCostCpu cpu;
-    SurfaceQuiltingStats estimate;
-    GlobalQuiltingStats layout;
-    bool global = method == "global", vines = method == "vines";
-    if (method == "auto")
-      quilt_surface_auto(base, swatch, counting, cpu, &estimate, &layout, nullptr, &global, &vines);
-    else if (global)
-      quilt_surface_global(base, swatch, counting, cpu, &estimate, &layout);
-    else if (vines)
-      quilt_surface_vines(base, swatch, counting, {}, &estimate);
-    else
-      prepare_surface_job(base, swatch, counting, estimate);
-    // Under a mask only the masked part is kept (whole elements, about as many as its area).
-    const double faces =
-        (global && layout.layout_faces > 0 ? layout.layout_faces : estimate.estimated_faces) *
-        (cl.has("mask") ? masked_area_share(mask, base) : 1.0);
-    const double bytes = faces * kBytesPerOutputFace + kBaseBytes;
-    const double limit = memory_limit(cl);
-    const bool fits = faces <= options.max_faces && (!(limit > 0) || bytes <= limit);
-    std::printf("estimate faces %.0f bytes %.0f seconds %.1f fits %d\n", faces, bytes,
-                0.5 + 4e-6 * faces, fits ? 1 : 0);
+    print_estimate(cl, r, in);
     return 0;
   }
-  std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
-  SurfaceQuiltingStats stats;
-  GlobalQuiltingStats gstats;
-  bool global = method == "global", vines = method == "vines";
-  VineGrowthStats vstats;
-  SurfaceQuilt quilt =
-      method == "auto" ? quilt_surface_auto(base, swatch, options, *evaluator, &stats, &gstats,
-                                            run.progress(), &global, &vines, &vstats)
-      : global
-          ? quilt_surface_global(base, swatch, options, *evaluator, &stats, &gstats, run.progress())
-      : vines ? quilt_surface_vines(base, swatch, options, {}, &stats, &vstats, run.progress())
-              : quilt_surface(base, swatch, options, *evaluator, &stats, run.progress());
+  std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
+  SurfaceOutcome o;
+  SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
   if (cl.has("mask")) {
-    embedding.coverage_faces = mask_quilt_faces(mask, base, quilt);
-    drop_unmasked_elements(quilt, embedding.coverage_faces);
+    r.embedding.coverage_faces = mask_quilt_faces(in.mask, in.base, quilt);
+    drop_unmasked_elements(quilt, r.embedding.coverage_faces);
   }
-  std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(device);
-  QuiltEmbeddingStats embedding_stats;
-  const TriMesh result = embed_quilt(quilt, embedding, *stretch, &embedding_stats, run.progress());
+  std::unique_ptr<TetStretchEvaluator> stretch = make_tet_stretch_evaluator(r.device);
+  const TriMesh result = embed_quilt(quilt, r.embedding, *stretch, &o.embedding, run.progress());
   // A run that makes no geometry is an error, not an empty file (issue 14).
   MQ_CHECK(!quilt.elements.empty(), InvalidInput,
-           "no element of the swatch could be placed on "
-           "the base at ",
-           size_option(options),
-           " (is the swatch larger than the base?); "
-           "nothing written");
+           "no element of the swatch could be placed on the base at ", size_option(r.options),
+           " (is the swatch larger than the base?); nothing written");
   // No silent wrong result (issue 23): a result that leaves the base bare fails, naming the
   // likely cause.
+  const TriMesh& swatch = in.swatch.mesh;
   const double own_coverage = swatch_coverage(swatch);
-  check_embedded_result(static_cast<int>(quilt.elements.size()), result, embedding_stats,
-                        min_coverage, own_coverage, "try a smaller --scale");
-  // The saved quilt: the output in prism coordinates over the base (issue 25).
+  check_embedded_result(static_cast<int>(quilt.elements.size()), result, o.embedding,
+                        r.min_coverage, own_coverage, "try a smaller --scale");
   SavedQuilt saved;
   if (cl.has("save-quilt")) {
-    ScopedStageTimer timer(stats.times, "save quilt");
-    SavedQuiltHeader header;
-    header.base = fingerprint(base);
-    header.origin = "surface --swatch " + cl.get("swatch") + " --method " + method +
-                    (cl.has("element-size") ? " --element-size " + cl.get("element-size")
-                                            : " --scale " + cl.get("scale")) +
-                    (cl.has("mask") ? " --mask " + cl.get("mask") : std::string()) +
-                    (detail < 1 ? " --detail " + cl.get("detail") : std::string()) + " --seed " +
-                    cl.get("seed");
-    saved = make_saved_quilt(quilt, result, header);
+    ScopedStageTimer timer(o.stats.times, "save quilt");
+    saved = make_saved(cl, r, in, quilt, result);
   }
   // The structure figures (issue 13) are measured for --stats: a second or so on a million
   // faces, not worth it on every run; not part of the run's wall time.
-  StructureSummary structure;
   double measuring = 0;
   if (!run.stats_path().empty()) {
     const auto t0 = std::chrono::steady_clock::now();
-    ScopedStageTimer timer(stats.times, "structure");
-    structure = summarize_structure(result, swatch, &base, stats.swatch_scale);
+    ScopedStageTimer timer(o.stats.times, "structure");
+    o.structure = summarize_structure(result, swatch, &in.base, o.stats.swatch_scale);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
   // The mesh and the --stats file are one commit (issue 28).
-  const double wall = write_output_and_stats(
-      run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
-        return stats_json(stats, embedding_stats, embedding_name, evaluator->name(), run.threads(),
+  o.wall = write_output_and_stats(
+      run, r.out_path, result, r.write_options, o.stats.times, start, measuring, [&](double w) {
+        return stats_json(o.stats, o.embedding, r.embedding_name, evaluator->name(), run.threads(),
                           w, cl.get("base"), cl.get("swatch"),
-                          global  ? "global"
-                          : vines ? "vines"
-                                  : "patches",
-                          global ? &gstats : nullptr, structure, memory_limit(cl), min_coverage,
-                          own_coverage, swatch_detail, detail);
+                          o.global  ? "global"
+                          : o.vines ? "vines"
+                                    : "patches",
+                          o.global ? &o.global_stats : nullptr, o.structure, memory_limit(cl),
+                          r.min_coverage, own_coverage, in.swatch, r.detail);
       });
   run.progress()->finish();
   if (!run.quiet()) {
-    print_detail(swatch_detail, detail);
-    std::printf(
-        "wrote %s: %d faces, %d vertices, %d elements (shell height %.4g), %.1f%% of the base "
-        "covered\n",
-        out_path.c_str(), embedding_stats.faces, embedding_stats.vertices, embedding_stats.elements,
-        stats.shell_height, 100.0 * embedding_stats.coverage);
-    // Faces meeting three or more at an edge (fins, flaps): the layout ends there as at a
-    // border, which the user should know of rather than find (issue 28, item 7).
-    if (stats.fin_faces > 0)
-      std::printf(
-          "base: %d faces in fins (pieces sticking out at non-manifold edges, %.2g%% of the "
-          "area) were left out: the texture covers the surface they stand on\n",
-          stats.fin_faces, 100.0 * stats.fin_area_share);
-    if (stats.non_manifold_edges > 0)
-      std::printf(
-          "base: %d non-manifold edges (three or more faces meeting) are borders: the "
-          "texture ends at them on every side\n",
-          stats.non_manifold_edges);
-    if (stats.flipped_components > 0)
-      std::printf(
-          "base: %d components faced inward and were turned outward "
-          "(--keep-orientation keeps them)\n",
-          stats.flipped_components);
-    if (stats.proxy_faces > 0)
-      std::printf(
-          "base: simplified to %d faces, within %.3g of the surface given "
-          "(--no-proxy keeps it)\n",
-          stats.proxy_faces, stats.proxy_error);
-    const QuiltEmbeddingStats& e = embedding_stats;
-    if (!e.shell_map_failure.empty())
-      std::printf("shell map unavailable (%s): placed by normal displacement\n",
-                  e.shell_map_failure.c_str());
-    else if (embedding.shell_map)
-      std::printf("shell map: L2 stretch %.4f -> %.4f (%d charts)\n", e.stretch_before,
-                  e.stretch_after, e.atlas_charts);
-    if (e.shell_map_failure.empty() && e.fallback_faces > 0)
-      std::printf(
-          "shell map left out %d base faces (%.1f%% of the area; %s): %d elements "
-          "placed over them by normal displacement\n",
-          e.fallback_faces, 100 * e.fallback_area_share, e.fallback_reason.c_str(),
-          e.fallback_elements);
-    std::printf(
-        "placement: %.2f%% of vertices under the base (%.2f%% as embedded; elements "
-        "under it: %d placed again by normal displacement, %d lifted, %d removed), "
-        "%.2f%% above the shell\n",
-        100 * e.below_base, 100 * e.below_base_embedded, e.replaced_below, e.lifted_below,
-        e.removed_below, 100 * e.above_shell);
-    if (global)
-      std::printf(
-          "global parameterisation: %d cones, %d cut edges%s; %s plane texture, %d elements "
-          "placed (%d off the surface)\n",
-          gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
-          gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
-    if (vines)
-      std::printf(
-          "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "
-          "intersect, %d pieces and %d short lines left out), %d of %d leaves placed (%d moved "
-          "along the stem), %.2f s on %d threads; %d removed (%d folded)\n",
-          vstats.stems, vstats.spacing, vstats.median_length, vstats.stems_cut,
-          vstats.stems_dropped, vstats.streamlines_short, vstats.leaves, vstats.leaf_slots,
-          vstats.leaves_shifted, wall, run.threads(),
-          embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
-          embedding_stats.removed_self_intersecting);
-    else if (global && gstats.tiled)
-      std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", wall,
-                  evaluator->name().c_str(), run.threads(), embedding_stats.rigid_repairs,
-                  embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting);
-    else
-      std::printf(
-          "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "
-          "%d added, %d matched, %d removed (%d folded)\n",
-          stats.iterations, global ? "plane iterations" : "patches", wall,
-          evaluator->name().c_str(), run.threads(), stats.counts.stitched, stats.counts.replaced,
-          stats.counts.added, stats.counts.matched,
-          embedding_stats.removed_intersecting + embedding_stats.removed_self_intersecting,
-          embedding_stats.removed_self_intersecting);
+    print_surface_summary(r, in, o, evaluator->name(), run.threads());
     if (!run.stats_path().empty())
-      print_structure(structure.output, &structure.swatch, &structure.comparison);
+      print_structure(o.structure.output, &o.structure.swatch, &o.structure.comparison);
   }
   return 0;
 }
