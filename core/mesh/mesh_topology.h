@@ -1,6 +1,7 @@
 // Combinatorial structure of a triangle mesh: edges, adjacency, boundaries, components.
 #pragma once
 
+#include <queue>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -42,6 +43,34 @@ Adjacency vertex_faces(const MatrixX3i& F, int num_vertices);
 // Face neighbours across each edge: #F by 3, TT(f,k) across the edge F(f,k)-F(f,(k+1)%3);
 // -1 across a boundary or a non-manifold edge.
 MatrixX3i face_adjacency(const EdgeTopology& topo);
+
+// Breadth first over each component's faces (from its lowest face) joined across TT (the
+// manifold edges): calls visit(f, k, g) once per edge of the dual spanning tree this makes, from
+// face f across its edge k to a face g not reached before, in the order faces are reached. The
+// one walk behind the global layout's cut graph and the line field's representatives.
+//   TT  #F by 3, as face_adjacency gives
+template <class Visit>
+void breadth_first_dual_tree(const MatrixX3i& TT, Visit&& visit) {
+  const int nf = static_cast<int>(TT.rows());
+  std::vector<char> seen(static_cast<size_t>(nf), 0);
+  std::queue<int> q;
+  for (int start = 0; start < nf; ++start) {
+    if (seen[static_cast<size_t>(start)]) continue;
+    seen[static_cast<size_t>(start)] = 1;
+    q.push(start);
+    while (!q.empty()) {
+      const int f = q.front();
+      q.pop();
+      for (int k = 0; k < 3; ++k) {
+        const int g = TT(f, k);
+        if (g < 0 || seen[static_cast<size_t>(g)]) continue;
+        seen[static_cast<size_t>(g)] = 1;
+        visit(f, k, g);
+        q.push(g);
+      }
+    }
+  }
+}
 
 // Per vertex (#V entries), whether its incident faces, linked through the manifold edges they
 // share at it, form more than one fan: a vertex where pieces of surface touch (a bow tie), or

@@ -22,38 +22,21 @@ int corner_of(const MatrixX3i& F, int f, int v) {
 }
 
 // The edges of a breadth-first dual spanning tree (faces joined across TT).
-std::vector<char> dual_spanning_tree(const EdgeTopology& topo, const MatrixX3i& TT, int nf) {
-  std::vector<char> tree(static_cast<size_t>(topo.num_edges()), 0),
-      seen(static_cast<size_t>(nf), 0);
-  for (int start = 0; start < nf; ++start) {
-    if (seen[start]) continue;
-    seen[start] = 1;
-    std::queue<int> q;
-    q.push(start);
-    while (!q.empty()) {
-      const int f = q.front();
-      q.pop();
-      for (int k = 0; k < 3; ++k) {
-        const int g = TT(f, k);
-        if (g < 0 || seen[g]) continue;
-        seen[g] = 1;
-        tree[topo.FE(f, k)] = 1;
-        q.push(g);
-      }
-    }
-  }
+std::vector<char> dual_spanning_tree(const EdgeTopology& topo, const MatrixX3i& TT) {
+  std::vector<char> tree(static_cast<size_t>(topo.num_edges()), 0);
+  breadth_first_dual_tree(TT, [&](int f, int k, int) { tree[topo.FE(f, k)] = 1; });
   return tree;
 }
 
 // Cut graph: the interior edges outside the dual spanning tree, pruned from their dangling
 // ends (boundaries, and non-manifold edges, which TT does not cross, anchor it; so do cones
 // whose transition is not the identity), and the half-turn sign of each cut edge.
-void cut_graph(const EdgeTopology& topo, const MatrixX3i& TT, const DirectionField& field, int nf,
-               int nv, GlobalParameterization& gp) {
+void cut_graph(const EdgeTopology& topo, const MatrixX3i& TT, const DirectionField& field, int nv,
+               GlobalParameterization& gp) {
   const int ne = topo.num_edges();
   gp.cut.assign(static_cast<size_t>(ne), 0);
   gp.sign.assign(static_cast<size_t>(ne), 1);
-  const std::vector<char> tree = dual_spanning_tree(topo, TT, nf);
+  const std::vector<char> tree = dual_spanning_tree(topo, TT);
   std::vector<int> degree(static_cast<size_t>(nv), 0);
   std::vector<std::vector<int>> edges_at(static_cast<size_t>(nv));
   for (int e = 0; e < ne; ++e) {
@@ -265,7 +248,7 @@ GlobalParameterization global_parameterization(const MatrixX3d& V, const MatrixX
       gp.singular[v] = 1;
       ++gp.num_singular;
     }
-  cut_graph(topo, TT, field, nf, nv, gp);
+  cut_graph(topo, TT, field, nv, gp);
   const int nw = group_corners(F, topo, gp);
   WedgeSystem sys;
   sys.rhs = Eigen::MatrixXd::Zero(nw, 2);

@@ -3,7 +3,6 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <cmath>
-#include <queue>
 
 #include "core/common/errors.h"
 
@@ -250,28 +249,13 @@ DirectionField smooth_direction_field(const MatrixX3d& V, const MatrixX3i& F,
   // Representatives along a breadth-first dual spanning tree: each face takes the one of its N
   // directions nearest to its parent's transported across the tree edge.
   const double unit = kTwoPi / N;
-  std::vector<char> seen(static_cast<size_t>(nf), 0);
-  for (int start = 0; start < nf; ++start) {
-    if (seen[start]) continue;
-    seen[start] = 1;
-    std::queue<int> q;
-    q.push(start);
-    while (!q.empty()) {
-      const int f = q.front();
-      q.pop();
-      for (int k = 0; k < 3; ++k) {
-        const int g = TT(f, k);
-        if (g < 0 || seen[g]) continue;
-        const int e = topo.FE(f, k);
-        const double rho = topo.edge_faces.begin(e)[0] == f ? transport(V, topo, fr, e)
-                                                            : -transport(V, topo, fr, e);
-        const double target = theta[f] + rho;
-        theta[g] += std::round((target - theta[g]) / unit) * unit;
-        seen[g] = 1;
-        q.push(g);
-      }
-    }
-  }
+  breadth_first_dual_tree(TT, [&](int f, int k, int g) {
+    const int e = topo.FE(f, k);
+    const double rho =
+        topo.edge_faces.begin(e)[0] == f ? transport(V, topo, fr, e) : -transport(V, topo, fr, e);
+    const double target = theta[f] + rho;
+    theta[g] += std::round((target - theta[g]) / unit) * unit;
+  });
   MatrixX3d direction(nf, 3);
   for (int f = 0; f < nf; ++f) direction.row(f) = direction_at(theta[f], fr, f).transpose();
   return direction_field_matching(V, F, topo, direction, N);
