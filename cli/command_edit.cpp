@@ -22,8 +22,7 @@ std::vector<int> parse_ids(const std::string& text) {
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
     int a = 0, b = 0, used = 0;
-    if (std::sscanf(item.c_str(), "%d-%d%n", &a, &b, &used) == 2 &&
-        used == static_cast<int>(item.size()) && 0 <= a && a <= b && b - a < 10'000'000) {
+    if (parse_range(item, a, b) && b - a < 10'000'000) {
       for (int i = a; i <= b; ++i) ids.push_back(i);
     } else if (std::sscanf(item.c_str(), "%d%n", &a, &used) == 1 &&
                used == static_cast<int>(item.size()) && a >= 0) {

@@ -160,9 +160,8 @@ int run_embed(int argc, char** argv, int first) {
   std::vector<FrameResult> frames;
   if (cl.has("frames")) {
     const std::string range = cl.get("frames");
-    int a = 0, b = 0, used = 0;
-    if (std::sscanf(range.c_str(), "%d-%d%n", &a, &b, &used) != 2 ||
-        used != static_cast<int>(range.size()) || a < 0 || b < a || b - a >= 100000)
+    int a = 0, b = 0;
+    if (!parse_range(range, a, b) || b - a >= 100000)
       throw UsageError("--frames expects A-B with 0 <= A <= B (at most 100000 frames), got '" +
                        range + "'");
     const FramePattern base_name(cl.get("base"), "--base"), out_name(cl.get("output"), "-o");

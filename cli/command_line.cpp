@@ -159,4 +159,10 @@ std::string CommandLine::help() const {
   return os.str();
 }
 
+bool parse_range(const std::string& text, int& a, int& b) {
+  int used = 0;
+  return std::sscanf(text.c_str(), "%d-%d%n", &a, &b, &used) == 2 &&
+         used == static_cast<int>(text.size()) && 0 <= a && a <= b;
+}
+
 }  // namespace mq::cli

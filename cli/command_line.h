@@ -63,4 +63,8 @@ class CommandLine {
   std::map<std::string, std::string> positional_values_;
 };
 
+// A range "A-B" with 0 <= A <= B as the whole text (embed --frames, edit --ids): true with a and
+// b set, false for anything else.
+bool parse_range(const std::string& text, int& a, int& b);
+
 }  // namespace mq::cli
