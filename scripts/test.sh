@@ -40,6 +40,7 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   # (2x the peak) do not keep.
   slow_under_asan+='|VineGrowth.SameResultWhateverTheThreadCount|VineGrowth.StemsBendOverABoxsEdges'
   slow_under_asan+='|VineGrowth.StemsFollowAGivenField|Cli.SurfaceGrowsIvyAsVines'
+  slow_under_asan+='|VineGrowth.StemsAndLeavesStayOutOfAPillarThroughTheWall'
   slow_under_asan+='|ThreadTiling.SameInputSameBytesWhateverTheThreadCount'
   slow_under_asan+='|ThreadTiling.ChainMailApplesAndIvyAreNoThreads'
   slow_under_asan+='|WeldVertices.PatchesWrapAroundTheBrickWallPillars'
