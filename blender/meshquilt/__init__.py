@@ -21,6 +21,7 @@ bl_info = {
     "category": "Mesh",
 }
 
+import math
 import os
 import shutil
 import tempfile
@@ -95,6 +96,10 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Minimise distortion", default=True,
         description="Minimise the shell map's stretch (slower, less distorted elements)")
     seed: bpy.props.IntProperty(name="Seed", default=1, min=0)
+    detail: bpy.props.IntProperty(
+        name="Detail", default=100, min=1, max=100, subtype="PERCENTAGE",
+        description="The share of each swatch element's faces kept, each element simplified "
+        "on its own; the layout is the same as at 100%. Lower is faster and lighter")
     # The engine's last estimate (meshquilt.estimate) and the settings it was made for.
     estimate_key: bpy.props.StringProperty(options={"SKIP_SAVE"})
     estimate_faces: bpy.props.IntProperty(name="Estimated faces", options={"SKIP_SAVE"})
@@ -106,7 +111,8 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
 
 def estimate_key(context, settings):
     """The settings an estimate depends on, as a string cheap enough for draw(): the base (its
-    mesh's size, modifiers and placement), the swatch, scale, seed, guidance and the limit."""
+    mesh's size, modifiers and placement), the swatch, scale, seed, guidance, detail and the
+    limit."""
     base = settings.base
     if base is None or base.type != "MESH":
         return ""
@@ -118,7 +124,8 @@ def estimate_key(context, settings):
         parts += ["object", sw.name if sw else "", len(sw.data.polygons) if sw else 0]
     else:
         parts += ["sample", settings.sample]
-    parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed, settings.stretch, settings.guidance]
+    parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed,
+              settings.stretch, settings.guidance, settings.detail]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -156,6 +163,54 @@ def base_diagonal(context, base):
         _diagonals.clear()
         _diagonals[key] = float(np.linalg.norm(V.max(0) - V.min(0))) if len(V) else 0.0
     return _diagonals[key]
+
+
+# The sample swatches as `meshquilt swatch KIND` makes them: median faces per element (checked
+# against the engine by the tests) and what the panel calls an element.
+SAMPLE_ELEMENTS = {"chainmail": (1152, "ring"), "weave": (1940, "thread"),
+                   "apples": (352, "apple"), "ivy": (192, "element")}
+ENGINE_MIN_FACES = 24  # core/mesh/element_detail.h: no element is simplified below this
+
+_element_faces = {}  # the swatch object's key -> its median faces per element
+
+
+def element_faces(context, settings):
+    """The swatch's median faces per element and the panel's word for an element ("ring"): a
+    sample's from SAMPLE_ELEMENTS, an object's counted over its connected parts (cached while it
+    is unchanged: cheap for draw()); 0 faces without a swatch."""
+    if settings.swatch_source == "SAMPLE":
+        return SAMPLE_ELEMENTS[settings.sample]
+    sw = settings.swatch
+    if sw is None or sw.type != "MESH":
+        return 0, "element"
+    key = repr([sw.name, len(sw.data.vertices), len(sw.data.polygons),
+                [(m.name, m.show_viewport) for m in sw.modifiers]])
+    if key not in _element_faces:
+        evaluated = sw.evaluated_get(context.evaluated_depsgraph_get())
+        me = evaluated.to_mesh()
+        try:
+            T = exchange.mesh_arrays(me)[1]
+            counts = exchange.part_face_counts(T, len(me.vertices))
+        finally:
+            evaluated.to_mesh_clear()
+        _element_faces.clear()
+        _element_faces[key] = int(np.median(counts)) if len(counts) else 0
+    return _element_faces[key], "element"
+
+
+def detail_faces(faces, share):
+    """An element's faces at a detail share, as the engine sets its target (element_detail)."""
+    return max(math.ceil(share * faces), min(faces, ENGINE_MIN_FACES))
+
+
+def detail_text(context, settings):
+    """'About 116 faces per ring (of 1152)': what Detail leaves of the swatch's elements."""
+    faces, word = element_faces(context, settings)
+    if faces <= 0:
+        return ""
+    kept = detail_faces(faces, settings.detail / 100.0)
+    text = "About %d faces per %s" % (kept, word)
+    return text if kept == faces else text + " (of %d)" % faces
 
 
 def _preferences(context):
@@ -222,6 +277,7 @@ class Run:
         # Element size (scene units; the base is exported in world space, so these are its
         # units): the engine's --element-size; Scale stands for it where a scale is needed.
         self.element_size = settings.element_size
+        self.detail = settings.detail / 100.0  # the share of each swatch element's faces
         if self.element_size > 0:
             diagonal = float(np.linalg.norm(V.max(0) - V.min(0)))
             if diagonal <= 0:
@@ -254,7 +310,7 @@ class Run:
         self.elements_path = os.path.join(self.dir, "elements.csv")
         self.options = dict(seed=settings.seed, stretch=settings.stretch, field=field,
                             field_file=field_file, max_memory=self.max_memory,
-                            element_size=self.element_size)
+                            element_size=self.element_size, detail=self.detail)
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.result_path, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
@@ -887,6 +943,10 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         layout.prop(s, "scale")
         layout.prop(s, "element_size")
         _draw_element_size(layout, context, s)
+        layout.prop(s, "detail")
+        text = detail_text(context, s)
+        if text:
+            layout.label(text=text)
         layout.prop(s, "guidance")
         if s.guidance == "AXIS":
             row = layout.row()

@@ -271,9 +271,10 @@ def swatch_job(engine, kind, output, seed=1):
 
 def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
                  field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None,
-                 element_size=0.0):
+                 element_size=0.0, detail=1.0):
     """The arguments of a surface job (surface_job; estimate with the same settings); an
-    element_size > 0 (the swatch's longer side in the base's units) replaces the scale."""
+    element_size > 0 (the swatch's longer side in the base's units) replaces the scale; a
+    detail below 1 keeps that share of each swatch element's faces (the same layout)."""
     size = ["--element-size", repr(float(element_size))] if element_size and \
         element_size > 0 else ["--scale", repr(float(scale))]
     args = ["surface", "--base", base, "--swatch", swatch, "-o", output] + size + \
@@ -284,6 +285,8 @@ def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
         args += ["--max-memory", "%.6g" % max_memory]  # a float32 property: 0.01 stays 0.01
     if stats:
         args += ["--stats", stats]
+    if detail < 1:
+        args += ["--detail", "%.6g" % detail]
     if not stretch:
         args.append("--no-stretch-opt")
     if field is not None:
@@ -297,7 +300,8 @@ def surface_job(engine, base, swatch, output, scale, **options):
     """Quilts the swatch over the base; options (surface_args): `field` an (x, y, z) direction
     or `field_file` a file of one vector per base vertex (at most one of them); `save_quilt`
     also saves the result over the base (.mqq) for embed_job; `max_memory` (GiB) refuses a
-    larger job before any work; `stats` writes the run's figures as JSON."""
+    larger job before any work; `stats` writes the run's figures as JSON; `detail` in (0, 1]
+    keeps that share of each swatch element's faces."""
     return Job(engine, surface_args(base, swatch, output, scale, **options))
 
 

@@ -27,6 +27,23 @@ def mesh_arrays(mesh):
     return V.reshape(-1, 3), T.reshape(-1, 3), M
 
 
+def part_face_counts(T, vertex_count):
+    """Triangles per connected part (triangles joined by shared vertices): a swatch's elements
+    as the engine counts them."""
+    label = np.arange(vertex_count)
+    while True:
+        lowest = label[T].min(axis=1)
+        new = label.copy()
+        for k in range(3):
+            np.minimum.at(new, T[:, k], lowest)
+        new = new[new]  # each vertex takes its label's label: a long part settles in few passes
+        if np.array_equal(new, label):
+            break
+        label = new
+    counts = np.bincount(label[T[:, 0]], minlength=vertex_count)
+    return counts[counts > 0]
+
+
 def write_ply(path, V, T, kinds=None, triangle_kind=None):
     """Binary PLY; with kinds, each vertex takes the kind of a triangle using it."""
     V = np.ascontiguousarray(V, dtype="<f8")

@@ -12,7 +12,8 @@ at rest), stopping with the engine's message when the base's connectivity change
 shape keys that play without the engine, and elements removed from the saved quilt; a
 command-line result through File > Import; the engine's estimate for the panel; the memory
 limit refusing a job in the artist's words; the structure report on a result and selecting its
-distorted elements.
+distorted elements; Detail in the engine's command, its estimate and the panel's faces per
+element.
 """
 
 import glob
@@ -554,20 +555,26 @@ def positions(obj, evaluated=False):
     return V.reshape(-1, 3)
 
 
+def small_chainmail_path():
+    """A chain mail of 16 rings of 64 faces (`swatch chainmail --detail 6`), made once."""
+    from meshquilt import engine
+    path = os.path.join(WORK, "small_chainmail.ply")
+    if not os.path.exists(path):
+        job = engine.Job(ENGINE, ["swatch", "chainmail", "-o", path, "--rows", "4", "--cols",
+                                  "4", "--detail", "6", "--quiet"], progress=False)
+        check(job.wait(60) == "done", "swatch failed: %s" % job.error)
+    return path
+
+
 def twisting_grid_quilt():
     """A 12 x 12 grid twisted about y by a Simple Deform modifier keyed from 0 (frame 0, the
     rest) to 90 degrees (frame 24), quilted at rest with a small chain mail (16 rings of 64 faces): about
     60 rings, 4,000 faces. Returns the scene, the base and the result."""
     scene = new_scene()
     import meshquilt
-    from meshquilt import engine, exchange
-    path = os.path.join(WORK, "small_chainmail.ply")
-    if not os.path.exists(path):
-        job = engine.Job(ENGINE, ["swatch", "chainmail", "-o", path, "--rows", "4", "--cols",
-                                  "4", "--detail", "6", "--quiet"], progress=False)
-        check(job.wait(60) == "done", "swatch failed: %s" % job.error)
+    from meshquilt import exchange
     swatch = bpy.data.objects.new("mail", exchange.build_mesh(
-        bpy, "mail", exchange.read_ply(path), meshquilt.material_for))
+        bpy, "mail", exchange.read_ply(small_chainmail_path()), meshquilt.material_for))
     scene.collection.objects.link(swatch)
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=13, y_subdivisions=13, size=2)
     base = bpy.context.active_object
@@ -818,6 +825,65 @@ def test_element_size_in_scene_units_is_passed_to_the_engine():
         check(len(obj.data.polygons) > 100, "only %d faces" % len(obj.data.polygons))
     finally:
         run.cleanup()
+
+
+@test
+def test_detail_reaches_the_engine_command_and_its_estimate():
+    scene = new_scene()
+    import meshquilt
+    s = scene.meshquilt
+    s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.4
+
+    def surface_args():
+        """The surface job's command for the current settings (started and stopped at once)."""
+        run = meshquilt.Run(bpy.context, s)
+        try:
+            job = run.jobs[run.preparation]()
+            job.cancel()
+            return job.args
+        finally:
+            run.cleanup()
+
+    def detail(args):
+        return args[args.index("--detail") + 1] if "--detail" in args else None
+
+    check(s.detail == 100 and detail(surface_args()) is None, "at 100%%: %s" % surface_args())
+    check(bpy.ops.meshquilt.estimate() == {"FINISHED"}, "estimate failed")
+    full = s.estimate_faces
+    s.detail = 25
+    check(detail(surface_args()) == "0.25", "at 25%%: %s" % surface_args())
+    check(s.estimate_key != meshquilt.estimate_key(bpy.context, s), "stale estimate kept")
+    check(bpy.ops.meshquilt.estimate() == {"FINISHED"}, "estimate failed")
+    check(0.2 < s.estimate_faces / full < 0.35, "25%%: %d faces, 100%%: %d"
+          % (s.estimate_faces, full))
+
+
+@test
+def test_the_panel_shows_the_faces_per_element_detail_gives():
+    scene = new_scene()
+    import meshquilt
+    from meshquilt import engine, exchange
+    s = scene.meshquilt
+    s.base, s.sample = small_sphere(), "chainmail"
+    check("About 1152 faces per ring" in drawn_panel(), "panel: %s" % drawn_panel())
+    s.detail = 10
+    check("About 116 faces per ring (of 1152)" in drawn_panel(), "panel: %s" % drawn_panel())
+    s.detail = 1  # the engine keeps 24 faces of an element at least
+    check(meshquilt.detail_text(bpy.context, s) == "About 24 faces per ring (of 1152)",
+          meshquilt.detail_text(bpy.context, s))
+    # The samples' faces per element are the engine's swatches' own.
+    for kind, (faces, _) in meshquilt.SAMPLE_ELEMENTS.items():
+        path = os.path.join(WORK, "detail_%s.ply" % kind)
+        check(engine.swatch_job(ENGINE, kind, path).wait(60) == "done", "swatch failed")
+        counts = np.bincount(exchange.read_ply(path).face_element)
+        check(int(np.median(counts[counts > 0])) == faces, "%s: median %g faces, table %d"
+              % (kind, np.median(counts[counts > 0]), faces))
+    # An object swatch: its connected parts counted (16 rings of 64 faces).
+    swatch = bpy.data.objects.new("mail", exchange.build_mesh(
+        bpy, "mail", exchange.read_ply(small_chainmail_path()), meshquilt.material_for))
+    scene.collection.objects.link(swatch)
+    s.swatch_source, s.swatch, s.detail = "OBJECT", swatch, 50
+    check("About 32 faces per element (of 64)" in drawn_panel(), "panel: %s" % drawn_panel())
 
 
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
