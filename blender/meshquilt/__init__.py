@@ -170,6 +170,9 @@ def base_diagonal(context, base):
 SAMPLE_ELEMENTS = {"chainmail": (1152, "ring"), "weave": (1940, "thread"),
                    "apples": (352, "apple"), "ivy": (192, "element")}
 ENGINE_MIN_FACES = 24  # core/mesh/element_detail.h: no element is simplified below this
+# A Preview's detail: a tenth of the setting's, but about 48 faces per element at least (a
+# coarser ring no longer reads as a ring).
+PREVIEW_SHARE, PREVIEW_MIN_FACES = 0.1, 48
 
 _element_faces = {}  # the swatch object's key -> its median faces per element
 
@@ -213,6 +216,15 @@ def detail_text(context, settings):
     return text if kept == faces else text + " (of %d)" % faces
 
 
+def preview_share(share, faces):
+    """A Preview's detail for the setting's share and the swatch's faces per element: never
+    above the setting."""
+    low = PREVIEW_SHARE * share
+    if faces > 0:
+        low = max(low, PREVIEW_MIN_FACES / faces)
+    return min(share, low)
+
+
 def _preferences(context):
     return context.preferences.addons[__name__].preferences
 
@@ -230,7 +242,8 @@ def _follow_changed(self, context):
 
 
 class MeshquiltBinding(bpy.types.PropertyGroup):
-    """A result's tie to its base (Object.meshquilt): its saved quilt and how it follows."""
+    """A result's tie to its base (Object.meshquilt): its saved quilt and how it follows; on a
+    base, the result the panel made last."""
     quilt: bpy.props.StringProperty(
         name="Saved quilt", subtype="FILE_PATH",
         description="The quilt saved by the run that made this object (meshquilt embed places "
@@ -247,13 +260,17 @@ class MeshquiltBinding(bpy.types.PropertyGroup):
         name="Baked", default=False,
         description="The result's positions over the frame range are stored in shape keys")
     status: bpy.props.StringProperty(name="Status", default="")
+    result: bpy.props.PointerProperty(
+        name="Result", type=bpy.types.Object,
+        description="On a base: its latest result from Run or Preview, which the next one "
+        "replaces if either is a Preview")
 
 
 class Run:
     """One quilting run: inputs exported, the engine jobs in turn, the result imported. Both the
     modal operator (UI) and the blocking one (scripts) drive it through step()."""
 
-    def __init__(self, context, settings):
+    def __init__(self, context, settings, preview=False):
         prefs = _preferences(context)
         self.engine = engine.find_engine(prefs.engine_path)
         self.max_memory = prefs.max_memory
@@ -277,7 +294,11 @@ class Run:
         # Element size (scene units; the base is exported in world space, so these are its
         # units): the engine's --element-size; Scale stands for it where a scale is needed.
         self.element_size = settings.element_size
-        self.detail = settings.detail / 100.0  # the share of each swatch element's faces
+        # Detail: the share of each swatch element's faces kept; a Preview takes less.
+        self.preview = preview
+        self.detail = settings.detail / 100.0
+        if preview:
+            self.detail = preview_share(self.detail, element_faces(context, settings)[0])
         if self.element_size > 0:
             diagonal = float(np.linalg.norm(V.max(0) - V.min(0)))
             if diagonal <= 0:
@@ -435,14 +456,32 @@ class Run:
 
     def import_result(self, context):
         result = exchange.read_ply(self.result_path)
-        name = "%s_quilt" % self.base.name
+        # One result per base: a Preview replaces the base's last result, a Run its Preview.
+        replaced = self.base.meshquilt.result
+        if replaced is not None and (replaced.meshquilt.base != self.base or not (
+                self.preview or replaced.get("meshquilt_preview"))):
+            replaced = None
+        name = replaced.name if replaced is not None else "%s_quilt" % self.base.name
         # The swatch's own materials for its kinds (the engine's names replace spaces).
         me = exchange.build_mesh(bpy, name, result, lambda kind, look: material_for(
             self.material_names.get(kind, kind), look))
+        users = replaced.users_collection if replaced is not None else \
+            self.base.users_collection
+        collection = users[0] if users else context.scene.collection
+        if replaced is not None:
+            if replaced.mode != "OBJECT":
+                bpy.ops.object.mode_set(mode="OBJECT")  # not left in a mode with it gone
+            old = replaced.data
+            bpy.data.objects.remove(replaced)
+            if old.users == 0:
+                bpy.data.meshes.remove(old)
+            me.name = name
         obj = bpy.data.objects.new(name, me)
-        collection = self.base.users_collection[0] if self.base.users_collection else \
-            context.scene.collection
         collection.objects.link(obj)
+        obj.meshquilt.base = self.base
+        self.base.meshquilt.result = obj
+        if self.preview:
+            obj["meshquilt_preview"] = True
         # The result is in world coordinates: parented without moving.
         obj.parent = self.base
         obj.matrix_parent_inverse = self.base.matrix_world.inverted()
@@ -505,10 +544,8 @@ def _redraw_panels(context):
                         region.tag_redraw()
 
 
-class MESHQUILT_OT_run(bpy.types.Operator):
-    """Quilt the swatch over the base in the background"""
-    bl_idname = "meshquilt.run"
-    bl_label = "Run"
+class _Quilting:
+    """Run and Preview, one code path: a Preview is a Run at a lower detail (Run.preview)."""
     bl_options = {"REGISTER", "UNDO"}
 
     timeout: bpy.props.FloatProperty(name="Timeout", default=0.0, options={"SKIP_SAVE"},
@@ -527,7 +564,8 @@ class MESHQUILT_OT_run(bpy.types.Operator):
                 return {"CANCELLED"}
             finally:
                 run.cleanup()
-            self.report({"INFO"}, "meshquilt: %s, %d faces" % (obj.name, len(obj.data.polygons)))
+            self.report({"INFO"}, "meshquilt: %s%s, %d faces" % (
+                obj.name, " (preview)" if run.preview else "", len(obj.data.polygons)))
             return {"FINISHED"}
         run.cleanup()
         if run.state == "failed":
@@ -538,13 +576,13 @@ class MESHQUILT_OT_run(bpy.types.Operator):
 
     def _start(self, context):
         try:
-            return Run(context, context.scene.meshquilt)
+            return Run(context, context.scene.meshquilt, preview=self.preview)
         except (engine.EngineError, OSError, ValueError) as e:
             self.report({"ERROR"}, str(e))
             return None
 
     def execute(self, context):
-        # Blocking, for scripts: bpy.ops.meshquilt.run().
+        # Blocking, for scripts: bpy.ops.meshquilt.run(), bpy.ops.meshquilt.preview().
         run = self._start(context)
         if run is None:
             return {"CANCELLED"}
@@ -608,6 +646,21 @@ class MESHQUILT_OT_run(bpy.types.Operator):
         if run is None:
             return {"CANCELLED"}
         return self._finish(context, run)
+
+
+class MESHQUILT_OT_run(_Quilting, bpy.types.Operator):
+    """Quilt the swatch over the base in the background (it replaces the base's Preview)"""
+    bl_idname = "meshquilt.run"
+    bl_label = "Run"
+    preview = False
+
+
+class MESHQUILT_OT_preview(_Quilting, bpy.types.Operator):
+    """The same job at low detail, fast (a tenth of Detail, at least about 48 faces per
+    element): the layout of the full result, which the next Run puts in its place"""
+    bl_idname = "meshquilt.preview"
+    bl_label = "Preview"
+    preview = True
 
 
 class MESHQUILT_OT_estimate(bpy.types.Operator):
@@ -962,9 +1015,13 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             layout.label(text=run.status_text())
             layout.operator("meshquilt.cancel", icon="CANCEL")
         else:
-            layout.operator("meshquilt.run", icon="PLAY")
+            row = layout.row(align=True)
+            row.operator("meshquilt.run", icon="PLAY")
+            row.operator("meshquilt.preview", icon="HIDE_OFF")
         obj = context.active_object
         if obj is not None and obj.type == "MESH" and "element_id" in obj.data.attributes:
+            if obj.get("meshquilt_preview"):
+                layout.label(text="Preview (low detail) - Run for the full result", icon="INFO")
             layout.operator("meshquilt.select_element")
             _draw_report(layout, obj)
             b = obj.meshquilt
@@ -986,9 +1043,10 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
 
 
 classes = (MeshquiltPreferences, MeshquiltSettings, MeshquiltBinding, MESHQUILT_OT_run,
-           MESHQUILT_OT_estimate, MESHQUILT_OT_import, MESHQUILT_OT_select_distorted,
-           MESHQUILT_OT_cancel, MESHQUILT_OT_select_element, MESHQUILT_OT_bake,
-           MESHQUILT_OT_clear_bake, MESHQUILT_OT_remove_selected, MESHQUILT_PT_panel)
+           MESHQUILT_OT_preview, MESHQUILT_OT_estimate, MESHQUILT_OT_import,
+           MESHQUILT_OT_select_distorted, MESHQUILT_OT_cancel, MESHQUILT_OT_select_element,
+           MESHQUILT_OT_bake, MESHQUILT_OT_clear_bake, MESHQUILT_OT_remove_selected,
+           MESHQUILT_PT_panel)
 
 
 def register():

@@ -13,7 +13,7 @@ shape keys that play without the engine, and elements removed from the saved qui
 command-line result through File > Import; the engine's estimate for the panel; the memory
 limit refusing a job in the artist's words; the structure report on a result and selecting its
 distorted elements; Detail in the engine's command, its estimate and the panel's faces per
-element.
+element; a Preview replaced by the Run after it.
 """
 
 import glob
@@ -135,8 +135,8 @@ def test_installs_and_registers():
     enable_addon()
     check("meshquilt" in bpy.context.preferences.addons, "add-on not enabled")
     check(hasattr(bpy.types.Scene, "meshquilt"), "scene settings not registered")
-    for op in ("run", "cancel", "select_element", "bake", "clear_bake", "remove_selected",
-               "estimate", "select_distorted"):
+    for op in ("run", "preview", "cancel", "select_element", "bake", "clear_bake",
+               "remove_selected", "estimate", "select_distorted"):
         check(hasattr(bpy.ops.meshquilt, op), "operator meshquilt.%s missing" % op)
     check(hasattr(bpy.ops.import_mesh, "meshquilt_ply"), "import operator missing")
     import meshquilt
@@ -774,7 +774,8 @@ def test_run_shows_cancel_at_once_before_any_progress():
     # is called as invoke calls it, without the modal handler (which needs the event loop).
     op = meshquilt.MESHQUILT_OT_run
     fake = type("Op", (), {"report": lambda self, *a: None, "_start": op._start,
-                           "_begin": op._begin, "_end": op._end, "_finish": op._finish})()
+                           "_begin": op._begin, "_end": op._end, "_finish": op._finish,
+                           "preview": False})()
     started = fake._begin(bpy.context)
     run = meshquilt._running.get("run")
     try:
@@ -834,9 +835,9 @@ def test_detail_reaches_the_engine_command_and_its_estimate():
     s = scene.meshquilt
     s.base, s.sample, s.scale = small_sphere(), "chainmail", 0.4
 
-    def surface_args():
+    def surface_args(preview=False):
         """The surface job's command for the current settings (started and stopped at once)."""
-        run = meshquilt.Run(bpy.context, s)
+        run = meshquilt.Run(bpy.context, s, preview=preview)
         try:
             job = run.jobs[run.preparation]()
             job.cancel()
@@ -848,10 +849,15 @@ def test_detail_reaches_the_engine_command_and_its_estimate():
         return args[args.index("--detail") + 1] if "--detail" in args else None
 
     check(s.detail == 100 and detail(surface_args()) is None, "at 100%%: %s" % surface_args())
+    check(detail(surface_args(preview=True)) == "0.1", "Preview at 100%%: %s"
+          % detail(surface_args(preview=True)))
     check(bpy.ops.meshquilt.estimate() == {"FINISHED"}, "estimate failed")
     full = s.estimate_faces
     s.detail = 25
     check(detail(surface_args()) == "0.25", "at 25%%: %s" % surface_args())
+    # A tenth of 25% would leave 29 of a ring's 1152 faces: the Preview keeps 48.
+    check(abs(float(detail(surface_args(preview=True))) - 48 / 1152) < 1e-5, "Preview at 25%%: "
+          "%s" % detail(surface_args(preview=True)))
     check(s.estimate_key != meshquilt.estimate_key(bpy.context, s), "stale estimate kept")
     check(bpy.ops.meshquilt.estimate() == {"FINISHED"}, "estimate failed")
     check(0.2 < s.estimate_faces / full < 0.35, "25%%: %d faces, 100%%: %d"
@@ -884,6 +890,59 @@ def test_the_panel_shows_the_faces_per_element_detail_gives():
     scene.collection.objects.link(swatch)
     s.swatch_source, s.swatch, s.detail = "OBJECT", swatch, 50
     check("About 32 faces per element (of 64)" in drawn_panel(), "panel: %s" % drawn_panel())
+
+
+@test
+def test_preview_then_run_leave_one_result_for_the_base():
+    scene = new_scene()
+    s = scene.meshquilt
+    base = small_sphere()
+    s.base, s.sample, s.scale = base, "chainmail", 0.5
+
+    def results():
+        return [o for o in bpy.data.objects if o.meshquilt.base == base]
+
+    start = time.monotonic()
+    check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "preview did not finish")
+    print("[blender]   preview: %.1f s" % (time.monotonic() - start), flush=True)
+    check(len(results()) == 1 and results()[0].get("meshquilt_preview"), "results %s"
+          % results())
+    preview = results()[0]
+    name, faces, ids = preview.name, len(preview.data.polygons), face_ids(preview)
+    check(preview.parent == base and "meshquilt_report" in preview, "not a result like Run's")
+    # A tenth of a ring's 1152 faces (a few rings kept finer so that none intersects).
+    per_element = np.median(np.bincount(ids))
+    check(110 <= per_element <= 200, "median %g faces per ring" % per_element)
+    bpy.context.view_layer.objects.active = preview
+    check("Preview (low detail) - Run for the full result" in drawn_panel(), "panel: %s"
+          % drawn_panel())
+    bpy.ops.object.mode_set(mode="EDIT")  # an artist looking at the preview's faces
+    start = time.monotonic()
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    print("[blender]   run: %.1f s" % (time.monotonic() - start), flush=True)
+    check(len(results()) == 1, "%d results for the base" % len(results()))
+    check(all(o.mode == "OBJECT" for o in bpy.data.objects), "left in %s"
+          % [o.mode for o in bpy.data.objects])
+    full = results()[0]
+    check(full.name == name and not full.get("meshquilt_preview"), "%s, preview %s"
+          % (full.name, full.get("meshquilt_preview")))
+    check(faces < 0.3 * len(full.data.polygons), "preview %d faces, full %d"
+          % (faces, len(full.data.polygons)))
+    full_ids = face_ids(full)
+    n = int(full_ids.max()) + 1
+    # The same layout; a coarse ring's chords meet a neighbour sooner where this small sphere
+    # bends the shell hard, so a few more are removed (92-96% of the full run's rings here).
+    check(len(np.unique(full_ids)) == n and 0.85 * n <= len(np.unique(ids)) <= n,
+          "full: %d ids (0..%d), preview %d elements" % (len(np.unique(full_ids)), n - 1,
+                                                         len(np.unique(ids))))
+    check(not [m for m in bpy.data.meshes if m.users == 0], "the preview's mesh left behind")
+    bpy.context.view_layer.objects.active = full
+    check("Preview (low detail) - Run for the full result" not in drawn_panel(),
+          "the full result shown as a preview")
+    # A Preview after the full result takes its place too.
+    check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "second preview did not finish")
+    check(len(results()) == 1 and results()[0].get("meshquilt_preview"), "results %s"
+          % results())
 
 
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
