@@ -941,7 +941,7 @@ def _draw_estimate(layout, context, s):
         row.label(text="Size: not estimated")
     row.operator("meshquilt.estimate", text="", icon="FILE_REFRESH")
     if current and not s.estimate_error and not s.estimate_fits:
-        layout.label(text="Over the memory limit: raise Scale")
+        layout.label(text="Over the memory limit: raise Scale or lower Detail")
 
 
 def _draw_report(layout, obj):

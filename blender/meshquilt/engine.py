@@ -358,11 +358,13 @@ def refusal_message(error, scale, limit_gib):
             if n is not None else " is too large")
     if need_gib is not None and limit and need_gib <= limit_gib:
         return ("meshquilt: at Scale %g the texture%s, more than the engine's limit of %s "
-                "faces: raise Scale in the panel (fewer, larger elements)"
+                "faces: raise Scale in the panel (fewer, larger elements) or lower Detail "
+                "(fewer faces each)"
                 % (scale, need, format(int(float(limit.group(1))), ",")))
     return ("meshquilt: at Scale %g the texture%s, over the memory limit of %.3g GiB: raise "
-            "Scale in the panel (fewer, larger elements), or raise Memory limit in Edit > "
-            "Preferences > Add-ons > meshquilt" % (scale, need, limit_gib))
+            "Scale in the panel (fewer, larger elements) or lower Detail (fewer faces each), "
+            "or raise Memory limit in Edit > Preferences > Add-ons > meshquilt"
+            % (scale, need, limit_gib))
 
 
 def info_job(engine, result, swatch, base, elements_csv, scale):

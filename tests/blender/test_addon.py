@@ -409,7 +409,8 @@ def test_memory_limit_refuses_the_job_in_the_artists_words():
         start = time.monotonic()
         message = reported(bpy.ops.meshquilt.run)
         check("memory limit of" in message and "raise Scale" in message and
-              "Memory limit" in message and "--max" not in message, "reported: %s" % message)
+              "lower Detail" in message and "Memory limit" in message and
+              "--max" not in message, "reported: %s" % message)
         check(time.monotonic() - start < 15, "refused after %.1f s" % (time.monotonic() - start))
         check(set(bpy.data.objects) == before, "a refused run added an object")
         # The engine's face limit (--max-faces) binding below the memory limit: the memory
@@ -418,7 +419,8 @@ def test_memory_limit_refuses_the_job_in_the_artists_words():
             "at --scale 0.01 the texture would have about 2.5e+07 faces, more than the limit "
             "of 2e+07 (--max-faces, or --max-memory at 400 bytes a face); use a larger "
             "--scale", 0.01, 12.0)
-        check("limit of 20,000,000 faces" in faces and "Memory limit" not in faces,
+        check("limit of 20,000,000 faces" in faces and "lower Detail" in faces and
+              "Memory limit" not in faces,
               "reported: %s" % faces)
     finally:
         enable_addon()
