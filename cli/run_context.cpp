@@ -49,7 +49,7 @@ ElementDetail read_swatch(const std::string& path, double share, TriMesh* full) 
   options.detail = share;
   TriMesh swatch = read_mesh(path);
   ElementDetail detail = reduce_element_detail(swatch, options);
-  if (full) *full = std::move(swatch);
+  if (full && share < 1) *full = std::move(swatch);  // the layout's, needed below full detail
   return detail;
 }
 

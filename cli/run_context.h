@@ -75,8 +75,8 @@ void add_detail_option(CommandLine& cl);
 double detail_share(const CommandLine& cl);
 
 // The swatch at `path` at a share of its detail (core/mesh/element_detail.h), with the element
-// counts before and after; `full` (optional) receives the swatch as read. Throws as read_mesh
-// and reduce_element_detail do.
+// counts before and after; `full` (optional) receives the swatch as read when share < 1. Throws as
+// read_mesh and reduce_element_detail do.
 ElementDetail read_swatch(const std::string& path, double share, TriMesh* full = nullptr);
 
 // The detail's line of a run's summary (nothing at full detail) and its --stats entry.

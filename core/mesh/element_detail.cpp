@@ -131,6 +131,85 @@ int median(std::vector<int> values) {
   return *mid;
 }
 
+// The elements at lower detail, in swatch order (reduce_element_detail below full detail): groups
+// of congruent copies simplified once, each raised until nothing intersects that did not.
+// out.groups and out.raised are set; after[c] receives element c's faces.
+TriMesh reduce_elements(const TriMesh& swatch, const ElementDetailOptions& options,
+                        const std::vector<int>& face_component,
+                        const std::vector<std::vector<int>>& faces, ElementDetail& out,
+                        std::vector<int>& after) {
+  const int count = static_cast<int>(faces.size());
+  std::vector<TriMesh> elements(static_cast<size_t>(count));
+  tbb::parallel_for(0, count, [&](int c) { elements[c] = extract_faces(swatch, faces[c]); });
+
+  // Groups of congruent copies, each led by its first element (in swatch order); the kept
+  // vertices are every member's box extremes, so every copy keeps its box.
+  std::vector<int> group(static_cast<size_t>(count), -1);
+  std::vector<int> leaders;
+  std::vector<std::vector<int>> kept;
+  std::unordered_map<std::uint64_t, std::vector<int>> by_hash;  // hash -> group leaders
+  for (int c = 0; c < count; ++c) {
+    std::vector<int>& candidates = by_hash[connectivity_hash(elements[c])];
+    for (const int leader : candidates)
+      if (congruent(elements[leader], elements[c])) {
+        group[c] = group[leader];
+        break;
+      }
+    if (group[c] < 0) {
+      group[c] = static_cast<int>(leaders.size());
+      leaders.push_back(c);
+      kept.emplace_back();
+      candidates.push_back(c);
+    }
+    add_box_extremes(elements[c].V, kept[group[c]]);
+  }
+  for (std::vector<int>& k : kept) {
+    std::sort(k.begin(), k.end());
+    k.erase(std::unique(k.begin(), k.end()), k.end());
+  }
+  out.groups = static_cast<int>(leaders.size());
+
+  // Coarse enough, a thin wire folds through itself or a chord on its inner side cuts into a
+  // neighbour it hugs: such groups get more faces (x1.6 a round, up to their own) until nothing
+  // intersects that did not at full detail.
+  const std::set<std::pair<int, int>> touching = element_pairs(swatch, face_component);
+  const std::vector<int> folded = self_intersecting_components(swatch.V, swatch.F);
+  std::vector<double> share(leaders.size(), options.detail);
+  std::vector<char> redo(leaders.size(), 1);
+  std::vector<Collapses> collapses(leaders.size());
+  TriMesh mesh;
+  for (bool any = true; any;) {
+    tbb::parallel_for(size_t(0), leaders.size(), [&](size_t g) {
+      if (!redo[g]) return;
+      ElementDetailOptions o = options;
+      o.detail = share[g];
+      collapses[g] = simplify_element(elements[leaders[g]], kept[g], o);
+    });
+    mesh = assemble(swatch, elements, group, collapses);
+    // The element of each face: the elements one after the other, each its group's faces.
+    std::vector<int> element_of;
+    for (int c = 0; c < count; ++c) {
+      after[static_cast<size_t>(c)] = static_cast<int>(collapses[group[c]].F.rows());
+      element_of.insert(element_of.end(), static_cast<size_t>(after[c]), c);
+    }
+    std::fill(redo.begin(), redo.end(), 0);
+    any = false;
+    const auto raise = [&](int c) {
+      const int g = group[c];
+      if (redo[g] || share[g] >= 1) return;
+      redo[g] = 1;
+      any = true;
+      share[g] = std::min(1.0, 1.6 * share[g]);
+    };
+    for (const auto& [a, b] : element_pairs(mesh, element_of))
+      if (!touching.count({a, b})) raise(a), raise(b);
+    for (const int c : self_intersecting_components(mesh.V, mesh.F))
+      if (!std::binary_search(folded.begin(), folded.end(), c)) raise(c);
+  }
+  for (size_t g = 0; g < leaders.size(); ++g) out.raised += share[g] > options.detail;
+  return mesh;
+}
+
 }  // namespace
 
 QuadricSimplification simplify_to_share(const TriMesh& mesh, double share, int min_faces,
@@ -175,85 +254,14 @@ ElementDetail reduce_element_detail(const TriMesh& swatch, const ElementDetailOp
   std::vector<int> face_component;
   const int count = connected_components(swatch.F, nv, face_component);
   const std::vector<std::vector<int>> faces = component_faces(face_component, count);
-  std::vector<TriMesh> elements(static_cast<size_t>(count));
-  tbb::parallel_for(0, count, [&](int c) { elements[c] = extract_faces(swatch, faces[c]); });
-
-  // Groups of congruent copies, each led by its first element (in swatch order); the kept
-  // vertices are every member's box extremes, so every copy keeps its box.
-  std::vector<int> group(static_cast<size_t>(count), -1);
-  std::vector<int> leaders;
-  std::vector<std::vector<int>> kept;
-  if (options.detail < 1) {
-    std::unordered_map<std::uint64_t, std::vector<int>> by_hash;  // hash -> group leaders
-    for (int c = 0; c < count; ++c) {
-      std::vector<int>& candidates = by_hash[connectivity_hash(elements[c])];
-      for (const int leader : candidates)
-        if (congruent(elements[leader], elements[c])) {
-          group[c] = group[leader];
-          break;
-        }
-      if (group[c] < 0) {
-        group[c] = static_cast<int>(leaders.size());
-        leaders.push_back(c);
-        kept.emplace_back();
-        candidates.push_back(c);
-      }
-      add_box_extremes(elements[c].V, kept[group[c]]);
-    }
-  }
-  for (std::vector<int>& k : kept) {
-    std::sort(k.begin(), k.end());
-    k.erase(std::unique(k.begin(), k.end()), k.end());
-  }
-
   ElementDetail out;
   out.elements = count;
-  std::vector<int> before, after;
-  for (const std::vector<int>& f : faces) before.push_back(static_cast<int>(f.size()));
-  if (options.detail == 1) {
-    out.mesh = swatch;
-    after = before;
-  } else {
-    // Coarse enough, a thin wire folds through itself or a chord on its inner side cuts into a
-    // neighbour it hugs: such groups get more faces (x1.6 a round, up to their own) until
-    // nothing intersects that did not at full detail.
-    const std::set<std::pair<int, int>> touching = element_pairs(swatch, face_component);
-    const std::vector<int> folded = self_intersecting_components(swatch.V, swatch.F);
-    std::vector<double> share(leaders.size(), options.detail);
-    std::vector<char> redo(leaders.size(), 1);
-    std::vector<Collapses> collapses(leaders.size());
-    for (;;) {
-      tbb::parallel_for(size_t(0), leaders.size(), [&](size_t g) {
-        if (!redo[g]) return;
-        ElementDetailOptions o = options;
-        o.detail = share[g];
-        collapses[g] = simplify_element(elements[leaders[g]], kept[g], o);
-      });
-      out.mesh = assemble(swatch, elements, group, collapses);
-      std::fill(redo.begin(), redo.end(), 0);
-      bool any = false;
-      const auto raise = [&](int c) {
-        const int g = group[c];
-        if (redo[g] || share[g] >= 1) return;
-        redo[g] = 1;
-        any = true;
-        share[g] = std::min(1.0, 1.6 * share[g]);
-      };
-      std::vector<int> now_component;
-      connected_components(out.mesh.F, out.mesh.num_vertices(), now_component);
-      for (const auto& [a, b] : element_pairs(out.mesh, now_component))
-        if (!touching.count({a, b})) raise(a), raise(b);
-      for (const int c : self_intersecting_components(out.mesh.V, out.mesh.F))
-        if (!std::binary_search(folded.begin(), folded.end(), c)) raise(c);
-      if (!any) break;
-    }
-    for (size_t g = 0; g < leaders.size(); ++g) out.raised += share[g] > options.detail;
-    std::vector<int> component;
-    connected_components(out.mesh.F, out.mesh.num_vertices(), component);
-    after.assign(static_cast<size_t>(count), 0);
-    for (const int c : component) ++after[static_cast<size_t>(c)];
-  }
-  out.groups = static_cast<int>(leaders.size());
+  std::vector<int> before(faces.size());
+  for (size_t c = 0; c < faces.size(); ++c) before[c] = static_cast<int>(faces[c].size());
+  std::vector<int> after = before;
+  out.mesh = options.detail == 1
+                 ? swatch
+                 : reduce_elements(swatch, options, face_component, faces, out, after);
   if (count > 0) {
     out.max_faces_before = *std::max_element(before.begin(), before.end());
     out.max_faces_after = *std::max_element(after.begin(), after.end());
