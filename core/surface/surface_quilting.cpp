@@ -21,274 +21,15 @@
 #include "core/planar/planar_quilting.h"
 #include "core/planar/quilt_elements.h"
 #include "core/surface/local_patch.h"
+#include "core/surface/patch_frame.h"
+#include "core/surface/points_near_2d.h"
+#include "core/surface/surface_store.h"
+#include "core/surface/synthesis_front.h"
 #include "core/surface/tangent_field.h"
 
 namespace mq {
 
 namespace {
-
-// Barycentric coordinates of p's orthogonal projection onto the plane of (a, b, c); they are not
-// clamped, so points beyond the triangle extrapolate its affine map.
-Vector3d plane_barycentric(const Vector3d& p, const Vector3d& a, const Vector3d& b,
-                           const Vector3d& c) {
-  const Vector3d e0 = b - a, e1 = c - a, d = p - a;
-  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
-  const double d20 = d.dot(e0), d21 = d.dot(e1);
-  const double den = d00 * d11 - d01 * d01;
-  if (!(std::abs(den) > 0)) return Vector3d(1, 0, 0);
-  const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
-  return Vector3d(1 - v - w, v, w);
-}
-
-Vector3d triangle_barycentric_2d(const Vector2d& p, const Vector2d& a, const Vector2d& b,
-                                 const Vector2d& c) {
-  const Vector2d e0 = b - a, e1 = c - a, d = p - a;
-  const double den = e0.x() * e1.y() - e1.x() * e0.y();
-  if (!(std::abs(den) > 0)) return Vector3d(1, 0, 0);
-  const double v = (d.x() * e1.y() - e1.x() * d.y()) / den;
-  const double w = (e0.x() * d.y() - d.x() * e0.y()) / den;
-  return Vector3d(1 - v - w, v, w);
-}
-
-// A flattened local patch in the synthesis frame: the LSCM map rotated so that the guidance
-// field points along +x at the seed and translated so the seed's centroid is the origin.
-class PatchFrame {
- public:
-  // device: where the BVH for points beyond the patch is built when first needed.
-  PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction,
-             const EmbreeDevice& device)
-      : base_(base), patch_(std::move(patch)), device_(device) {
-    const MatrixX3i& F = patch_.mesh.F;
-    for (int f = 0; f < F.rows(); ++f) local_of_[patch_.faces[f]] = f;
-    // The seed face's affine map takes the 3D field direction into the UV plane.
-    const int s = 0;
-    const Vector3d a = patch_.mesh.V.row(F(s, 0)), b = patch_.mesh.V.row(F(s, 1)),
-                   c = patch_.mesh.V.row(F(s, 2));
-    const Vector2d ua = patch_.uv.row(F(s, 0)), ub = patch_.uv.row(F(s, 1)),
-                   uc = patch_.uv.row(F(s, 2));
-    const Vector3d w = plane_barycentric(a + direction, a, b, c);
-    Vector2d d = w(0) * ua + w(1) * ub + w(2) * uc - ua;
-    if (!(d.norm() > 0)) d = Vector2d(1, 0);
-    d.normalize();
-    const Vector2d origin = (ua + ub + uc) / 3.0;
-    uv_.resize(patch_.uv.rows(), 2);
-    for (int v = 0; v < patch_.uv.rows(); ++v) {
-      const Vector2d q = patch_.uv.row(v).transpose() - origin;
-      uv_.row(v) << q.dot(d), q.x() * -d.y() + q.y() * d.x();
-    }
-    build_grid();
-  }
-
-  const LocalPatch& patch() const { return patch_; }
-  const MatrixX2d& uv() const { return uv_; }
-  int local_face(int base_face) const {
-    auto it = local_of_.find(base_face);
-    return it == local_of_.end() ? -1 : it->second;
-  }
-
-  // Frame position of a local coordinate; beyond the patch, through the nearest patch face.
-  Vector2d to_frame(int base_face, const Vector3d& bary) const {
-    int f = local_face(base_face);
-    Vector3d w = bary;
-    if (f < 0) {
-      const Vector3d p = bary(0) * base_.V.row(base_.F(base_face, 0)).transpose() +
-                         bary(1) * base_.V.row(base_.F(base_face, 1)).transpose() +
-                         bary(2) * base_.V.row(base_.F(base_face, 2)).transpose();
-      // Built on first use: most patches never need it, and a BVH per patch is not free.
-      if (!query_)
-        query_ = std::make_unique<ClosestPointQuery>(device_, patch_.mesh.V, patch_.mesh.F);
-      f = query_->closest(p).face;
-      const MatrixX3i& F = patch_.mesh.F;
-      w = plane_barycentric(p, patch_.mesh.V.row(F(f, 0)), patch_.mesh.V.row(F(f, 1)),
-                            patch_.mesh.V.row(F(f, 2)));
-    }
-    const MatrixX3i& F = patch_.mesh.F;
-    return w(0) * uv_.row(F(f, 0)).transpose() + w(1) * uv_.row(F(f, 1)).transpose() +
-           w(2) * uv_.row(F(f, 2)).transpose();
-  }
-
-  // The patch face containing frame point q (true) or the nearest one (false, with barycentric
-  // coordinates extrapolating it).
-  bool locate(const Vector2d& q, int& face, Vector3d& bary) const {
-    const MatrixX3i& F = patch_.mesh.F;
-    face = -1;
-    double best = std::numeric_limits<double>::infinity();
-    const int cx = std::clamp(static_cast<int>((q.x() - lo_.x()) / cell_), 0, nx_ - 1);
-    const int cy = std::clamp(static_cast<int>((q.y() - lo_.y()) / cell_), 0, ny_ - 1);
-    // Ring search over the grid: the first containing triangle wins; else the nearest by the
-    // most negative barycentric coordinate over the rings visited.
-    for (int r = 0; r < std::max(nx_, ny_); ++r) {
-      for (int y = cy - r; y <= cy + r; ++y)
-        for (int x = cx - r; x <= cx + r; ++x) {
-          if (std::max(std::abs(x - cx), std::abs(y - cy)) != r) continue;
-          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
-          for (const int f : cells_[y * nx_ + x]) {
-            const Vector3d w =
-                triangle_barycentric_2d(q, uv_.row(F(f, 0)), uv_.row(F(f, 1)), uv_.row(F(f, 2)));
-            const double outside = -w.minCoeff();
-            if (outside <= 1e-9) {
-              face = f;
-              bary = w;
-              return true;
-            }
-            if (outside < best || (outside == best && f < face)) {
-              best = outside;
-              face = f;
-              bary = w;
-            }
-          }
-        }
-      if (face >= 0 && r >= 1) break;
-    }
-    return false;
-  }
-
-  // Frame position of the centroid of patch face f.
-  Vector2d face_centroid(int f) const {
-    const MatrixX3i& F = patch_.mesh.F;
-    return (uv_.row(F(f, 0)) + uv_.row(F(f, 1)) + uv_.row(F(f, 2))).transpose() / 3.0;
-  }
-
-  // Minimum distance from q to the patch's boundary in the frame.
-  double distance_to_border(const Vector2d& q) const {
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& [i, j] : border_) {
-      const Vector2d a = uv_.row(i), b = uv_.row(j), d = b - a;
-      const double t =
-          d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
-      best = std::min(best, (a + t * d - q).norm());
-    }
-    return best;
-  }
-
- private:
-  void build_grid() {
-    const MatrixX3i& F = patch_.mesh.F;
-    lo_ = uv_.colwise().minCoeff().transpose();
-    const Vector2d hi = uv_.colwise().maxCoeff().transpose();
-    const double side = std::max((hi - lo_).maxCoeff(), 1e-12);
-    const int n = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(F.rows()))));
-    cell_ = side / n;
-    nx_ = std::max(1, static_cast<int>((hi.x() - lo_.x()) / cell_) + 1);
-    ny_ = std::max(1, static_cast<int>((hi.y() - lo_.y()) / cell_) + 1);
-    cells_.assign(static_cast<size_t>(nx_) * ny_, {});
-    for (int f = 0; f < F.rows(); ++f) {
-      Vector2d a = uv_.row(F(f, 0)), b = a;
-      for (int k = 1; k < 3; ++k) {
-        a = a.cwiseMin(uv_.row(F(f, k)).transpose());
-        b = b.cwiseMax(uv_.row(F(f, k)).transpose());
-      }
-      const int x0 = std::clamp(static_cast<int>((a.x() - lo_.x()) / cell_), 0, nx_ - 1);
-      const int x1 = std::clamp(static_cast<int>((b.x() - lo_.x()) / cell_), 0, nx_ - 1);
-      const int y0 = std::clamp(static_cast<int>((a.y() - lo_.y()) / cell_), 0, ny_ - 1);
-      const int y1 = std::clamp(static_cast<int>((b.y() - lo_.y()) / cell_), 0, ny_ - 1);
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) cells_[y * nx_ + x].push_back(f);
-    }
-    const EdgeTopology topo = edge_topology(F, static_cast<int>(uv_.rows()));
-    for (int e = 0; e < topo.num_edges(); ++e)
-      if (topo.is_boundary(e)) border_.emplace_back(topo.E(e, 0), topo.E(e, 1));
-  }
-
-  const TriMesh& base_;
-  LocalPatch patch_;
-  MatrixX2d uv_;
-  std::unordered_map<int, int> local_of_;
-  Vector2d lo_ = Vector2d::Zero();
-  double cell_ = 1;
-  int nx_ = 1, ny_ = 1;
-  std::vector<std::vector<int>> cells_;
-  std::vector<std::pair<int, int>> border_;
-  const EmbreeDevice& device_;
-  mutable std::unique_ptr<ClosestPointQuery> query_;
-};
-
-// 2D points binned in a uniform hash grid of cell `radius`, answering "is any point within
-// radius of q" by looking at the 3 x 3 cells around q.
-class PointsNear2D {
- public:
-  explicit PointsNear2D(double radius) : r_(radius) {}
-  void add(const Vector2d& p) { cells_[key(cell_of(p.x()), cell_of(p.y()))].push_back(p); }
-  bool any_within(const Vector2d& q) const {
-    const long long cx = cell_of(q.x()), cy = cell_of(q.y());
-    for (long long y = cy - 1; y <= cy + 1; ++y)
-      for (long long x = cx - 1; x <= cx + 1; ++x) {
-        auto it = cells_.find(key(x, y));
-        if (it == cells_.end()) continue;
-        for (const Vector2d& p : it->second)
-          if ((p - q).squaredNorm() <= r_ * r_) return true;
-      }
-    return false;
-  }
-
- private:
-  long long cell_of(double v) const { return static_cast<long long>(std::floor(v / r_)); }
-  static long long key(long long x, long long y) { return x * 73856093LL ^ y * 19349663LL; }
-  double r_;
-  std::unordered_map<long long, std::vector<Vector2d>> cells_;
-};
-
-// The output elements in local coordinates, with an index from base faces to the elements that
-// have vertices above them.
-struct SurfaceStore {
-  std::vector<SurfaceElement> elements;
-  std::vector<unsigned char> alive;
-  std::vector<std::vector<int>> by_face;
-
-  explicit SurfaceStore(int num_faces) : by_face(num_faces) {}
-  void index(int id) {
-    std::vector<int> faces = elements[id].face;
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-    for (const int f : faces)
-      if (by_face[f].empty() || by_face[f].back() != id) by_face[f].push_back(id);
-  }
-  int add(SurfaceElement e) {
-    elements.push_back(std::move(e));
-    alive.push_back(1);
-    index(static_cast<int>(elements.size()) - 1);
-    return static_cast<int>(elements.size()) - 1;
-  }
-};
-
-// The store seen through one patch frame: the elements near the patch, flattened.
-class FramedOutput final : public PatchOutput {
- public:
-  FramedOutput(SurfaceStore& store, std::map<int, Element> frame)
-      : store_(store), frame_(std::move(frame)) {}
-
-  const Element& element(int id) const override { return frame_.at(id); }
-  bool alive(int id) const override { return store_.alive[id] != 0 && frame_.count(id); }
-  std::vector<int> elements_near(const Vector2d& lo, const Vector2d& hi) const override {
-    std::vector<int> ids;
-    for (const auto& [id, e] : frame_)
-      if (store_.alive[id] && e.lo.x() <= hi.x() && e.hi.x() >= lo.x() && e.lo.y() <= hi.y() &&
-          e.hi.y() >= lo.y())
-        ids.push_back(id);
-    return ids;
-  }
-  int add(Element e) override {
-    const int id = static_cast<int>(store_.elements.size());
-    store_.elements.emplace_back();  // filled in local coordinates by the caller
-    store_.alive.push_back(1);
-    frame_[id] = std::move(e);
-    changed_.insert(id);
-    return id;
-  }
-  void replace(int id, Element e) override {
-    frame_[id] = std::move(e);
-    changed_.insert(id);
-  }
-  void remove(int id) override { store_.alive[id] = 0; }
-
-  const std::set<int>& changed() const { return changed_; }
-  const Element& frame_element(int id) const { return frame_.at(id); }
-
- private:
-  SurfaceStore& store_;
-  std::map<int, Element> frame_;
-  std::set<int> changed_;
-};
 
 void validate_base(const TriMesh& base) {
   MQ_CHECK(base.F.rows() > 0, InvalidInput, "the base mesh has no faces");
@@ -443,9 +184,10 @@ double swatch_scale_for(const TriMesh& base, const TriMesh& swatch, double scale
   return scale * diagonal / longer_footprint_side(swatch);
 }
 
-SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mesh,
-                               const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
-  validate_base(base_in);
+namespace {
+
+// The options prepare_surface_job uses, checked where they enter, in the user's terms.
+void validate_surface_options(const SurfaceQuiltingOptions& options, const TriMesh& base_in) {
   MQ_CHECK(std::isfinite(options.base_edge_fraction) && options.base_edge_fraction > 0,
            InvalidInput, "base_edge_fraction must be positive and finite, got ",
            options.base_edge_fraction);
@@ -460,8 +202,12 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
            "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
            " base faces");
-  ScopedStageTimer timer(stats.times, "prepare");
-  SurfaceJob job;
+}
+
+// job.cleaned and job.input_vertex from the base as given; returns, per face of job.cleaned,
+// the face of base_in it is.
+std::vector<int> clean_base(const TriMesh& base_in, const SurfaceQuiltingOptions& options,
+                            SurfaceJob& job, SurfaceQuiltingStats& stats) {
   // Exporters split vertices along hard edges; welded, a box's sides form one surface and
   // patches (and elements) can wrap around its edges.
   job.cleaned = weld_vertices(base_in, &stats.welded_vertices, &job.input_vertex);
@@ -471,57 +217,62 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   // The shell grows along the normal: components turned inside out would hide the texture
   // inside the object.
   if (options.orient_outward) stats.flipped_components = orient_outward(job.cleaned);
-  // The output estimated before any work: the swatch's faces per unit of footprint area at its
-  // scale on the surface, over the base's area (issue 14: --scale 1e-6 ran out of memory).
-  // The swatch's box sides, thinnest (its thickness: the shell height at scale 1) first.
-  Vector3d swatch_sides = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
-  std::sort(swatch_sides.data(), swatch_sides.data() + 3);
-  {
-    // The refined base below has the same bounding box, so this is the scale used throughout.
-    job.swatch_scale =
-        options.element_size > 0
-            ? options.element_size / std::max(longer_footprint_side(swatch_mesh), 1e-300)
-            : swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
-    const double k = job.swatch_scale;
-    const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
-    const double faces = static_cast<double>(swatch_mesh.num_faces()) *
-                         face_areas(base_in.V, base_in.F).sum() / footprint;
-    stats.estimated_faces = faces;
-    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
-             " the texture would have about ", faces, " faces, more than the limit of ",
-             options.max_faces,
-             " (--max-faces, or --max-memory at 400 bytes a face); use a "
-             "larger ",
-             options.element_size > 0 ? "--element-size" : "--scale");
-  }
-  // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
-  // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
-  // is unchanged) until no edge is longer than base_edge_fraction of the swatch's longer side.
-  const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-  const double max_edge =
-      (options.element_size > 0 ? options.element_size : options.scale * diagonal) *
-      options.base_edge_fraction;
-  // A base far finer than the texture costs the patches and the shell map in proportion to
-  // its faces, not to its surface (issue 14: 354 s for a 1.1M-face bunny that is the 70k one
-  // split twice): simplified to the refinement's edge length within a twentieth of the shell
-  // height, the texture lies on a surface no farther from the one given than that.
-  if (options.proxy_min_faces > 0 && job.cleaned.num_faces() > options.proxy_min_faces) {
-    QuadricSimplificationOptions so;
-    so.max_error = options.proxy_error * swatch_sides(0) * job.swatch_scale;
-    so.max_edge_length = max_edge;
-    QuadricSimplification proxy = simplify_by_quadrics(job.cleaned, so);
-    if (proxy.mesh.num_faces() < job.cleaned.num_faces()) {
-      for (int& f : proxy.origin_face) f = input_face[static_cast<size_t>(f)];
-      input_face = std::move(proxy.origin_face);
-      job.cleaned = std::move(proxy.mesh);
-      job.input_vertex.clear();
-      stats.proxy_faces = job.cleaned.num_faces();
-      stats.proxy_error = proxy.max_error;
-    }
-  }
+  return input_face;
+}
+
+// The swatch's scale on the surface (section 3.1's relative size s), and the output estimated
+// before any work: the swatch's faces per unit of footprint area at that scale, over the base's
+// area (issue 14: --scale 1e-6 ran out of memory). Throws InvalidInput over options.max_faces.
+//   swatch_sides  the swatch's box sides, thinnest (its thickness) first
+void scale_within_estimate(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                           const Vector3d& swatch_sides, const SurfaceQuiltingOptions& options,
+                           SurfaceJob& job, SurfaceQuiltingStats& stats) {
+  // The refined base has the same bounding box, so this is the scale used throughout.
+  job.swatch_scale =
+      options.element_size > 0
+          ? options.element_size / std::max(longer_footprint_side(swatch_mesh), 1e-300)
+          : swatch_scale_for(job.cleaned, swatch_mesh, options.scale);
+  const double k = job.swatch_scale;
+  const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
+  const double faces = static_cast<double>(swatch_mesh.num_faces()) *
+                       face_areas(base_in.V, base_in.F).sum() / footprint;
+  stats.estimated_faces = faces;
+  MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
+           " the texture would have about ", faces, " faces, more than the limit of ",
+           options.max_faces,
+           " (--max-faces, or --max-memory at 400 bytes a face); use a "
+           "larger ",
+           options.element_size > 0 ? "--element-size" : "--scale");
+}
+
+// A base far finer than the texture costs the patches and the shell map in proportion to its
+// faces, not to its surface (issue 14: 354 s for a 1.1M-face bunny that is the 70k one split
+// twice): simplified to the refinement's edge length within a twentieth of the shell height, the
+// texture lies on a surface no farther from the one given than that.
+void simplify_to_proxy(const SurfaceQuiltingOptions& options, double thickness, double max_edge,
+                       SurfaceJob& job, std::vector<int>& input_face, SurfaceQuiltingStats& stats) {
+  if (options.proxy_min_faces <= 0 || job.cleaned.num_faces() <= options.proxy_min_faces) return;
+  QuadricSimplificationOptions so;
+  so.max_error = options.proxy_error * thickness * job.swatch_scale;
+  so.max_edge_length = max_edge;
+  QuadricSimplification proxy = simplify_by_quadrics(job.cleaned, so);
+  if (proxy.mesh.num_faces() >= job.cleaned.num_faces()) return;
+  for (int& f : proxy.origin_face) f = input_face[static_cast<size_t>(f)];
+  input_face = std::move(proxy.origin_face);
+  job.cleaned = std::move(proxy.mesh);
+  job.input_vertex.clear();
+  stats.proxy_faces = job.cleaned.num_faces();
+  stats.proxy_error = proxy.max_error;
+}
+
+// Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
+// small next to the swatch: the base is refined by longest-edge bisection (the surface itself
+// is unchanged) until no edge is longer than max_edge; the guidance field (given per input
+// face, or the smooth default) and the adjacency over the refined faces.
+void refine_base(const SurfaceQuiltingOptions& options, double max_edge,
+                 const std::vector<int>& input_face, SurfaceJob& job, SurfaceQuiltingStats& stats) {
   job.base = bisect_longest_edges(job.cleaned, max_edge, 2'000'000, &job.refinement);
   stats.base_faces = job.base.num_faces();
-  // The field is per input face.
   if (options.field.rows()) {
     job.field.resize(job.base.num_faces(), 3);
     for (int f = 0; f < job.base.num_faces(); ++f)
@@ -532,6 +283,26 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   }
   job.topo = edge_topology(job.base.F, job.base.num_vertices());
   job.TT = face_adjacency(job.topo);
+}
+
+}  // namespace
+
+SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mesh,
+                               const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
+  validate_base(base_in);
+  validate_surface_options(options, base_in);
+  ScopedStageTimer timer(stats.times, "prepare");
+  SurfaceJob job;
+  std::vector<int> input_face = clean_base(base_in, options, job, stats);
+  Vector3d swatch_sides = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
+  std::sort(swatch_sides.data(), swatch_sides.data() + 3);
+  scale_within_estimate(base_in, swatch_mesh, swatch_sides, options, job, stats);
+  const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
+  const double max_edge =
+      (options.element_size > 0 ? options.element_size : options.scale * diagonal) *
+      options.base_edge_fraction;
+  simplify_to_proxy(options, swatch_sides(0), max_edge, job, input_face, stats);
+  refine_base(options, max_edge, input_face, job, stats);
   // The swatch at its size on the surface (section 3.1's relative size s).
   job.swatch = swatch_mesh;
   job.swatch.V *= job.swatch_scale;
@@ -553,277 +324,319 @@ SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
                                 progress);
 }
 
+namespace {
+
+// Local-patch synthesis (paper section 3.1) between its steps: the prepared swatch and its
+// queries, the output store, the front of synthesised faces. One iteration grows a patch around
+// the front's next seed, flattens the output near it into the patch's frame, matches the swatch
+// there (section 2.4), runs the planar steps of section 2 in the frame, stores what changed in
+// local coordinates and marks the faces now synthesised.
+class LocalPatchSynthesis {
+ public:
+  LocalPatchSynthesis(SurfaceJob& job, const SurfaceQuiltingOptions& options,
+                      TranslationCostEvaluator& evaluator, SurfaceQuiltingStats& stats);
+  bool finished() const { return front_.empty(); }
+  void run_patch(ProgressSink* progress);
+  SurfaceQuilt take_quilt(SurfaceJob& job);
+
+ private:
+  std::unique_ptr<PatchFrame> grow_patch(int seed);
+  std::map<int, Element> flatten_output(const PatchFrame& frame);
+  Vector3d match(const std::map<int, Element>& flat);
+  void store_changed(const PatchFrame& frame, const FramedOutput& framed);
+  void mark_synthesised(int seed, const PatchFrame& frame, const FramedOutput& framed,
+                        const Vector3d& t, const std::vector<int>& rejected,
+                        const PatchCounts& counts);
+
+  const SurfaceJob& job_;
+  const SurfaceQuiltingOptions& options_;
+  TranslationCostEvaluator& evaluator_;
+  SurfaceQuiltingStats& stats_;
+  StageTimes& times_;
+  PreparedSwatch swatch_;
+  std::unique_ptr<SwatchFaceTree> swatch_tree_;
+  const EmbreeDevice embree_;  // one device for every BVH of the run
+  LaplacianTopologyCache laplacians_;
+  double H_ = 0;            // the shell height
+  double cell_ = 0;         // the matching grid's cell (section 2.4)
+  int window_ = 1;          // the sub-patch window around the seed, in cells
+  double max_element_ = 0;  // the largest element's footprint diameter
+  double margin_ = 0;       // faces are marked synthesised this far inside swatch and patch
+  LocalPatchBuilder builder_;
+  LocalPatchOptions patch_options_;
+  SurfaceStore store_;
+  SynthesisFront front_;
+  std::mt19937_64 rng_;
+  std::unique_ptr<ClosestPointQuery> base_query_;
+};
+
+LocalPatchSynthesis::LocalPatchSynthesis(SurfaceJob& job, const SurfaceQuiltingOptions& options,
+                                         TranslationCostEvaluator& evaluator,
+                                         SurfaceQuiltingStats& stats)
+    : job_(job),
+      options_(options),
+      evaluator_(evaluator),
+      stats_(stats),
+      times_(stats.times),
+      builder_(job.base, job.topo, job.TT),
+      store_(job.base.num_faces()),
+      front_(job.TT),
+      rng_(options.seed) {
+  {
+    ScopedStageTimer timer(times_, "prepare");
+    swatch_ = prepare_swatch(job.swatch);
+    swatch_tree_ = std::make_unique<SwatchFaceTree>(swatch_.mesh.V, swatch_.mesh.F);
+    laplacians_ = swatch_topologies(swatch_);
+  }
+  H_ = swatch_.size.z();
+  stats_.shell_height = H_;
+  cell_ = matching_cell_size(swatch_);
+  stats_.cell_size = cell_;
+  const int swatch_cells =
+      static_cast<int>(std::floor(std::min(swatch_.size.x(), swatch_.size.y()) / cell_ + 1e-9));
+  window_ = std::max(
+      1, std::min(swatch_cells, static_cast<int>(options.subpatch_fraction * swatch_cells)));
+  const double footprint_area = swatch_.size.x() * swatch_.size.y();
+  // Faces are marked synthesised only this far inside both the swatch and the patch, so that
+  // elements cut off at the patch border are grown again by a later patch.
+  for (const Element& e : swatch_.elements)
+    max_element_ = std::max(max_element_, e.footprint_diameter());
+  margin_ = std::min(0.5 * max_element_, 0.25 * std::min(swatch_.size.x(), swatch_.size.y()));
+  // Automatic size: a disk whose radius reaches the farthest swatch corner of any admissible
+  // placement (the sub-patch window around the seed stays inside the swatch), so that the
+  // swatch lands on the patch wherever matching puts it; elements beyond the patch cannot be
+  // stored and are rejected.
+  const double half = 0.5 * window_ * cell_;
+  const double reach = Vector2d(swatch_.size.x() - half, swatch_.size.y() - half).norm();
+  patch_options_.max_area = options.patch_area_factor > 0
+                                ? options.patch_area_factor * footprint_area
+                                : 3.14159265358979 * reach * reach;
+  patch_options_.max_distortion = options.max_distortion;
+  base_query_ = std::make_unique<ClosestPointQuery>(embree_, job.base.V, job.base.F);
+}
+
+void LocalPatchSynthesis::run_patch(ProgressSink* progress) {
+  const int seed = front_.next();
+  ++stats_.iterations;
+  const std::unique_ptr<PatchFrame> frame = grow_patch(seed);
+  if (!frame) {
+    front_.mark(seed);  // a degenerate triangle: nothing can be placed on it
+    return;
+  }
+  std::map<int, Element> flat = flatten_output(*frame);
+  const Vector3d t = match(flat);
+  // Whether a frame point lies over a face synthesised before this patch.
+  const auto synthesised = [this, &frame](double x, double y) {
+    int f;
+    Vector3d b;
+    if (!frame->locate(Vector2d(x, y), f, b)) return false;
+    return front_.synthesised(frame->patch().faces[f]);
+  };
+  const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch_.size.head<2>();
+  const OverlapRegion region(patch_lo, patch_hi, synthesised);
+  // Steps 3-5 in the frame. A swatch element enters only if it lies wholly on the patch, so
+  // that it can be stored in local coordinates.
+  FramedOutput framed(store_, std::move(flat));
+  int outside = 0;
+  const std::function<bool(const Element&)> admissible = [&](const Element& e) {
+    int f;
+    Vector3d b;
+    for (int v = 0; v < e.V.rows(); ++v)
+      if (!frame->locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b)) {
+        ++outside;
+        return false;
+      }
+    return true;
+  };
+  const SwatchQueries queries{*swatch_tree_, embree_, laplacians_};
+  PatchCounts counts;
+  std::vector<int> rejected;
+  quilt_patch(framed, swatch_, queries, t, region, admissible, options_.patch, counts, times_,
+              &rejected);
+  accumulate(stats_.counts, counts);
+  stats_.rejected_outside_patch += outside;
+  store_changed(*frame, framed);
+  mark_synthesised(seed, *frame, framed, t, rejected, counts);
+  report_progress(progress, "quilting", front_.num_synthesised(), job_.base.num_faces());
+}
+
+// The local patch around the seed (core/surface/local_patch), flattened into the frame the
+// guidance field orients; null for a degenerate seed triangle.
+std::unique_ptr<PatchFrame> LocalPatchSynthesis::grow_patch(int seed) {
+  ScopedStageTimer timer(times_, "parameterization");
+  LocalPatch patch;
+  try {
+    patch = builder_.grow(seed, patch_options_);
+  } catch (const InvalidInput&) {
+    return nullptr;
+  }
+  if (patch.shrink_steps > 0) ++stats_.patches_shrunk;
+  stats_.patch_faces += static_cast<long long>(patch.faces.size());
+  return std::make_unique<PatchFrame>(job_.base, std::move(patch), job_.field.row(seed).transpose(),
+                                      embree_);
+}
+
+// The output near the patch, flattened into the frame, by id.
+std::map<int, Element> LocalPatchSynthesis::flatten_output(const PatchFrame& frame) {
+  ScopedStageTimer timer(times_, "parameterization");
+  std::map<int, Element> flat;
+  std::set<int> ids;
+  for (const int f : frame.patch().faces)
+    for (const int id : store_.by_face[f])
+      if (store_.alive[id]) ids.insert(id);
+  for (const int id : ids) {
+    const SurfaceElement& s = store_.elements[id];
+    Element e;
+    e.F = s.F;
+    e.kind = s.kind;
+    e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
+    for (size_t v = 0; v < s.face.size(); ++v) {
+      const Vector2d q = frame.to_frame(s.face[v], s.barycentric.row(v).transpose());
+      e.V.row(v) << q.x(), q.y(), s.height(v);
+    }
+    e.update();
+    flat.emplace(id, std::move(e));
+  }
+  return flat;
+}
+
+// Step 2: geometry matching around the seed (the frame origin); the swatch's offset.
+Vector3d LocalPatchSynthesis::match(const std::map<int, Element>& flat) {
+  ScopedStageTimer timer(times_, "matching");
+  const double half = 0.5 * window_ * cell_;
+  std::vector<const Element*> near;
+  near.reserve(flat.size());
+  for (const auto& [id, e] : flat) near.push_back(&e);
+  MatrixX3d P, NP;
+  // Seeds lie just beyond the synthesised surface (faces within 1.5 shell heights of geometry
+  // count as synthesised), so the sub-patch reaches half an element (at most three shell
+  // heights: long vines would pull in the whole patch) further than the window the swatch must
+  // cover: without that it would often hold no output at all and the swatch would be placed
+  // unmatched.
+  const double reach = half + std::min(0.5 * max_element_, 3.0 * H_);
+  gather_subpatch(near, Vector2d::Constant(-reach), Vector2d::Constant(reach),
+                  options_.match_points, P, NP);
+  const Vector2d t_min = Vector2d::Constant(half) - swatch_.size.head<2>();
+  const Vector2d t_max = Vector2d::Constant(-half);
+  MatrixX3d T = whole_cell_offsets(t_min, t_max, cell_);
+  MatchingOptions matching = options_.matching;
+  matching.lambda = options_.matching.lambda / cell_;
+  // The first patch has nothing to match: the swatch is centred on the seed.
+  if (P.rows() == 0) T = Vector3d(-0.5 * swatch_.size.x(), -0.5 * swatch_.size.y(), 0).transpose();
+  const OffsetChoice choice =
+      choose_offset(*swatch_tree_, evaluator_, P, NP, T, t_min, t_max, cell_, matching, rng_);
+  stats_.matched_point_offsets += choice.point_offsets;
+  return choice.offset;
+}
+
+// New and changed elements back to local coordinates.
+void LocalPatchSynthesis::store_changed(const PatchFrame& frame, const FramedOutput& framed) {
+  ScopedStageTimer timer(times_, "parameterization");
+  const LocalPatch& patch = frame.patch();
+  for (const int id : framed.changed()) {
+    if (!store_.alive[id]) continue;
+    const Element& e = framed.frame_element(id);
+    SurfaceElement s;
+    s.F = e.F;
+    s.kind = e.kind;
+    s.face.resize(e.V.rows());
+    s.barycentric.resize(e.V.rows(), 3);
+    s.height.resize(e.V.rows());
+    for (int v = 0; v < e.V.rows(); ++v) {
+      int f;
+      Vector3d b;
+      const bool in = frame.locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b);
+      if (in) {
+        s.face[v] = patch.faces[f];
+        s.barycentric.row(v) = b.cwiseMax(0.0).transpose() / b.cwiseMax(0.0).sum();
+      } else {
+        // Beyond the patch (a changed element reaching out of it): extrapolate the nearest
+        // patch face's map into 3D and project onto the base.
+        const MatrixX3i& PF = patch.mesh.F;
+        const Vector3d p = b(0) * patch.mesh.V.row(PF(f, 0)).transpose() +
+                           b(1) * patch.mesh.V.row(PF(f, 1)).transpose() +
+                           b(2) * patch.mesh.V.row(PF(f, 2)).transpose();
+        const ClosestPointHit hit = base_query_->closest(p);
+        s.face[v] = hit.face;
+        s.barycentric.row(v) = hit.barycentric.transpose();
+      }
+      s.height(v) = std::clamp(e.V(v, 2), 0.0, H_);
+    }
+    store_.elements[id] = std::move(s);
+    store_.index(id);
+  }
+}
+
+// Marks the patch faces now synthesised: within 1.5 shell heights of output geometry (issue 4's
+// coverage criterion), whichever patch placed it, or inside the swatch footprint, away from the
+// patch border by the margin (elements there may have been cut off) and away from the swatch
+// elements refused here. Those are the places a later patch must try again; a gap of the swatch
+// itself is a gap of the texture. Elements that would reach into the footprint from outside are
+// missing from every swatch; a later patch seeded beyond the footprint adds them, since they lie
+// partly outside the synthesised region. (Marking only the footprint's central quarter left ~15
+// faces of every 16 in a patch to later patches: on the ivy wall half of the patches added
+// nothing.)
+void LocalPatchSynthesis::mark_synthesised(int seed, const PatchFrame& frame,
+                                           const FramedOutput& framed, const Vector3d& t,
+                                           const std::vector<int>& rejected,
+                                           const PatchCounts& counts) {
+  const LocalPatch& patch = frame.patch();
+  const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch_.size.head<2>();
+  PointsNear2D geometry(1.5 * H_);
+  for (const int id : framed.elements_near(frame.uv().colwise().minCoeff().transpose(),
+                                           frame.uv().colwise().maxCoeff().transpose())) {
+    const Element& e = framed.element(id);
+    for (int v = 0; v < e.V.rows(); ++v) geometry.add(Vector2d(e.V(v, 0), e.V(v, 1)));
+  }
+  PointsNear2D refused(std::max(1.5 * H_, cell_));
+  for (const int i : rejected) {
+    const Element& e = swatch_.elements[static_cast<size_t>(i)];
+    for (int v = 0; v < e.V.rows(); ++v)
+      refused.add(Vector2d(e.V(v, 0) + t.x(), e.V(v, 1) + t.y()));
+  }
+  for (size_t f = 0; f < patch.faces.size(); ++f) {
+    const Vector2d q = frame.face_centroid(static_cast<int>(f));
+    if (geometry.any_within(q) ||
+        (q.x() >= patch_lo.x() && q.y() >= patch_lo.y() && q.x() <= patch_hi.x() &&
+         q.y() <= patch_hi.y() && frame.distance_to_border(q) >= margin_ && !refused.any_within(q)))
+      front_.mark(patch.faces[f]);
+  }
+  // A patch that added nothing found a hole no swatch element fits into: give up on the faces
+  // around its seed, within half an element, instead of retrying them one by one.
+  if (counts.added + counts.replaced + counts.stitched == 0) {
+    for (size_t f = 0; f < patch.faces.size(); ++f) {
+      if (frame.face_centroid(static_cast<int>(f)).norm() <= 0.5 * max_element_)
+        front_.mark(patch.faces[f]);
+    }
+  }
+  front_.mark(seed);  // progress is guaranteed
+}
+
+// The surviving elements, in the order they were made, over the job's bases.
+SurfaceQuilt LocalPatchSynthesis::take_quilt(SurfaceJob& job) {
+  SurfaceQuilt quilt;
+  quilt.kinds = swatch_.kinds;
+  quilt.shell_height = H_;
+  quilt.base = job.base;
+  quilt.input_base = std::move(job.cleaned);
+  quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
+  ScopedStageTimer timer(times_, "post-processing");
+  for (size_t id = 0; id < store_.elements.size(); ++id)
+    if (store_.alive[id] && !store_.elements[id].face.empty())
+      quilt.elements.push_back(std::move(store_.elements[id]));
+  return quilt;
+}
+
+}  // namespace
+
 SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
                                     const SurfaceQuiltingOptions& options,
                                     TranslationCostEvaluator& evaluator,
                                     SurfaceQuiltingStats* stats_out, ProgressSink* progress) {
-  StageTimes& times = stats.times;
-  TriMesh& cleaned = job.cleaned;
-  const TriMesh& base = job.base;
-  Refinement& refinement = job.refinement;
-  const MatrixX3d& field = job.field;
-  const EdgeTopology& topo = job.topo;
-  const MatrixX3i& TT = job.TT;
-  const int nf = base.num_faces();
-
-  PreparedSwatch swatch;
-  std::unique_ptr<SwatchFaceTree> swatch_tree;
-  const EmbreeDevice embree;  // one device for every BVH of the run
-  LaplacianTopologyCache laplacians;
-  {
-    ScopedStageTimer timer(times, "prepare");
-    swatch = prepare_swatch(job.swatch);
-    swatch_tree = std::make_unique<SwatchFaceTree>(swatch.mesh.V, swatch.mesh.F);
-    laplacians = swatch_topologies(swatch);
-  }
-  const SwatchQueries queries{*swatch_tree, embree, laplacians};
-  const double H = swatch.size.z();
-  stats.shell_height = H;
-  const double cell = matching_cell_size(swatch);
-  stats.cell_size = cell;
-  const int swatch_cells =
-      static_cast<int>(std::floor(std::min(swatch.size.x(), swatch.size.y()) / cell + 1e-9));
-  const int window = std::max(
-      1, std::min(swatch_cells, static_cast<int>(options.subpatch_fraction * swatch_cells)));
-  const double footprint_area = swatch.size.x() * swatch.size.y();
-  // Faces are marked synthesised only this far inside both the swatch and the patch, so that
-  // elements cut off at the patch border are grown again by a later patch.
-  double max_element = 0;
-  for (const Element& e : swatch.elements)
-    max_element = std::max(max_element, e.footprint_diameter());
-  const double margin =
-      std::min(0.5 * max_element, 0.25 * std::min(swatch.size.x(), swatch.size.y()));
-
-  LocalPatchBuilder builder(base, topo, TT);
-  SurfaceStore store(nf);
-  std::vector<unsigned char> done(nf, 0);
-  std::vector<int> count(nf, 0);
-  std::set<std::pair<int, int>> queue;  // (-synthesised neighbours, face)
-  for (int f = 0; f < nf; ++f) queue.emplace(0, f);
-  int num_done = 0;
-  auto mark = [&](int f) {
-    if (done[f]) return;
-    done[f] = 1;
-    ++num_done;
-    queue.erase({-count[f], f});
-    for (int k = 0; k < 3; ++k) {
-      const int g = TT(f, k);
-      if (g < 0 || done[g]) continue;
-      queue.erase({-count[g], g});
-      ++count[g];
-      queue.emplace(-count[g], g);
-    }
-  };
-  std::mt19937_64 rng(options.seed);
-  LocalPatchOptions patch_options;
-  {
-    // Automatic size: a disk whose radius reaches the farthest swatch corner of any admissible
-    // placement (the sub-patch window around the seed stays inside the swatch), so that the
-    // swatch lands on the patch wherever matching puts it; elements beyond the patch cannot be
-    // stored and are rejected.
-    const double half = 0.5 * window * cell;
-    const double reach = Vector2d(swatch.size.x() - half, swatch.size.y() - half).norm();
-    patch_options.max_area = options.patch_area_factor > 0
-                                 ? options.patch_area_factor * footprint_area
-                                 : 3.14159265358979 * reach * reach;
-  }
-  patch_options.max_distortion = options.max_distortion;
-  const MatrixX3d base_normals = vertex_normals(base.V, base.F);
-  const ClosestPointQuery base_query(embree, base.V, base.F);
-
-  while (!queue.empty()) {
-    const int seed = queue.begin()->second;
-    ++stats.iterations;
-    std::unique_ptr<PatchFrame> frame;
-    {
-      ScopedStageTimer timer(times, "parameterization");
-      LocalPatch patch;
-      try {
-        patch = builder.grow(seed, patch_options);
-      } catch (const InvalidInput&) {
-        mark(seed);  // a degenerate triangle: nothing can be placed on it
-        continue;
-      }
-      if (patch.shrink_steps > 0) ++stats.patches_shrunk;
-      stats.patch_faces += static_cast<long long>(patch.faces.size());
-      frame =
-          std::make_unique<PatchFrame>(base, std::move(patch), field.row(seed).transpose(), embree);
-    }
-    const LocalPatch& patch = frame->patch();
-
-    // The output near the patch, flattened into the frame.
-    std::map<int, Element> flat;
-    {
-      ScopedStageTimer timer(times, "parameterization");
-      std::set<int> ids;
-      for (const int f : patch.faces)
-        for (const int id : store.by_face[f])
-          if (store.alive[id]) ids.insert(id);
-      for (const int id : ids) {
-        const SurfaceElement& s = store.elements[id];
-        Element e;
-        e.F = s.F;
-        e.kind = s.kind;
-        e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
-        for (size_t v = 0; v < s.face.size(); ++v) {
-          const Vector2d q = frame->to_frame(s.face[v], s.barycentric.row(v).transpose());
-          e.V.row(v) << q.x(), q.y(), s.height(v);
-        }
-        e.update();
-        flat.emplace(id, std::move(e));
-      }
-    }
-    // Whether a frame point lies over a face synthesised before this patch.
-    auto processed = [&frame, &done](double x, double y) {
-      int f;
-      Vector3d b;
-      if (!frame->locate(Vector2d(x, y), f, b)) return false;
-      return done[frame->patch().faces[f]] != 0;
-    };
-
-    // Step 2: geometry matching around the seed (the frame origin).
-    OffsetChoice choice;
-    {
-      ScopedStageTimer timer(times, "matching");
-      const double half = 0.5 * window * cell;
-      std::vector<const Element*> near;
-      near.reserve(flat.size());
-      for (const auto& [id, e] : flat) near.push_back(&e);
-      MatrixX3d P, NP;
-      // Seeds lie just beyond the synthesised surface (faces within 1.5 shell heights of
-      // geometry count as synthesised), so the sub-patch reaches half an element (at most three
-      // shell heights: long vines would pull in the whole patch) further than the window the
-      // swatch must cover: without that it would often hold no output at all and the swatch
-      // would be placed unmatched.
-      const double reach = half + std::min(0.5 * max_element, 3.0 * H);
-      gather_subpatch(near, Vector2d::Constant(-reach), Vector2d::Constant(reach),
-                      options.match_points, P, NP);
-      const Vector2d t_min = Vector2d::Constant(half) - swatch.size.head<2>();
-      const Vector2d t_max = Vector2d::Constant(-half);
-      MatrixX3d T = whole_cell_offsets(t_min, t_max, cell);
-      MatchingOptions matching = options.matching;
-      matching.lambda = options.matching.lambda / cell;
-      // The first patch has nothing to match: the swatch is centred on the seed.
-      if (P.rows() == 0)
-        T = Vector3d(-0.5 * swatch.size.x(), -0.5 * swatch.size.y(), 0).transpose();
-      choice = choose_offset(*swatch_tree, evaluator, P, NP, T, t_min, t_max, cell, matching, rng);
-      stats.matched_point_offsets += choice.point_offsets;
-    }
-    const Vector3d t = choice.offset;
-    const Vector2d patch_lo = t.head<2>(), patch_hi = patch_lo + swatch.size.head<2>();
-    const OverlapRegion region(patch_lo, patch_hi, processed);
-
-    // Steps 3-5 in the frame. A swatch element enters only if it lies wholly on the patch, so
-    // that it can be stored in local coordinates.
-    FramedOutput framed(store, std::move(flat));
-    int outside = 0;
-    const std::function<bool(const Element&)> admissible = [&](const Element& e) {
-      int f;
-      Vector3d b;
-      for (int v = 0; v < e.V.rows(); ++v)
-        if (!frame->locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b)) {
-          ++outside;
-          return false;
-        }
-      return true;
-    };
-    PatchCounts counts;
-    std::vector<int> rejected;
-    quilt_patch(framed, swatch, queries, t, region, admissible, options.patch, counts, times,
-                &rejected);
-    accumulate(stats.counts, counts);
-    stats.rejected_outside_patch += outside;
-
-    // New and changed elements back to local coordinates.
-    {
-      ScopedStageTimer timer(times, "parameterization");
-      for (const int id : framed.changed()) {
-        if (!store.alive[id]) continue;
-        const Element& e = framed.frame_element(id);
-        SurfaceElement s;
-        s.F = e.F;
-        s.kind = e.kind;
-        s.face.resize(e.V.rows());
-        s.barycentric.resize(e.V.rows(), 3);
-        s.height.resize(e.V.rows());
-        for (int v = 0; v < e.V.rows(); ++v) {
-          int f;
-          Vector3d b;
-          const bool in = frame->locate(Vector2d(e.V(v, 0), e.V(v, 1)), f, b);
-          if (in) {
-            s.face[v] = patch.faces[f];
-            s.barycentric.row(v) = b.cwiseMax(0.0).transpose() / b.cwiseMax(0.0).sum();
-          } else {
-            // Beyond the patch (a changed element reaching out of it): extrapolate the nearest
-            // patch face's map into 3D and project onto the base.
-            const MatrixX3i& PF = patch.mesh.F;
-            const Vector3d p = b(0) * patch.mesh.V.row(PF(f, 0)).transpose() +
-                               b(1) * patch.mesh.V.row(PF(f, 1)).transpose() +
-                               b(2) * patch.mesh.V.row(PF(f, 2)).transpose();
-            const ClosestPointHit hit = base_query.closest(p);
-            s.face[v] = hit.face;
-            s.barycentric.row(v) = hit.barycentric.transpose();
-          }
-          s.height(v) = std::clamp(e.V(v, 2), 0.0, H);
-        }
-        store.elements[id] = std::move(s);
-        store.index(id);
-      }
-    }
-    // Mark the patch faces now covered: within 1.5 shell heights of output geometry (issue 4's
-    // coverage criterion), whichever patch placed it, or inside the swatch footprint, away from
-    // the patch border by the margin (elements there may have been cut off) and away from the
-    // swatch elements refused here. Those are the places a later patch must try again; a gap of
-    // the swatch itself is a gap of the texture. Elements that would reach into the footprint
-    // from outside are missing from every swatch; a later patch seeded beyond the footprint
-    // adds them, since they lie partly outside the processed region. (Marking only the
-    // footprint's central quarter left ~15 faces of every 16 in a patch to later patches: on
-    // the ivy wall half of the patches added nothing.)
-    PointsNear2D geometry(1.5 * H);
-    for (const int id : framed.elements_near(frame->uv().colwise().minCoeff().transpose(),
-                                             frame->uv().colwise().maxCoeff().transpose())) {
-      const Element& e = framed.element(id);
-      for (int v = 0; v < e.V.rows(); ++v) geometry.add(Vector2d(e.V(v, 0), e.V(v, 1)));
-    }
-    PointsNear2D refused(std::max(1.5 * H, cell));
-    for (const int i : rejected) {
-      const Element& e = swatch.elements[static_cast<size_t>(i)];
-      for (int v = 0; v < e.V.rows(); ++v)
-        refused.add(Vector2d(e.V(v, 0) + t.x(), e.V(v, 1) + t.y()));
-    }
-    for (size_t f = 0; f < patch.faces.size(); ++f) {
-      const Vector2d q = frame->face_centroid(static_cast<int>(f));
-      if (geometry.any_within(q) ||
-          (q.x() >= patch_lo.x() && q.y() >= patch_lo.y() && q.x() <= patch_hi.x() &&
-           q.y() <= patch_hi.y() && frame->distance_to_border(q) >= margin &&
-           !refused.any_within(q)))
-        mark(patch.faces[f]);
-    }
-    // A patch that added nothing found a hole no swatch element fits into: give up on the
-    // faces around its seed, within half an element, instead of retrying them one by one.
-    if (counts.added + counts.replaced + counts.stitched == 0) {
-      for (size_t f = 0; f < patch.faces.size(); ++f) {
-        if (frame->face_centroid(static_cast<int>(f)).norm() <= 0.5 * max_element)
-          mark(patch.faces[f]);
-      }
-    }
-    mark(seed);  // progress is guaranteed
-    report_progress(progress, "quilting", num_done, nf);
-  }
-
-  SurfaceQuilt quilt;
-  quilt.kinds = swatch.kinds;
-  quilt.shell_height = H;
-  quilt.base = base;
-  quilt.input_base = std::move(cleaned);
-  quilt.refinement = std::move(refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
-  {
-    ScopedStageTimer timer(times, "post-processing");
-    for (size_t id = 0; id < store.elements.size(); ++id)
-      if (store.alive[id] && !store.elements[id].face.empty())
-        quilt.elements.push_back(std::move(store.elements[id]));
-  }
+  LocalPatchSynthesis synthesis(job, options, evaluator, stats);
+  while (!synthesis.finished()) synthesis.run_patch(progress);
+  SurfaceQuilt quilt = synthesis.take_quilt(job);
   report_progress(progress, "quilting", 1, 1);
   stats.elements = static_cast<int>(quilt.elements.size());
   for (const SurfaceElement& e : quilt.elements) {
