@@ -212,7 +212,7 @@ int run_embed(int argc, char** argv, int first) {
     }
     const TriMesh result = follow_base(saved, V, follow, &f.stats);
     {
-      ScopedStageProgress shown(run.progress(), "writing");
+      ScopedStageProgress shown(run.progress(), Stage::Writing);
       write_output(f.output, result, write_options);
     }
     f.seconds =

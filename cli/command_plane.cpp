@@ -139,7 +139,7 @@ int run_plane(int argc, char** argv, int first) {
   double measuring = 0;
   if (!run.stats_path().empty()) {
     const auto t0 = std::chrono::steady_clock::now();
-    ScopedStageTimer timer(stats.times, "structure");
+    ScopedStageTimer timer(stats.times, Stage::Structure);
     structure = summarize_structure(result, swatch, nullptr, 1.0);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -563,7 +563,7 @@ int run_surface(int argc, char** argv, int first) {
                         r.min_coverage, own_coverage, "try a smaller --scale");
   SavedQuilt saved;
   if (cl.has("save-quilt")) {
-    ScopedStageTimer timer(o.stats.times, "save quilt");
+    ScopedStageTimer timer(o.stats.times, Stage::SaveQuilt);
     saved = make_saved(cl, r, in, quilt, result);
   }
   // The structure figures (issue 13) are measured for --stats: a second or so on a million
@@ -571,7 +571,7 @@ int run_surface(int argc, char** argv, int first) {
   double measuring = 0;
   if (!run.stats_path().empty()) {
     const auto t0 = std::chrono::steady_clock::now();
-    ScopedStageTimer timer(o.stats.times, "structure");
+    ScopedStageTimer timer(o.stats.times, Stage::Structure);
     o.structure = summarize_structure(result, swatch, &in.base, o.stats.swatch_scale);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -113,12 +113,12 @@ double write_output_and_stats(RunContext& run, const std::string& path, const Tr
                               const WriteOptions& options, StageTimes& times,
                               std::chrono::steady_clock::time_point start, double excluded,
                               const std::function<std::string(double wall)>& stats_json) {
-  ScopedStageProgress shown(run.progress(), "writing");
+  ScopedStageProgress shown(run.progress(), Stage::Writing);
   const auto write_start = std::chrono::steady_clock::now();
   double wall = 0;
   const auto finish_timing = [&] {
     const auto now = std::chrono::steady_clock::now();
-    times.add("write", std::chrono::duration<double>(now - write_start).count());
+    times.add(Stage::Writing, std::chrono::duration<double>(now - write_start).count());
     wall = std::chrono::duration<double>(now - start).count() - excluded;
   };
   WriteOptions with_stats = options;

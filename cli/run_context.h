@@ -103,7 +103,7 @@ class RunContext {
 
 // Writes a result (write_output) and its --stats file, when the run asks for one, as one commit
 // (issue 28): stats_json(wall) makes the stats once the mesh is written out, so that they hold
-// the write's seconds (added to `times` as "write") and the run's wall time: since `start`,
+// the write's seconds (added to `times` as Stage::Writing) and the run's wall time: since `start`,
 // less `excluded` (seconds spent on figures for the stats alone). Returns that wall time.
 double write_output_and_stats(RunContext& run, const std::string& path, const TriMesh& mesh,
                               const WriteOptions& options, StageTimes& times,

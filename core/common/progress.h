@@ -3,7 +3,8 @@
 #pragma once
 
 #include <string>
-#include <utility>
+
+#include "core/common/stage.h"
 
 namespace mq {
 
@@ -17,10 +18,9 @@ class ProgressSink {
   virtual void finish() {}
 };
 
-// Null-safe forwarding helper.
-inline void report_progress(ProgressSink* sink, const std::string& stage, double done,
-                            double total) {
-  if (sink) sink->update(stage, done, total);
+// Null-safe forwarding helper: the sink sees the stage's name.
+inline void report_progress(ProgressSink* sink, Stage stage, double done, double total) {
+  if (sink) sink->update(stage_name(stage), done, total);
 }
 
 // A stage without finer progress: reported at 0 when the scope starts and done when it ends,
@@ -28,8 +28,7 @@ inline void report_progress(ProgressSink* sink, const std::string& stage, double
 // optimisation, ...), not only those with many units of work.
 class ScopedStageProgress {
  public:
-  ScopedStageProgress(ProgressSink* sink, std::string stage)
-      : sink_(sink), stage_(std::move(stage)) {
+  ScopedStageProgress(ProgressSink* sink, Stage stage) : sink_(sink), stage_(stage) {
     report_progress(sink_, stage_, 0, 1);
   }
   ~ScopedStageProgress() { report_progress(sink_, stage_, 1, 1); }
@@ -38,7 +37,7 @@ class ScopedStageProgress {
 
  private:
   ProgressSink* sink_;
-  std::string stage_;
+  Stage stage_;
 };
 
 }  // namespace mq

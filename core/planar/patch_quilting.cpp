@@ -304,17 +304,17 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
   if (rejected) rejected->clear();
   Patch patch;
   {
-    ScopedStageTimer timer(times, "correspondence");
+    ScopedStageTimer timer(times, Stage::Correspondence);
     patch = find_patch_correspondences(output, swatch, queries, t, region, options.correspondence,
                                        counts);
   }
   find_partners(patch, region, options.partner_share);
   choose_deformed(patch, output, region);
   {
-    ScopedStageTimer timer(times, "deformation");
+    ScopedStageTimer timer(times, Stage::Deformation);
     deform_related(patch, swatch, queries, options);
   }
-  ScopedStageTimer timer(times, "merging");
+  ScopedStageTimer timer(times, Stage::Merging);
   PatchMerger merger(output, patch, region, queries, options.merging, swatch.mean_edge_length,
                      counts);
   for (size_t i = 0; i < patch.moved.size(); ++i) {

@@ -154,7 +154,7 @@ class PlaneQuilter {
     window_ = std::max(
         1, std::min({static_cast<int>(options_.subpatch_fraction * std::min(cells_x, cells_y)),
                      cells_x, cells_y}));
-    ScopedStageTimer timer(stats_.times, "prepare");
+    ScopedStageTimer timer(stats_.times, Stage::Prepare);
     swatch_tree_ = std::make_unique<SwatchFaceTree>(swatch_.mesh.V, swatch_.mesh.F);
     laplacians_ = swatch_topologies(swatch_);
     // The swatch must be able to shift by a period of its texture and still cover the
@@ -174,7 +174,7 @@ class PlaneQuilter {
 
   // First patch: the swatch as it is, at the origin.
   void place_first_patch() {
-    ScopedStageTimer timer(stats_.times, "merging");
+    ScopedStageTimer timer(stats_.times, Stage::Merging);
     for (const Element& e : swatch_.elements)
       if (in_domain_(e)) {
         output_.add(e);
@@ -201,7 +201,7 @@ class PlaneQuilter {
   // Post-processing: elements outside the domain go; border elements stay whole unless
   // trimmed (into `trimmed`, which the result points into).
   std::vector<const Element*> keep_in_domain(std::vector<Element>& trimmed) {
-    ScopedStageTimer timer(stats_.times, "post-processing");
+    ScopedStageTimer timer(stats_.times, Stage::PostProcessing);
     std::vector<const Element*> kept;
     trimmed.reserve(output_.size());
     for (int id = 0; id < output_.size(); ++id) {
@@ -236,7 +236,7 @@ class PlaneQuilter {
     const Vector2d sub_lo(px0 * cell_, py0 * cell_), sub_hi((px1 + 1) * cell_, (py1 + 1) * cell_);
     const Vector2d t_min = sub_hi - swatch_.size.head<2>();
     const Vector2d& t_max = sub_lo;
-    ScopedStageTimer timer(stats_.times, "matching");
+    ScopedStageTimer timer(stats_.times, Stage::Matching);
     std::vector<const Element*> near;
     for (const int id : output_.query(sub_lo, sub_hi)) near.push_back(&output_[id]);
     MatrixX3d P, NP;
@@ -326,7 +326,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   PlanarQuiltingStats stats;
   PreparedSwatch swatch;
   {
-    ScopedStageTimer timer(stats.times, "prepare");
+    ScopedStageTimer timer(stats.times, Stage::Prepare);
     swatch = prepare_swatch(swatch_mesh);
     // After the swatch, so that a bad swatch is what a job with both wrong is refused for.
     options.validate();
@@ -336,11 +336,11 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   quilter.prepare_queries();
   quilter.place_first_patch();
   SynthesisGrid& grid = quilter.grid();
-  report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
+  report_progress(progress, Stage::Quilting, grid.num_processed(), grid.num_cells());
   Cell seed;
   while (grid.next_seed(seed)) {
     quilter.quilt_at(seed);
-    report_progress(progress, "quilting", grid.num_processed(), grid.num_cells());
+    report_progress(progress, Stage::Quilting, grid.num_processed(), grid.num_cells());
   }
   std::vector<Element> trimmed;
   const std::vector<const Element*> kept = quilter.keep_in_domain(trimmed);
@@ -350,7 +350,7 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   const Eigen::Matrix3d back = swatch.rotation.transpose();
   result.V = (result.V * back.transpose()).eval();
   result.N = (result.N * back.transpose()).eval();
-  report_progress(progress, "quilting", 1, 1);
+  report_progress(progress, Stage::Quilting, 1, 1);
   stats.faces = result.num_faces();
   stats.vertices = result.num_vertices();
   stats.elements = static_cast<int>(kept.size());

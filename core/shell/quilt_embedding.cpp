@@ -220,8 +220,7 @@ QuiltEmbedder::QuiltEmbedder(const SurfaceQuilt& quilt, const QuiltEmbeddingOpti
 void QuiltEmbedder::build_shell_map() {
   ShellMapOptions map_options;
   map_options.height = quilt_.shell_height;
-  ScopedStageTimer timer(stats_.times, "shell map");
-  ScopedStageProgress shown(progress_, "shell map");
+  ScopedStage stage(stats_.times, progress_, Stage::ShellMap);
   try {
     map_ = std::make_unique<ShellMap>(quilt_.base.V, quilt_.base.F, map_options);
     stats_.atlas_charts = map_->atlas().num_charts;
@@ -259,8 +258,7 @@ void QuiltEmbedder::embed(TetStretchEvaluator& stretch) {
     embed_through_map(stretch);
     return;
   }
-  ScopedStageTimer timer(stats_.times, "embedding");
-  ScopedStageProgress shown(progress_, "embedding");
+  ScopedStage stage(stats_.times, progress_, Stage::Embedding);
   all_.V = normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(quilt_), points_);
 }
 
@@ -272,13 +270,11 @@ void QuiltEmbedder::embed(TetStretchEvaluator& stretch) {
 void QuiltEmbedder::embed_through_map(TetStretchEvaluator& stretch) {
   MatrixX3d unoptimized;
   if (options_.optimize_stretch) {
-    ScopedStageTimer timer(stats_.times, "embedding");
-    ScopedStageProgress shown(progress_, "embedding");
+    ScopedStage stage(stats_.times, progress_, Stage::Embedding);
     unoptimized = ShellEmbedding(*map_).embed(mapped_);
   }
   {
-    ScopedStageTimer timer(stats_.times, "stretch optimization");
-    ScopedStageProgress shown(progress_, "stretch optimization");
+    ScopedStage stage(stats_.times, progress_, Stage::StretchOptimization);
     stats_.stretch_before = stats_.stretch_after = map_->stretch(stretch);
     if (options_.optimize_stretch) {
       ShellOptimizeOptions o;
@@ -288,8 +284,7 @@ void QuiltEmbedder::embed_through_map(TetStretchEvaluator& stretch) {
       stats_.optimization_sweeps = report.sweeps;
     }
   }
-  ScopedStageTimer timer(stats_.times, "embedding");
-  ScopedStageProgress shown(progress_, "embedding");
+  ScopedStage stage(stats_.times, progress_, Stage::Embedding);
   all_.V = ShellEmbedding(*map_).embed(mapped_);
   place_by_normal(quilt_, points_, first_, by_normal_, all_.V);
   if (!options_.optimize_stretch) return;
@@ -357,8 +352,7 @@ void QuiltEmbedder::embed_layout_versions() {
 // by the repairs that follow are checked again before the output.
 void QuiltEmbedder::check_placement() {
   if (first_.back() == 0) return;
-  ScopedStageTimer timer(stats_.times, "placement check");
-  ScopedStageProgress shown(progress_, "placement check");
+  ScopedStage stage(stats_.times, progress_, Stage::PlacementCheck);
   base_height_.emplace(quilt_.input_base.V, quilt_.input_base.F);
   heights_ = check_element_heights(*base_height_, all_.V, first_, check_);
   stats_.below_base_embedded = placement_figures(heights_).below_share();
@@ -440,8 +434,7 @@ std::vector<char> QuiltEmbedder::lift_moved() {
 // Repair (issue 13): an element the map folds through itself is replaced by its flat shape
 // fitted where the map put it, as little as removes the fold (core/shell/element_unfolding).
 void QuiltEmbedder::repair_folds() {
-  ScopedStageTimer timer(stats_.times, "fold repair");
-  ScopedStageProgress shown(progress_, "fold repair");
+  ScopedStage stage(stats_.times, progress_, Stage::FoldRepair);
   if (!known_disjoint_) find_pairs_once();
   // Folded: a pair within the element, or for an element moved since the pairs were found (kept
   // on the unoptimised map), its own test.
@@ -483,8 +476,7 @@ void QuiltEmbedder::repair_folds() {
 // swatch's 4 links 84.2 -> 91.3%, rings removed 122 -> 32.
 void QuiltEmbedder::separate_touching_rings() {
   if (!have_pairs_) return;
-  ScopedStageTimer timer(stats_.times, "ring separation");
-  ScopedStageProgress shown(progress_, "ring separation");
+  ScopedStage stage(stats_.times, progress_, Stage::RingSeparation);
   std::vector<char> touching(ne_, 0), folded_now(ne_, 0);
   for (const auto& [f, g] : pairs_) {
     if (element_of_[f] == element_of_[g])
@@ -537,8 +529,7 @@ void QuiltEmbedder::separate_touching_rings() {
 // armor's rings are left to remove instead of 122.
 void QuiltEmbedder::remove_intersecting() {
   if (known_disjoint_) return;
-  ScopedStageTimer timer(stats_.times, "element removal");
-  ScopedStageProgress shown(progress_, "element removal");
+  ScopedStage stage(stats_.times, progress_, Stage::ElementRemoval);
   find_pairs_once();
   choose_removals(pairs_, element_of_, drop_, folded_);
   // Folded and sunk elements are not tried again.
@@ -563,8 +554,7 @@ void QuiltEmbedder::remove_intersecting() {
 // under the base is removed; the output's figures.
 void QuiltEmbedder::check_output() {
   if (heights_.empty()) return;
-  ScopedStageTimer timer(stats_.times, "placement check");
-  ScopedStageProgress shown(progress_, "placement check");
+  ScopedStage stage(stats_.times, progress_, Stage::PlacementCheck);
   for (size_t k = 0; k < ne_; ++k) moved_after_check_[k] = moved_after_check_[k] && !drop_[k];
   if (std::find(moved_after_check_.begin(), moved_after_check_.end(), 1) !=
       moved_after_check_.end()) {
@@ -639,8 +629,7 @@ TriMesh QuiltEmbedder::output() {
 // jump by 0.2 between runs of nearly identical output). Only geometry on the base's outer side
 // counts (issue 23: texture inside the base covered the open quadruped's legs from within).
 void QuiltEmbedder::measure_coverage(const TriMesh& out) {
-  ScopedStageTimer timer(stats_.times, "coverage");
-  ScopedStageProgress shown(progress_, "coverage");
+  ScopedStage stage(stats_.times, progress_, Stage::Coverage);
   stats_.coverage =
       surface_coverage(quilt_.base, out, 1.5 * quilt_.shell_height,
                        stats_.placement_tolerance * quilt_.shell_height, options_.coverage_faces);

@@ -512,8 +512,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
   std::vector<Vector2d> centres;
   std::vector<LatticeCopy> copies;
   {
-    ScopedStageTimer timer(times, "tiling");
-    ScopedStageProgress shown(progress, "tiling");
+    ScopedStage stage(times, progress, Stage::Tiling);
     // The orbits and their centres at full detail: a Preview places the same copies.
     reps = orbit_representatives(full, sym);
     gstats.orbits = static_cast<int>(reps.size());
@@ -533,8 +532,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
           0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
     }
   }
-  ScopedStageTimer timer(times, "placement");
-  ScopedStageProgress shown(progress, "placement");
+  ScopedStage stage(times, progress, Stage::Placement);
   Eigen::Matrix2d basis;
   basis.col(0) = sym.a;
   basis.col(1) = sym.b;
@@ -546,7 +544,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
   // placement depends only on it: the result is the same whatever the blocks).
   const int block = std::max(64, n / 50);
   for (int first = 0; first < n; first += block) {
-    report_progress(progress, "placement", first, n);
+    report_progress(progress, Stage::Placement, first, n);
     tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
       const LatticeCopy& c = copies[static_cast<size_t>(i)];
       const Element& e = swatch.elements[static_cast<size_t>(reps[c.rep])];
@@ -602,8 +600,7 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
                                         const TriMesh& plane, double shell_height,
                                         GlobalQuiltingStats& gstats, StageTimes& times,
                                         ProgressSink* progress) {
-  ScopedStageTimer timer(times, "placement");
-  ScopedStageProgress shown(progress, "placement");
+  ScopedStage stage(times, progress, Stage::Placement);
   const ChartGrid grid(gp, job.base.num_faces());
   std::vector<int> fc;
   const int n = connected_components(plane.F, plane.num_vertices(), fc);
@@ -612,7 +609,7 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
   std::vector<int> off(static_cast<size_t>(n), 0);
   const int block = std::max(64, n / 50);
   for (int first = 0; first < n; first += block) {
-    report_progress(progress, "placement", first, n);
+    report_progress(progress, Stage::Placement, first, n);
     tbb::parallel_for(first, std::min(n, first + block), [&](int c) {
       const TriMesh part = extract_faces(plane, groups[c]);
       const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
@@ -705,8 +702,7 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
   basis.col(1) = sym.b;
   std::vector<LatticeCopy> copies;
   {
-    ScopedStageTimer timer(times, "tiling");
-    ScopedStageProgress shown(progress, "tiling");
+    ScopedStage stage(times, progress, Stage::Tiling);
     std::vector<Vector2d> centres;
     for (const ThreadPiece& p : tiling.pieces) centres.push_back(p.centre + lo);
     copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
@@ -723,8 +719,7 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
           0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
     }
   }
-  ScopedStageTimer timer(times, "placement");
-  ScopedStageProgress shown(progress, "placement");
+  ScopedStage stage(times, progress, Stage::Placement);
   const Eigen::MatrixXd differential = layout_differential(gp, job.base);
   const MatrixX3d N = vertex_normals(job.base.V, job.base.F);
   std::vector<Vector3d> cones;
@@ -740,7 +735,7 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
   std::vector<char> outcome(copies.size(), kOff);
   const int block = std::max(64, n / 50);
   for (int first = 0; first < n; first += block) {
-    report_progress(progress, "placement", first, n);
+    report_progress(progress, Stage::Placement, first, n);
     tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
       const LatticeCopy& c = copies[static_cast<size_t>(i)];
       const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(c.rep)];
@@ -909,8 +904,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   GlobalParameterization gp;
   Vector2d anchor = Vector2d::Zero();
   {
-    ScopedStageTimer timer(times, "parameterization");
-    ScopedStageProgress shown(progress, "parameterization");
+    ScopedStage stage(times, progress, Stage::Parameterization);
     const MatrixX3d smoothed = options.global.smoothing > 0
                                    ? smoothed_positions(base, job.topo, options.global.smoothing)
                                    : base.V;
@@ -1018,7 +1012,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     stats.cell_size = ps.cell_size;
     stats.matched_point_offsets = ps.matched_point_offsets;
     stats.counts = ps.counts;
-    for (const auto& [stage, seconds] : ps.times.stages()) times.add(stage, seconds);
+    times.merge(ps.times);
     // Back into the synthesis frame (thickness along z).
     plane.V = (plane.V * swatch.rotation.transpose()).eval();
     plane.V.col(0).array() += lo.x();
@@ -1040,14 +1034,14 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
     stats.faces += static_cast<int>(e.F.rows());
     stats.vertices += static_cast<int>(e.face.size());
   }
-  report_progress(progress, "quilting", 1, 1);
+  report_progress(progress, Stage::Quilting, 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (global_out) *global_out = gstats;
   return quilt;
 }
 
 SwatchSymmetry timed_symmetry(const PreparedSwatch& swatch, StageTimes& times) {
-  ScopedStageTimer timer(times, "symmetry");
+  ScopedStageTimer timer(times, Stage::Symmetry);
   const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
   return detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch));
 }
@@ -1085,7 +1079,7 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
   bool repeating = false, threads = false;
   {
-    ScopedStageTimer timer(stats.times, "method choice");
+    ScopedStageTimer timer(stats.times, Stage::MethodChoice);
     repeating = repeating_elements(deciding);
     threads = !repeating && long_elements(deciding);
   }
@@ -1095,7 +1089,7 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
     ThreadTiling tiling;
     bool global = false;
     {
-      ScopedStageTimer timer(stats.times, "method choice");
+      ScopedStageTimer timer(stats.times, Stage::MethodChoice);
       global = repeating ? tileable(deciding, symmetry)
                          : !(tiling = detailed_thread_tiling(swatch, deciding, symmetry)).empty();
     }
@@ -1117,7 +1111,7 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
         return quilt;
       }
       stats.times.add(
-          "unfit layout",
+          Stage::UnfitLayout,
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
   }
@@ -1125,7 +1119,7 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   if (used_vines) *used_vines = false;
   bool vines = false;
   {
-    ScopedStageTimer timer(stats.times, "method choice");
+    ScopedStageTimer timer(stats.times, Stage::MethodChoice);
     vines = is_vine_swatch(deciding);
   }
   if (vines) {

@@ -291,7 +291,7 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
                                const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
   validate_base(base_in);
   validate_surface_options(options, base_in);
-  ScopedStageTimer timer(stats.times, "prepare");
+  ScopedStageTimer timer(stats.times, Stage::Prepare);
   SurfaceJob job;
   std::vector<int> input_face = clean_base(base_in, options, job, stats);
   Vector3d swatch_sides = bounding_box(swatch_mesh.V, swatch_mesh.F).extent();
@@ -383,7 +383,7 @@ LocalPatchSynthesis::LocalPatchSynthesis(SurfaceJob& job, const SurfaceQuiltingO
       front_(job.TT),
       rng_(options.seed) {
   {
-    ScopedStageTimer timer(times_, "prepare");
+    ScopedStageTimer timer(times_, Stage::Prepare);
     swatch_ = prepare_swatch(job.swatch);
     swatch_tree_ = std::make_unique<SwatchFaceTree>(swatch_.mesh.V, swatch_.mesh.F);
     laplacians_ = swatch_topologies(swatch_);
@@ -457,13 +457,13 @@ void LocalPatchSynthesis::run_patch(ProgressSink* progress) {
   stats_.rejected_outside_patch += outside;
   store_changed(*frame, framed);
   mark_synthesised(seed, *frame, framed, t, rejected, counts);
-  report_progress(progress, "quilting", front_.num_synthesised(), job_.base.num_faces());
+  report_progress(progress, Stage::Quilting, front_.num_synthesised(), job_.base.num_faces());
 }
 
 // The local patch around the seed (core/surface/local_patch), flattened into the frame the
 // guidance field orients; null for a degenerate seed triangle.
 std::unique_ptr<PatchFrame> LocalPatchSynthesis::grow_patch(int seed) {
-  ScopedStageTimer timer(times_, "parameterization");
+  ScopedStageTimer timer(times_, Stage::Parameterization);
   LocalPatch patch;
   try {
     patch = builder_.grow(seed, patch_options_);
@@ -478,7 +478,7 @@ std::unique_ptr<PatchFrame> LocalPatchSynthesis::grow_patch(int seed) {
 
 // The output near the patch, flattened into the frame, by id.
 std::map<int, Element> LocalPatchSynthesis::flatten_output(const PatchFrame& frame) {
-  ScopedStageTimer timer(times_, "parameterization");
+  ScopedStageTimer timer(times_, Stage::Parameterization);
   std::map<int, Element> flat;
   std::set<int> ids;
   for (const int f : frame.patch().faces)
@@ -502,7 +502,7 @@ std::map<int, Element> LocalPatchSynthesis::flatten_output(const PatchFrame& fra
 
 // Step 2: geometry matching around the seed (the frame origin); the swatch's offset.
 Vector3d LocalPatchSynthesis::match(const std::map<int, Element>& flat) {
-  ScopedStageTimer timer(times_, "matching");
+  ScopedStageTimer timer(times_, Stage::Matching);
   const double half = 0.5 * window_ * cell_;
   std::vector<const Element*> near;
   near.reserve(flat.size());
@@ -531,7 +531,7 @@ Vector3d LocalPatchSynthesis::match(const std::map<int, Element>& flat) {
 
 // New and changed elements back to local coordinates.
 void LocalPatchSynthesis::store_changed(const PatchFrame& frame, const FramedOutput& framed) {
-  ScopedStageTimer timer(times_, "parameterization");
+  ScopedStageTimer timer(times_, Stage::Parameterization);
   const LocalPatch& patch = frame.patch();
   for (const int id : framed.changed()) {
     if (!store_.alive[id]) continue;
@@ -621,7 +621,7 @@ SurfaceQuilt LocalPatchSynthesis::take_quilt(SurfaceJob& job) {
   quilt.input_base = std::move(job.cleaned);
   quilt.refinement = std::move(job.refinement);
   quilt.input_vertex = std::move(job.input_vertex);
-  ScopedStageTimer timer(times_, "post-processing");
+  ScopedStageTimer timer(times_, Stage::PostProcessing);
   for (size_t id = 0; id < store_.elements.size(); ++id)
     if (store_.alive[id] && !store_.elements[id].face.empty())
       quilt.elements.push_back(std::move(store_.elements[id]));
@@ -637,7 +637,7 @@ SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
   LocalPatchSynthesis synthesis(job, options, evaluator, stats);
   while (!synthesis.finished()) synthesis.run_patch(progress);
   SurfaceQuilt quilt = synthesis.take_quilt(job);
-  report_progress(progress, "quilting", 1, 1);
+  report_progress(progress, Stage::Quilting, 1, 1);
   stats.elements = static_cast<int>(quilt.elements.size());
   for (const SurfaceElement& e : quilt.elements) {
     stats.faces += static_cast<int>(e.F.rows());

@@ -592,7 +592,7 @@ class Streamlines {
       Seed seed;
       seed.point.face = seed_faces[k];
       if ((k & 1023) == 0)
-        report_progress(progress, "streamlines", static_cast<double>(k),
+        report_progress(progress, Stage::Streamlines, static_cast<double>(k),
                         static_cast<double>(seed_faces.size()));
       if (!free_at(seed.point)) continue;
       nearest_line(seed);
@@ -1076,7 +1076,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   VineModel model;
   double spacing = 0;  // between stems, for the vine at full detail (the Preview's is the same)
   {
-    ScopedStageTimer timer(times, "prepare");
+    ScopedStageTimer timer(times, Stage::Prepare);
     swatch = prepare_swatch(job.swatch);
     // Measured at full detail, so that a Preview grows the full run's stems.
     const PreparedSwatch full =
@@ -1159,7 +1159,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   std::vector<std::vector<Sample>> lines;
   std::vector<double> phases;  // where each line's swatch pattern starts (arc length)
   {
-    ScopedStageTimer timer(times, "streamlines");
+    ScopedStageTimer timer(times, Stage::Streamlines);
     // The base's boundary, sampled, keeps the tubes off it.
     std::vector<Vector3d> obstacles;
     for (int e = 0; e < job.topo.num_edges(); ++e) {
@@ -1208,7 +1208,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     return false;
   };
   {
-    ScopedStageTimer timer(times, "stems");
+    ScopedStageTimer timer(times, Stage::Stems);
     const int kRounds = 3;
     for (int round = 0; round < kRounds && !pending.empty(); ++round) {
       const int n = static_cast<int>(pending.size());
@@ -1282,7 +1282,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     vs.stems_dropped = static_cast<int>(pending.size());
   }
   {
-    ScopedStageTimer timer(times, "leaves");
+    ScopedStageTimer timer(times, Stage::Leaves);
     const double pitch = model.period / std::max<size_t>(1, model.leaves.size());
     // A leaf that dips under the base is tried elsewhere along the stem, like one that meets
     // a neighbour.
@@ -1315,7 +1315,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
           break;
         }
       }
-      report_progress(progress, "leaves", static_cast<double>(k + 1),
+      report_progress(progress, Stage::Leaves, static_cast<double>(k + 1),
                       static_cast<double>(kept.size()));
     }
   }
@@ -1343,7 +1343,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     stats.faces += static_cast<int>(e.F.rows());
     stats.vertices += static_cast<int>(e.face.size());
   }
-  report_progress(progress, "leaves", 1, 1);
+  report_progress(progress, Stage::Leaves, 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (vine_stats) *vine_stats = vs;
   return quilt;
