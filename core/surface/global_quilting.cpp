@@ -1062,9 +1062,8 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
-  const PreparedSwatch full =
-      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+  PreparedSwatch full;
+  const PreparedSwatch& deciding = swatch_at_full_detail(job, swatch, full);
   const SwatchSymmetry symmetry = timed_symmetry(deciding, stats.times);
   return quilt_prepared_global(job, swatch, deciding, symmetry, {}, options, evaluator,
                                std::move(stats), stats_out, global_out, progress);
@@ -1080,9 +1079,8 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
   // The method and the lattice are decided at full detail (a Preview is the same layout).
-  const PreparedSwatch full =
-      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+  PreparedSwatch full;
+  const PreparedSwatch& deciding = swatch_at_full_detail(job, swatch, full);
   bool repeating = false, threads = false;
   {
     ScopedStageTimer timer(stats.times, "method choice");

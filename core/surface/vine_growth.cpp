@@ -1079,9 +1079,8 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     ScopedStageTimer timer(times, "prepare");
     swatch = prepare_swatch(job.swatch);
     // Measured at full detail, so that a Preview grows the full run's stems.
-    const PreparedSwatch full =
-        job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-    const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+    PreparedSwatch full;
+    const PreparedSwatch& deciding = swatch_at_full_detail(job, swatch, full);
     MQ_CHECK(is_vine_swatch(deciding), InvalidInput,
              "the vine method needs a swatch of one long element (a vine) with compact elements "
              "attached along it");
