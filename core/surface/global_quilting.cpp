@@ -497,6 +497,14 @@ GlobalParameterization seamless_parameterization(const MatrixX3d& V, const TriMe
 
 namespace {
 
+// The parameter plane's area over the base's faces, added to `area`.
+void add_parameter_area(const GlobalParameterization& gp, int num_faces, double& area) {
+  for (int f = 0; f < num_faces; ++f) {
+    const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
+    area += 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+  }
+}
+
 // The lattice of a tileable swatch carried onto the base (section 2's quilt of such a swatch is
 // its lattice tiling, core/planar/swatch_symmetry): every copy whose centre lies on the
 // parameterised surface, placed from the face holding its centre. The output is counted before
@@ -526,11 +534,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
     MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", copies.size(),
              " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
              " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
-    for (int f = 0; f < job.base.num_faces(); ++f) {
-      const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
-      gstats.parameter_area +=
-          0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
-    }
+    add_parameter_area(gp, job.base.num_faces(), gstats.parameter_area);
   }
   ScopedStage stage(times, progress, Stage::Placement);
   Eigen::Matrix2d basis;
@@ -674,6 +678,172 @@ bool layout_fit_for_tiling(const GlobalParameterization& gp, const TriMesh& base
   return surface > 0 && plane <= 4 * surface && even >= 0.8 * surface;
 }
 
+// Every lattice copy of every thread piece whose centre lies on the parameterised surface
+// (lattice_copies), counted before anything is built and refused over options.max_faces.
+std::vector<LatticeCopy> thread_piece_copies(const GlobalParameterization& gp,
+                                             const SurfaceJob& job, const ThreadTiling& tiling,
+                                             const SwatchSymmetry& sym, const Vector2d& lo,
+                                             const SurfaceQuiltingOptions& options,
+                                             GlobalQuiltingStats& gstats) {
+  std::vector<Vector2d> centres;
+  for (const ThreadPiece& p : tiling.pieces) centres.push_back(p.centre + lo);
+  std::vector<LatticeCopy> copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
+  double faces = 0;
+  for (const LatticeCopy& c : copies)
+    faces += static_cast<double>(tiling.pieces[static_cast<size_t>(c.rep)].F.rows());
+  MQ_CHECK(faces <= options.max_faces, InvalidInput, "the global layout would place ",
+           copies.size(), " thread pieces of about ", faces,
+           " faces in all, more than the limit of ", options.max_faces,
+           " (--max-faces); use a larger --scale");
+  add_parameter_area(gp, job.base.num_faces(), gstats.parameter_area);
+  return copies;
+}
+
+// Why a lattice copy of a thread piece is left out, if it is (place_threads).
+enum ThreadPieceOutcome : char { kPiecePlaced, kPieceOff, kPieceDistorted, kPieceNearCone };
+
+// Lattice copies of thread pieces carried onto the base through the layout, vertex by vertex
+// like place_lattice's elements, each checked against the shape limits and the cones.
+class ThreadPiecePlacer {
+ public:
+  ThreadPiecePlacer(const GlobalParameterization& gp, const SurfaceJob& job,
+                    const ThreadTiling& tiling, const SwatchSymmetry& sym, const Vector2d& lo,
+                    double shell_height, const SurfaceQuiltingOptions::Global& options,
+                    const MatrixX3d& N)
+      : gp_(gp),
+        job_(job),
+        tiling_(tiling),
+        lo_(lo),
+        shell_height_(shell_height),
+        N_(N),
+        differential_(layout_differential(gp, job.base)),
+        limits_(options) {
+    basis_.col(0) = sym.a;
+    basis_.col(1) = sym.b;
+    for (int v = 0; v < job.base.num_vertices(); ++v)
+      if (gp.singular[static_cast<size_t>(v)]) cones_.push_back(job.base.V.row(v).transpose());
+    limits_.max_element_scale = limits_.max_element_aspect = limits_.max_element_variation =
+        kThreadShapeLimit;
+  }
+
+  // Copy c placed into pp, its vertices embedded by normal displacement into X when it is kept.
+  ThreadPieceOutcome place(const LatticeCopy& c, PlacedPiece& pp, MatrixX3d& X) const {
+    const ThreadPiece& piece = tiling_.pieces[static_cast<size_t>(c.rep)];
+    const Vector2d t = lo_ + basis_ * c.k.cast<double>();
+    MatrixX3d P = piece.V;
+    P.col(0).array() += t.x();
+    P.col(1).array() += t.y();
+    pp.piece = c.rep;
+    SurfaceElement& s = pp.element;
+    s.F = piece.F;
+    s.kind = piece.kind;
+    std::vector<signed char> turn;
+    if (!place_from(gp_, job_, P, c.face, shell_height_, s, &turn)) return kPieceOff;
+    s.flat.resize(0, 3);  // a thread has no rigid shape to fall back to
+    Eigen::Matrix<double, 2, 3> M;
+    if (!within_shape_limits(differential_, P, s, turn, limits_, M)) return kPieceDistorted;
+    X.resize(P.rows(), 3);
+    for (Eigen::Index v = 0; v < P.rows(); ++v)
+      X.row(v) = displace_along_normal(job_.base, N_, s.face[static_cast<size_t>(v)],
+                                       s.barycentric.row(v).transpose(), s.height(v))
+                     .transpose();
+    // One thread spacing: the distance between a thread and its next copy alongside.
+    const double clearance = std::abs(basis_.determinant()) / piece.period.norm();
+    for (const Vector3d& cone : cones_)
+      if (((X.rowwise() - cone.transpose()).rowwise().norm().array() < clearance).any())
+        return kPieceNearCone;
+    return kPiecePlaced;
+  }
+
+ private:
+  const GlobalParameterization& gp_;
+  const SurfaceJob& job_;
+  const ThreadTiling& tiling_;
+  const Vector2d lo_;
+  const double shell_height_;
+  const MatrixX3d& N_;
+  const Eigen::MatrixXd differential_;
+  Eigen::Matrix2d basis_;
+  std::vector<Vector3d> cones_;
+  SurfaceQuiltingOptions::Global limits_;
+};
+
+// The copies placed (ThreadPiecePlacer), in parallel in blocks so that progress is reported from
+// this thread between them; those kept, in order, with their vertices embedded by normal
+// displacement (*positions), the others counted in gstats.
+std::vector<PlacedPiece> place_thread_copies(const ThreadPiecePlacer& placer,
+                                             const std::vector<LatticeCopy>& copies,
+                                             std::vector<MatrixX3d>* positions,
+                                             GlobalQuiltingStats& gstats, ProgressSink* progress) {
+  const int n = static_cast<int>(copies.size());
+  std::vector<PlacedPiece> out(copies.size());
+  std::vector<MatrixX3d> proxy(copies.size());
+  std::vector<char> outcome(copies.size(), kPieceOff);
+  const int block = std::max(64, n / 50);
+  for (int first = 0; first < n; first += block) {
+    report_progress(progress, Stage::Placement, first, n);
+    tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
+      const size_t k = static_cast<size_t>(i);
+      outcome[k] = placer.place(copies[k], out[k], proxy[k]);
+    });
+  }
+  std::vector<PlacedPiece> placed;
+  for (size_t i = 0; i < copies.size(); ++i) {
+    gstats.off_surface += outcome[i] == kPieceOff;
+    gstats.pieces_distorted += outcome[i] == kPieceDistorted;
+    gstats.pieces_near_cones += outcome[i] == kPieceNearCone;
+    if (outcome[i] != kPiecePlaced) continue;
+    placed.push_back(std::move(out[i]));
+    positions->push_back(std::move(proxy[i]));
+  }
+  gstats.thread_pieces = static_cast<int>(placed.size());
+  return placed;
+}
+
+// The pieces to leave out of the welded threads (#pieces flags): as few as leave no two
+// intersecting once embedded by normal displacement (greedy_vertex_cover), and, when
+// drop_folded says the quilt will be embedded so, those folded through themselves. The pieces
+// of a thread share their loops and do not count as touching there.
+std::vector<char> intersecting_thread_pieces(const SurfaceJob& job, const MatrixX3d& N,
+                                             const std::vector<SurfaceElement>& threads,
+                                             const std::vector<std::vector<int>>& face_piece,
+                                             size_t num_pieces, bool drop_folded,
+                                             GlobalQuiltingStats& gstats) {
+  std::vector<Eigen::Index> first(threads.size() + 1, 0), first_face(threads.size() + 1, 0);
+  for (size_t k = 0; k < threads.size(); ++k) {
+    first[k + 1] = first[k] + static_cast<Eigen::Index>(threads[k].face.size());
+    first_face[k + 1] = first_face[k] + threads[k].F.rows();
+  }
+  MatrixX3d V(first.back(), 3);
+  MatrixX3i F(first_face.back(), 3);
+  std::vector<int> piece_of(static_cast<size_t>(first_face.back()));
+  tbb::parallel_for(size_t{0}, threads.size(), [&](size_t k) {
+    const SurfaceElement& e = threads[k];
+    for (size_t v = 0; v < e.face.size(); ++v) {
+      const Eigen::Index r = static_cast<Eigen::Index>(v);
+      V.row(first[k] + r) = displace_along_normal(job.base, N, e.face[v],
+                                                  e.barycentric.row(r).transpose(), e.height(r))
+                                .transpose();
+    }
+    F.middleRows(first_face[k], e.F.rows()) = e.F.array() + static_cast<int>(first[k]);
+    std::copy(face_piece[k].begin(), face_piece[k].end(), piece_of.begin() + first_face[k]);
+  });
+  IntersectionOptions io;
+  io.between_components_only = false;
+  std::vector<char> drop(num_pieces, 0);
+  std::vector<std::pair<int, int>> touching;
+  for (const auto& [f, g] : intersecting_face_pairs(V, F, io)) {
+    const int a = piece_of[static_cast<size_t>(f)], b = piece_of[static_cast<size_t>(g)];
+    if (a != b)
+      touching.emplace_back(a, b);
+    else if (drop_folded)
+      drop[static_cast<size_t>(a)] = 1;
+  }
+  greedy_vertex_cover(touching, drop);
+  gstats.pieces_intersecting = static_cast<int>(std::count(drop.begin(), drop.end(), 1));
+  return drop;
+}
+
 // A periodic swatch of threads (core/surface/thread_tiling) carried onto the base: every lattice
 // copy of every thread piece whose centre lies on the parameterised surface, placed through the
 // layout like place_lattice's elements, then welded end to end into threads. A piece is left out,
@@ -697,93 +867,17 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
                                           const SurfaceQuiltingOptions& options,
                                           GlobalQuiltingStats& gstats, StageTimes& times,
                                           ProgressSink* progress) {
-  Eigen::Matrix2d basis;
-  basis.col(0) = sym.a;
-  basis.col(1) = sym.b;
   std::vector<LatticeCopy> copies;
   {
     ScopedStage stage(times, progress, Stage::Tiling);
-    std::vector<Vector2d> centres;
-    for (const ThreadPiece& p : tiling.pieces) centres.push_back(p.centre + lo);
-    copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
-    double faces = 0;
-    for (const LatticeCopy& c : copies)
-      faces += static_cast<double>(tiling.pieces[static_cast<size_t>(c.rep)].F.rows());
-    MQ_CHECK(faces <= options.max_faces, InvalidInput, "the global layout would place ",
-             copies.size(), " thread pieces of about ", faces,
-             " faces in all, more than the limit of ", options.max_faces,
-             " (--max-faces); use a larger --scale");
-    for (int f = 0; f < job.base.num_faces(); ++f) {
-      const Vector2d a = gp.uv(f, 0), b = gp.uv(f, 1), c = gp.uv(f, 2);
-      gstats.parameter_area +=
-          0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
-    }
+    copies = thread_piece_copies(gp, job, tiling, sym, lo, options, gstats);
   }
   ScopedStage stage(times, progress, Stage::Placement);
-  const Eigen::MatrixXd differential = layout_differential(gp, job.base);
   const MatrixX3d N = vertex_normals(job.base.V, job.base.F);
-  std::vector<Vector3d> cones;
-  for (int v = 0; v < job.base.num_vertices(); ++v)
-    if (gp.singular[static_cast<size_t>(v)]) cones.push_back(job.base.V.row(v).transpose());
-  SurfaceQuiltingOptions::Global limits = options.global;
-  limits.max_element_scale = limits.max_element_aspect = limits.max_element_variation =
-      kThreadShapeLimit;
-  const int n = static_cast<int>(copies.size());
-  enum Outcome : char { kPlaced, kOff, kDistorted, kNearCone };
-  std::vector<PlacedPiece> out(copies.size());
-  std::vector<MatrixX3d> proxy(copies.size());
-  std::vector<char> outcome(copies.size(), kOff);
-  const int block = std::max(64, n / 50);
-  for (int first = 0; first < n; first += block) {
-    report_progress(progress, Stage::Placement, first, n);
-    tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
-      const LatticeCopy& c = copies[static_cast<size_t>(i)];
-      const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(c.rep)];
-      const Vector2d t = lo + basis * c.k.cast<double>();
-      MatrixX3d P = piece.V;
-      P.col(0).array() += t.x();
-      P.col(1).array() += t.y();
-      PlacedPiece& pp = out[static_cast<size_t>(i)];
-      pp.piece = c.rep;
-      SurfaceElement& s = pp.element;
-      s.F = piece.F;
-      s.kind = piece.kind;
-      std::vector<signed char> turn;
-      if (!place_from(gp, job, P, c.face, shell_height, s, &turn)) return;
-      s.flat.resize(0, 3);  // a thread has no rigid shape to fall back to
-      Eigen::Matrix<double, 2, 3> M;
-      if (!within_shape_limits(differential, P, s, turn, limits, M)) {
-        outcome[static_cast<size_t>(i)] = kDistorted;
-        return;
-      }
-      MatrixX3d& X = proxy[static_cast<size_t>(i)];
-      X.resize(P.rows(), 3);
-      for (Eigen::Index v = 0; v < P.rows(); ++v)
-        X.row(v) = displace_along_normal(job.base, N, s.face[static_cast<size_t>(v)],
-                                         s.barycentric.row(v).transpose(), s.height(v))
-                       .transpose();
-      // One thread spacing: the distance between a thread and its next copy alongside.
-      const double clearance = std::abs(basis.determinant()) / piece.period.norm();
-      for (const Vector3d& cone : cones)
-        if (((X.rowwise() - cone.transpose()).rowwise().norm().array() < clearance).any()) {
-          outcome[static_cast<size_t>(i)] = kNearCone;
-          return;
-        }
-      outcome[static_cast<size_t>(i)] = kPlaced;
-    });
-  }
-  std::vector<PlacedPiece> placed;
   std::vector<MatrixX3d> positions;
-  for (size_t i = 0; i < copies.size(); ++i) {
-    gstats.off_surface += outcome[i] == kOff;
-    gstats.pieces_distorted += outcome[i] == kDistorted;
-    gstats.pieces_near_cones += outcome[i] == kNearCone;
-    if (outcome[i] != kPlaced) continue;
-    placed.push_back(std::move(out[i]));
-    positions.push_back(std::move(proxy[i]));
-  }
-  std::vector<PlacedPiece>().swap(out);
-  gstats.thread_pieces = static_cast<int>(placed.size());
+  const std::vector<PlacedPiece> placed = place_thread_copies(
+      ThreadPiecePlacer(gp, job, tiling, sym, lo, shell_height, options.global, N), copies,
+      &positions, gstats, progress);
   const std::vector<ThreadWeld> welds =
       find_thread_welds(placed, tiling, [&](int k, int v) -> Vector3d {
         return positions[static_cast<size_t>(k)].row(v).transpose();
@@ -791,43 +885,9 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
   ThreadWeldStats ws;
   std::vector<std::vector<int>> face_piece;
   std::vector<SurfaceElement> threads = weld_threads(placed, tiling, welds, {}, &ws, &face_piece);
-  // The threads embedded by normal displacement, welded: the pieces of a thread share their
-  // loops and do not count as touching there.
-  {
-    std::vector<Eigen::Index> first(threads.size() + 1, 0), first_face(threads.size() + 1, 0);
-    for (size_t k = 0; k < threads.size(); ++k) {
-      first[k + 1] = first[k] + static_cast<Eigen::Index>(threads[k].face.size());
-      first_face[k + 1] = first_face[k] + threads[k].F.rows();
-    }
-    MatrixX3d V(first.back(), 3);
-    MatrixX3i F(first_face.back(), 3);
-    std::vector<int> piece_of(static_cast<size_t>(first_face.back()));
-    tbb::parallel_for(size_t{0}, threads.size(), [&](size_t k) {
-      const SurfaceElement& e = threads[k];
-      for (size_t v = 0; v < e.face.size(); ++v) {
-        const Eigen::Index r = static_cast<Eigen::Index>(v);
-        V.row(first[k] + r) = displace_along_normal(job.base, N, e.face[v],
-                                                    e.barycentric.row(r).transpose(), e.height(r))
-                                  .transpose();
-      }
-      F.middleRows(first_face[k], e.F.rows()) = e.F.array() + static_cast<int>(first[k]);
-      std::copy(face_piece[k].begin(), face_piece[k].end(), piece_of.begin() + first_face[k]);
-    });
-    IntersectionOptions io;
-    io.between_components_only = false;
-    std::vector<char> drop(placed.size(), 0);
-    std::vector<std::pair<int, int>> touching;
-    for (const auto& [f, g] : intersecting_face_pairs(V, F, io)) {
-      const int a = piece_of[static_cast<size_t>(f)], b = piece_of[static_cast<size_t>(g)];
-      if (a != b)
-        touching.emplace_back(a, b);
-      else if (options.global.drop_folded_pieces)
-        drop[static_cast<size_t>(a)] = 1;
-    }
-    greedy_vertex_cover(touching, drop);
-    gstats.pieces_intersecting = static_cast<int>(std::count(drop.begin(), drop.end(), 1));
-    threads = weld_threads(placed, tiling, welds, drop, &ws, nullptr, kMinThreadPieces);
-  }
+  const std::vector<char> drop = intersecting_thread_pieces(
+      job, N, threads, face_piece, placed.size(), options.global.drop_folded_pieces, gstats);
+  threads = weld_threads(placed, tiling, welds, drop, &ws, nullptr, kMinThreadPieces);
   gstats.thread_welds = ws.welds;
   gstats.thread_ends = ws.caps;
   gstats.closed_threads = ws.closed_threads;
@@ -876,6 +936,139 @@ ThreadTiling detailed_thread_tiling(const PreparedSwatch& swatch, const Prepared
   return tiling;
 }
 
+// The cones moved to where they flatten the surface with the least change of scale, and the
+// field made parallel in their flat metric, whose scale e^u the layout then follows: the map is
+// conformal, elements keep their shape (issue 23: rings on a sphere were 1.14x by 0.75x the
+// swatch's, median aspect 1.9). False, df and face_scale unchanged, when the cones of some
+// component do not balance (the layout then follows the line field at unit scale).
+bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions::Global& options,
+                            DirectionField& df, Eigen::VectorXd& face_scale,
+                            GlobalQuiltingStats& gstats) {
+  const TriMesh& base = job.base;
+  const TrivialConnection connection(base.V, base.F, job.topo, job.TT, df.N);
+  if (connection.unbalanced_component(df.index) >= 0) return false;
+  ConePlacementReport report;
+  const std::vector<int> cones =
+      place_cones(connection, df.index, vertex_adjacency(base.F, base.num_vertices()), {}, &report);
+  gstats.split_poles = report.split_poles;
+  gstats.cone_moves = report.moves;
+  gstats.scale_energy_before = report.energy_before;
+  gstats.scale_energy = report.energy_after;
+  const ConeMetric metric = connection.solve(cones, job.field);
+  df = metric.field;
+  // A metric that scales the surface unevenly (e^u, log-normal with variance E) is followed
+  // only partly, e^(a u): normalised to keep the typical element's size, the lattice fills the
+  // surface about e^(2 a^2 E) times over, kept under max_overfill. Measured on the knight at the
+  // armor job's scale (E 0.17), interior rings with 4 links / density / median ring: a = 1:
+  // 73.2% / 117% / 0.85x; a = 0.5: 71.3% / 94% / 0.91x; a = 0 (the field at unit scale): 69.7%
+  // / 90% / 0.95x. The dragon scan (372 cones, E 0.69) filled 8 times over at a = 1, with rings
+  // at 0.37x.
+  const double E = report.energy_after;
+  gstats.scale_exponent =
+      E > 0 ? std::min(1.0, std::sqrt(std::log(options.max_overfill) / (2 * E))) : 1.0;
+  face_scale.resize(base.num_faces());
+  for (int f = 0; f < base.num_faces(); ++f)
+    face_scale(f) =
+        std::exp(gstats.scale_exponent *
+                 (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) + metric.u(base.F(f, 2))) / 3);
+  return true;
+}
+
+// The base's global parameterisation (the plane texture's layout over it), seamless at the
+// swatch's symmetries when options.seamless. The line field is found on a smoothed copy of the
+// base (same connectivity): detail of an edge's size would otherwise put a cone at every sharp
+// corner of a coarse model. Measured, interior rings with the swatch's 4 links, without / with
+// one step: Spot 93.8 / 95.5%, knight 82.3 / 87.3%, bunny 95.7 / 96.8%, cup 97.9 / 98.6% (before
+// the conformal layout, which keeps the field's cones but moves them and lays the texture out on
+// the base itself: the layout computed on the smoothed copy and carried back to the base by
+// barycentric coordinates took on the smoothing's tangential drift, median element aspect 1.12
+// against 1.05 on Spot). anchor: where the plane quilt's coordinates start.
+GlobalParameterization global_layout(const SurfaceJob& job, const SwatchSymmetry& symmetry,
+                                     const SurfaceQuiltingOptions::Global& options,
+                                     Vector2d& anchor, GlobalQuiltingStats& gstats,
+                                     StageTimes& times, ProgressSink* progress) {
+  ScopedStage stage(times, progress, Stage::Parameterization);
+  const TriMesh& base = job.base;
+  const MatrixX3d smoothed =
+      options.smoothing > 0 ? smoothed_positions(base, job.topo, options.smoothing) : base.V;
+  DirectionField df = layout_line_field(smoothed, job, options, gstats);
+  Eigen::VectorXd face_scale;
+  const MatrixX3d* layout_V = &smoothed;
+  if (options.conformal && conformal_layout_field(job, options, df, face_scale, gstats))
+    layout_V = &base.V;
+  return seamless_parameterization(*layout_V, base, job, df, face_scale, symmetry, options.seamless,
+                                   anchor, gstats);
+}
+
+// The lower corner of the parameter plane's box, where the plane texture starts. Seamless, the
+// plane's origin stays at the anchor, moved back by a lattice vector if the parameterisation
+// reaches beyond it.
+Vector2d plane_origin(const GlobalParameterization& gp, const SwatchSymmetry& symmetry,
+                      const Vector2d& anchor, const GlobalQuiltingStats& gstats) {
+  Vector2d lo = gp.wedge_uv.colwise().minCoeff().transpose();
+  if (gstats.seamless) {
+    const Vector2d need = (anchor - lo).cwiseMax(0.0);
+    Vector2d shift = Vector2d::Zero();
+    if (need.squaredNorm() > 0)
+      shift = nearest_symmetry(symmetry,
+                               need + Vector2d::Constant(symmetry.a.norm() + symmetry.b.norm()),
+                               Vector2d::Zero());
+    lo = anchor - shift;
+  }
+  return lo;
+}
+
+// The swatch quilted over the parameter plane's box [lo, hi] (section 2's planar quilting, its
+// stages' figures and times into stats), then carried onto the base (place_plane).
+std::vector<SurfaceElement> place_quilted_plane(
+    const GlobalParameterization& gp, const SurfaceJob& job, const PreparedSwatch& swatch,
+    const Vector2d& lo, const Vector2d& hi, const SurfaceQuiltingOptions& options,
+    TranslationCostEvaluator& evaluator, SurfaceQuiltingStats& stats, GlobalQuiltingStats& gstats,
+    ProgressSink* progress) {
+  PlanarQuiltingOptions po;
+  po.length = std::max(hi.x() - lo.x(), swatch.size.x());
+  po.width = std::max(hi.y() - lo.y(), swatch.size.y());
+  po.matching = options.matching;
+  po.matching.refine_to = PlanarQuiltingOptions().matching.refine_to;
+  po.correspondence = options.patch.correspondence;
+  po.merging = options.patch.merging;
+  po.deform = options.patch.deform;
+  po.seed = options.seed;
+  po.max_faces = options.max_faces;
+  gstats.parameter_area = po.length * po.width;
+  PlanarQuiltingStats ps;
+  TriMesh plane = quilt_plane(job.swatch, po, evaluator, &ps, progress);
+  stats.iterations = ps.iterations;
+  stats.cell_size = ps.cell_size;
+  stats.matched_point_offsets = ps.matched_point_offsets;
+  stats.counts = ps.counts;
+  stats.times.merge(ps.times);
+  // Back into the synthesis frame (thickness along z).
+  plane.V = (plane.V * swatch.rotation.transpose()).eval();
+  plane.V.col(0).array() += lo.x();
+  plane.V.col(1).array() += lo.y();
+  return place_plane(gp, job, plane, swatch.size.z(), gstats, stats.times, progress);
+}
+
+// The quilt of the elements placed over the base, and its counts.
+SurfaceQuilt global_surface_quilt(SurfaceJob& job, const PreparedSwatch& swatch,
+                                  std::vector<SurfaceElement> placed, SurfaceQuiltingStats& stats) {
+  SurfaceQuilt quilt;
+  quilt.kinds = swatch.kinds;
+  quilt.shell_height = swatch.size.z();
+  quilt.base = job.base;
+  quilt.input_base = std::move(job.cleaned);
+  quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
+  quilt.elements = std::move(placed);
+  stats.elements = static_cast<int>(quilt.elements.size());
+  for (const SurfaceElement& e : quilt.elements) {
+    stats.faces += static_cast<int>(e.F.rows());
+    stats.vertices += static_cast<int>(e.face.size());
+  }
+  return quilt;
+}
+
 // The global method from a prepared job and the swatch's symmetry (found on `full`: the swatch
 // at full detail, `swatch` itself unless job.full_swatch was given). threads: the swatch's
 // thread tiling at swatch's detail when known (empty: found here when the swatch is no
@@ -890,80 +1083,16 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
                                    ProgressSink* progress, bool* unfit = nullptr) {
   GlobalQuiltingStats gstats;
   StageTimes& times = stats.times;
-  const TriMesh& base = job.base;
   stats.shell_height = swatch.size.z();
   gstats.periodic = symmetry.periodic;
-
-  // The line field on a smoothed copy of the base (same connectivity): detail of an edge's size
-  // would otherwise put a cone at every sharp corner of a coarse model. Measured, interior rings
-  // with the swatch's 4 links, without / with one step: Spot 93.8 / 95.5%, knight 82.3 / 87.3%,
-  // bunny 95.7 / 96.8%, cup 97.9 / 98.6% (before the conformal layout, which keeps the field's
-  // cones but moves them and lays the texture out on the base itself: the layout computed on
-  // the smoothed copy and carried back to the base by barycentric coordinates took on the
-  // smoothing's tangential drift, median element aspect 1.12 against 1.05 on Spot).
-  GlobalParameterization gp;
   Vector2d anchor = Vector2d::Zero();
-  {
-    ScopedStage stage(times, progress, Stage::Parameterization);
-    const MatrixX3d smoothed = options.global.smoothing > 0
-                                   ? smoothed_positions(base, job.topo, options.global.smoothing)
-                                   : base.V;
-    DirectionField df = layout_line_field(smoothed, job, options.global, gstats);
-    // The cones moved to where they flatten the surface with the least change of scale, and
-    // the field made parallel in their flat metric, whose scale e^u the layout then follows:
-    // the map is conformal, elements keep their shape (issue 23: rings on a sphere were
-    // 1.14x by 0.75x the swatch's, median aspect 1.9).
-    Eigen::VectorXd face_scale;
-    const MatrixX3d* layout_V = &smoothed;
-    if (options.global.conformal) {
-      const TrivialConnection connection(base.V, base.F, job.topo, job.TT, df.N);
-      if (connection.unbalanced_component(df.index) < 0) {
-        ConePlacementReport report;
-        const std::vector<int> cones = place_cones(
-            connection, df.index, vertex_adjacency(base.F, base.num_vertices()), {}, &report);
-        gstats.split_poles = report.split_poles;
-        gstats.cone_moves = report.moves;
-        gstats.scale_energy_before = report.energy_before;
-        gstats.scale_energy = report.energy_after;
-        const ConeMetric metric = connection.solve(cones, job.field);
-        df = metric.field;
-        layout_V = &base.V;
-        // A metric that scales the surface unevenly (e^u, log-normal with variance E) is
-        // followed only partly, e^(a u): normalised to keep the typical element's size, the
-        // lattice fills the surface about e^(2 a^2 E) times over, kept under max_overfill.
-        // Measured on the knight at the armor job's scale (E 0.17), interior rings with 4 links
-        // / density / median ring: a = 1: 73.2% / 117% / 0.85x; a = 0.5: 71.3% / 94% / 0.91x;
-        // a = 0 (the field at unit scale): 69.7% / 90% / 0.95x. The dragon scan (372 cones,
-        // E 0.69) filled 8 times over at a = 1, with rings at 0.37x.
-        const double E = report.energy_after;
-        gstats.scale_exponent =
-            E > 0 ? std::min(1.0, std::sqrt(std::log(options.global.max_overfill) / (2 * E))) : 1.0;
-        face_scale.resize(base.num_faces());
-        for (int f = 0; f < base.num_faces(); ++f)
-          face_scale(f) = std::exp(
-              gstats.scale_exponent *
-              (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) + metric.u(base.F(f, 2))) / 3);
-      }
-    }
-    gp = seamless_parameterization(*layout_V, base, job, df, face_scale, symmetry,
-                                   options.global.seamless, anchor, gstats);
-  }
+  const GlobalParameterization gp =
+      global_layout(job, symmetry, options.global, anchor, gstats, times, progress);
   gstats.singular_vertices = gp.num_singular;
   gstats.cut_edges = gp.num_cut_edges;
-
-  // The plane texture over the parameter plane's box. Seamless, the plane's origin stays at the
-  // anchor, moved back by a lattice vector if the parameterisation reaches beyond it.
-  Vector2d lo = gp.wedge_uv.colwise().minCoeff().transpose();
+  const Vector2d lo = plane_origin(gp, symmetry, anchor, gstats);
   const Vector2d hi = gp.wedge_uv.colwise().maxCoeff().transpose();
-  if (gstats.seamless) {
-    const Vector2d need = (anchor - lo).cwiseMax(0.0);
-    Vector2d shift = Vector2d::Zero();
-    if (need.squaredNorm() > 0)
-      shift = nearest_symmetry(symmetry,
-                               need + Vector2d::Constant(symmetry.a.norm() + symmetry.b.norm()),
-                               Vector2d::Zero());
-    lo = anchor - shift;
-  }
+
   std::vector<SurfaceElement> placed;
   if (options.global.tile && tileable(full, symmetry)) {
     gstats.tiled = true;
@@ -974,7 +1103,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
              !(threads.empty() ? (threads = detailed_thread_tiling(swatch, full, symmetry))
                                : threads)
                   .empty()) {
-    if (unfit && !layout_fit_for_tiling(gp, base)) {
+    if (unfit && !layout_fit_for_tiling(gp, job.base)) {
       *unfit = true;
       return {};
     }
@@ -995,45 +1124,11 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
       return {};
     }
   } else if (!options.global.count_only) {
-    PlanarQuiltingOptions po;
-    po.length = std::max(hi.x() - lo.x(), swatch.size.x());
-    po.width = std::max(hi.y() - lo.y(), swatch.size.y());
-    po.matching = options.matching;
-    po.matching.refine_to = PlanarQuiltingOptions().matching.refine_to;
-    po.correspondence = options.patch.correspondence;
-    po.merging = options.patch.merging;
-    po.deform = options.patch.deform;
-    po.seed = options.seed;
-    po.max_faces = options.max_faces;
-    gstats.parameter_area = po.length * po.width;
-    PlanarQuiltingStats ps;
-    TriMesh plane = quilt_plane(job.swatch, po, evaluator, &ps, progress);
-    stats.iterations = ps.iterations;
-    stats.cell_size = ps.cell_size;
-    stats.matched_point_offsets = ps.matched_point_offsets;
-    stats.counts = ps.counts;
-    times.merge(ps.times);
-    // Back into the synthesis frame (thickness along z).
-    plane.V = (plane.V * swatch.rotation.transpose()).eval();
-    plane.V.col(0).array() += lo.x();
-    plane.V.col(1).array() += lo.y();
-    placed = place_plane(gp, job, plane, swatch.size.z(), gstats, times, progress);
+    placed =
+        place_quilted_plane(gp, job, swatch, lo, hi, options, evaluator, stats, gstats, progress);
   }
   gstats.placed = static_cast<int>(placed.size());
-
-  SurfaceQuilt quilt;
-  quilt.kinds = swatch.kinds;
-  quilt.shell_height = swatch.size.z();
-  quilt.base = job.base;
-  quilt.input_base = std::move(job.cleaned);
-  quilt.refinement = std::move(job.refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
-  quilt.elements = std::move(placed);
-  stats.elements = static_cast<int>(quilt.elements.size());
-  for (const SurfaceElement& e : quilt.elements) {
-    stats.faces += static_cast<int>(e.F.rows());
-    stats.vertices += static_cast<int>(e.face.size());
-  }
+  SurfaceQuilt quilt = global_surface_quilt(job, swatch, std::move(placed), stats);
   report_progress(progress, Stage::Quilting, 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (global_out) *global_out = gstats;
@@ -1056,9 +1151,8 @@ SurfaceQuilt quilt_surface_global(const TriMesh& base_in, const TriMesh& swatch_
   SurfaceQuiltingStats stats;
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
-  const PreparedSwatch full =
-      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+  PreparedSwatch full;
+  const PreparedSwatch& deciding = swatch_at_full_detail(job, swatch, full);
   const SwatchSymmetry symmetry = timed_symmetry(deciding, stats.times);
   return quilt_prepared_global(job, swatch, deciding, symmetry, {}, options, evaluator,
                                std::move(stats), stats_out, global_out, progress);
@@ -1074,9 +1168,8 @@ SurfaceQuilt quilt_surface_auto(const TriMesh& base_in, const TriMesh& swatch_me
   SurfaceJob job = prepare_surface_job(base_in, swatch_mesh, options, stats);
   const PreparedSwatch swatch = prepare_swatch(job.swatch);
   // The method and the lattice are decided at full detail (a Preview is the same layout).
-  const PreparedSwatch full =
-      job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-  const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
+  PreparedSwatch full;
+  const PreparedSwatch& deciding = swatch_at_full_detail(job, swatch, full);
   bool repeating = false, threads = false;
   {
     ScopedStageTimer timer(stats.times, Stage::MethodChoice);

@@ -314,6 +314,13 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   return job;
 }
 
+const PreparedSwatch& swatch_at_full_detail(const SurfaceJob& job, const PreparedSwatch& swatch,
+                                            PreparedSwatch& storage) {
+  if (job.full_swatch.empty()) return swatch;
+  storage = prepare_swatch(job.full_swatch);
+  return storage;
+}
+
 SurfaceQuilt quilt_surface(const TriMesh& base_in, const TriMesh& swatch_mesh,
                            const SurfaceQuiltingOptions& options,
                            TranslationCostEvaluator& evaluator, SurfaceQuiltingStats* stats_out,

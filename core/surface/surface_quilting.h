@@ -14,6 +14,7 @@
 #include "core/mesh/mesh_topology.h"
 #include "core/planar/geometry_matching.h"
 #include "core/planar/patch_quilting.h"
+#include "core/planar/quilt_elements.h"
 
 namespace mq {
 
@@ -191,6 +192,12 @@ struct SurfaceJob {
   TriMesh swatch;           // the swatch scaled by it
   TriMesh full_swatch;      // options.full_detail_swatch scaled by it (empty: none given)
 };
+
+// The swatch at full detail, which decides the method and the layout (a Preview is then the full
+// run's layout, SurfaceQuiltingOptions::full_detail_swatch): job.full_swatch prepared into
+// `storage` when one was given, else `swatch` (job.swatch prepared), which is at full detail.
+const PreparedSwatch& swatch_at_full_detail(const SurfaceJob& job, const PreparedSwatch& swatch,
+                                            PreparedSwatch& storage);
 
 // The factor taking swatch units to base units for SurfaceQuiltingOptions::scale = `scale`: the
 // swatch's longer side (of its prepared footprint) becomes `scale` times the base's bounding-box

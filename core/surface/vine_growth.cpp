@@ -162,31 +162,25 @@ int find_vine(const PreparedSwatch& swatch, std::vector<ElementLength>* lengths)
   return long_count == 1 ? vine : -1;
 }
 
-// The vine of `swatch` (at full detail: its centreline and leaf positions are measured there).
-// detailed (optional): the swatch at lower detail (core/mesh/element_detail.h, same element
-// order): the leaves take its geometry, placed as the full ones, and the stem's tube its share
-// of faces (as many fewer sides as cross-sections).
-VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
-                       const PreparedSwatch* detailed = nullptr) {
-  const Element& vine = swatch.elements[static_cast<size_t>(vine_index)];
-  VineModel m;
-  m.kind = vine.kind;
-  // Not a structured binding: lambdas capture those only from C++20 (clang rejects it in C++17).
-  const std::pair<Vector2d, Vector2d> origin_axis = principal_axis(vine.V);
-  const Vector2d &origin = origin_axis.first, &axis = origin_axis.second;
-  const Vector2d left(-axis.y(), axis.x());
-  const auto frame = [&](const Vector3d& q) {
+// The vine's straight frame in the swatch plane: (along its principal axis, to the left of it,
+// height).
+struct VineAxisFrame {
+  Vector2d origin, axis, left;
+  Vector3d operator()(const Vector3d& q) const {
     const Vector2d d = q.head<2>() - origin;
     return Vector3d(d.dot(axis), d.dot(left), q.z());
-  };
+  }
+};
+
+VineAxisFrame vine_axis_frame(const MatrixX3d& V) {
+  const auto [origin, axis] = principal_axis(V);
+  return {origin, axis, Vector2d(-axis.y(), axis.x())};
+}
+
+// The tube's resolution as the swatch's: segments from the largest valence (a fan cap's centre
+// has one per segment), cross-sections from the vertex count.
+void set_vine_resolution(const Element& vine, VineModel& m) {
   const Eigen::Index nv = vine.V.rows();
-  MatrixX3d U(nv, 3);
-  for (Eigen::Index i = 0; i < nv; ++i) U.row(i) = frame(vine.V.row(i).transpose()).transpose();
-  const double u0 = U.col(0).minCoeff(), u1 = U.col(0).maxCoeff();
-  m.period = u1 - u0;
-  MQ_CHECK(m.period > 0, InvalidInput, "the swatch's vine has no length");
-  // Resolution as the swatch's: segments from the largest valence (a fan cap's centre has one
-  // per segment), cross-sections from the vertex count.
   const Adjacency adj = vertex_adjacency(vine.F, static_cast<int>(nv));
   int valence = 0;
   for (int v = 0; v < adj.size(); ++v) valence = std::max(valence, adj.degree(v));
@@ -194,11 +188,38 @@ VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
   const int rings =
       std::max(2, static_cast<int>(std::lround(static_cast<double>(nv - 2) / m.segments)));
   m.ring_spacing = std::clamp(m.period / (rings - 1), m.period / 2000, m.period / 4);
-  // The centreline: mean lateral offset and height of the vertices in slabs across the axis.
-  const int bins = std::max(4, static_cast<int>(std::lround(m.period / m.ring_spacing)));
-  const double width = m.period / bins;
+}
+
+// The swatch vine's centreline in its frame, as it is (before the periodic blend): lateral
+// offset v and height z at the slab borders u0 + i * width, i = 0..bins, linear between.
+struct SwatchCentreline {
+  double u0 = 0, u1 = 0, width = 0;
+  int bins = 0;
+  std::vector<double> v, z;  // bins + 1 nodes
+
+  double lateral(double u) const {
+    const double x = std::clamp((u - u0) / width, 0.0, static_cast<double>(bins));
+    const int i = std::min(bins - 1, static_cast<int>(x));
+    const double t = x - i;
+    return (1 - t) * v[static_cast<size_t>(i)] + t * v[static_cast<size_t>(i) + 1];
+  }
+  double slope(double u) const {
+    return (lateral(u + width) - lateral(u - width)) /
+           (std::min(u + width, u1) - std::max(u - width, u0));
+  }
+};
+
+// The centreline of the vine's vertices U (in its frame): their mean lateral offset and height
+// in slabs across the axis about a cross-section wide, an empty slab interpolated between the
+// nearest filled ones, each node the mean of the slabs on either side of it.
+SwatchCentreline measure_centreline(const MatrixX3d& U, double u0, double u1, const VineModel& m) {
+  SwatchCentreline c;
+  c.u0 = u0;
+  c.u1 = u1;
+  const int bins = c.bins = std::max(4, static_cast<int>(std::lround(m.period / m.ring_spacing)));
+  const double width = c.width = m.period / bins;
   std::vector<double> sv(static_cast<size_t>(bins), 0), sz(sv), count(sv);
-  for (Eigen::Index i = 0; i < nv; ++i) {
+  for (Eigen::Index i = 0; i < U.rows(); ++i) {
     const int b = std::clamp(static_cast<int>((U(i, 0) - u0) / width), 0, bins - 1);
     sv[static_cast<size_t>(b)] += U(i, 1);
     sz[static_cast<size_t>(b)] += U(i, 2);
@@ -226,101 +247,157 @@ VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
         (1 - t) * bz[static_cast<size_t>(l)] + t * bz[static_cast<size_t>(r)];
   }
   // Nodes at the slab borders u0 + i * width, i = 0..bins.
-  std::vector<double> nvv(static_cast<size_t>(bins) + 1), nvz(nvv);
+  c.v.resize(static_cast<size_t>(bins) + 1);
+  c.z.resize(static_cast<size_t>(bins) + 1);
   for (int i = 0; i <= bins; ++i) {
     const int a = std::max(0, i - 1), b = std::min(bins - 1, i);
-    nvv[static_cast<size_t>(i)] = 0.5 * (bv[static_cast<size_t>(a)] + bv[static_cast<size_t>(b)]);
-    nvz[static_cast<size_t>(i)] = 0.5 * (bz[static_cast<size_t>(a)] + bz[static_cast<size_t>(b)]);
+    c.v[static_cast<size_t>(i)] = 0.5 * (bv[static_cast<size_t>(a)] + bv[static_cast<size_t>(b)]);
+    c.z[static_cast<size_t>(i)] = 0.5 * (bz[static_cast<size_t>(a)] + bz[static_cast<size_t>(b)]);
   }
-  // Tube radius: the median distance of the vertices from the centreline polyline.
-  {
-    std::vector<double> d(static_cast<size_t>(nv));
-    for (Eigen::Index i = 0; i < nv; ++i) {
-      const Vector3d q = U.row(i).transpose();
-      const int b = std::clamp(static_cast<int>((q.x() - u0) / width), 0, bins - 1);
-      double best = kInf;
-      for (int k = std::max(0, b - 2); k <= std::min(bins - 1, b + 2); ++k) {
-        const Vector3d a(u0 + k * width, nvv[static_cast<size_t>(k)], nvz[static_cast<size_t>(k)]);
-        const Vector3d c(u0 + (k + 1) * width, nvv[static_cast<size_t>(k) + 1],
-                         nvz[static_cast<size_t>(k) + 1]);
-        const Vector3d e = c - a;
-        const double t = std::clamp((q - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
-        best = std::min(best, (a + t * e - q).norm());
-      }
-      d[static_cast<size_t>(i)] = best;
+  return c;
+}
+
+// The tube's radius: the median distance of the vine's vertices U from the centreline polyline.
+double tube_radius(const MatrixX3d& U, const SwatchCentreline& c) {
+  const Eigen::Index nv = U.rows();
+  const int bins = c.bins;
+  const double u0 = c.u0, width = c.width;
+  std::vector<double> d(static_cast<size_t>(nv));
+  for (Eigen::Index i = 0; i < nv; ++i) {
+    const Vector3d q = U.row(i).transpose();
+    const int b = std::clamp(static_cast<int>((q.x() - u0) / width), 0, bins - 1);
+    double best = kInf;
+    for (int k = std::max(0, b - 2); k <= std::min(bins - 1, b + 2); ++k) {
+      const Vector3d a(u0 + k * width, c.v[static_cast<size_t>(k)], c.z[static_cast<size_t>(k)]);
+      const Vector3d e1(u0 + (k + 1) * width, c.v[static_cast<size_t>(k) + 1],
+                        c.z[static_cast<size_t>(k) + 1]);
+      const Vector3d e = e1 - a;
+      const double t = std::clamp((q - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (a + t * e - q).norm());
     }
-    std::nth_element(d.begin(), d.begin() + nv / 2, d.end());
-    m.radius = d[static_cast<size_t>(nv / 2)];
+    d[static_cast<size_t>(i)] = best;
   }
-  MQ_CHECK(m.radius > 0, InvalidInput, "the swatch's vine has no thickness");
-  // The periodic blend h (cubic Hermite in t = u / period): h(0) = h'(0) = 0, and at the end
-  // h = f(0) - f(P), h' = f'(0) - f'(P), so that f + h joins itself with value and slope.
-  const auto blend = [&](const std::vector<double>& f) {
-    const double f0 = f.front(), f1 = f.back();
-    const double s0 = (f[1] - f[0]) / width,
-                 s1 = (f[static_cast<size_t>(bins)] - f[static_cast<size_t>(bins) - 1]) / width;
-    return [=](double u) {
-      const double t = std::clamp(u / (bins * width), 0.0, 1.0);
-      return (f0 - f1) * (3 * t * t - 2 * t * t * t) +
-             (s0 - s1) * bins * width * (t * t * t - t * t);
-    };
-  };
-  const auto hv = blend(nvv), hz = blend(nvz);
+  std::nth_element(d.begin(), d.begin() + nv / 2, d.end());
+  return d[static_cast<size_t>(nv / 2)];
+}
+
+// The periodic blend h of the centreline nodes f (cubic Hermite in t = u / period): h(0) =
+// h'(0) = 0, and at the end h = f(0) - f(P), h' = f'(0) - f'(P), so that f + h joins itself
+// with value and slope.
+class PeriodicBlend {
+ public:
+  PeriodicBlend(const std::vector<double>& f, int bins, double width)
+      : f0_(f.front()),
+        f1_(f.back()),
+        s0_((f[1] - f[0]) / width),
+        s1_((f[static_cast<size_t>(bins)] - f[static_cast<size_t>(bins) - 1]) / width),
+        bins_(bins),
+        width_(width) {}
+  double operator()(double u) const {
+    const double t = std::clamp(u / (bins_ * width_), 0.0, 1.0);
+    return (f0_ - f1_) * (3 * t * t - 2 * t * t * t) +
+           (s0_ - s1_) * bins_ * width_ * (t * t * t - t * t);
+  }
+
+ private:
+  double f0_, f1_, s0_, s1_;
+  int bins_;
+  double width_;
+};
+
+// The model's periodic wave and lift (the centreline plus its blend, sampled at the nodes) and
+// the tube's lateral reach from the axis.
+void set_periodic_centreline(const SwatchCentreline& c, const PeriodicBlend& hv,
+                             const PeriodicBlend& hz, VineModel& m) {
+  const int bins = c.bins;
+  const double width = c.width;
   m.step = width;
   m.wave.resize(static_cast<size_t>(bins));
   m.lift.resize(static_cast<size_t>(bins));
   for (int i = 0; i < bins; ++i) {
-    m.wave[static_cast<size_t>(i)] = nvv[static_cast<size_t>(i)] + hv(i * width);
-    m.lift[static_cast<size_t>(i)] = nvz[static_cast<size_t>(i)] + hz(i * width);
+    m.wave[static_cast<size_t>(i)] = c.v[static_cast<size_t>(i)] + hv(i * width);
+    m.lift[static_cast<size_t>(i)] = c.z[static_cast<size_t>(i)] + hz(i * width);
   }
   for (const double w : m.wave) m.extent = std::max(m.extent, std::abs(w) + m.radius);
   m.reach = m.extent;
-  // The other elements, relative to where they meet the vine: the swatch's centreline (before
-  // the blend) and its slope there.
-  const auto centre_v = [&](double u) {
-    const double x = std::clamp((u - u0) / width, 0.0, static_cast<double>(bins));
-    const int i = std::min(bins - 1, static_cast<int>(x));
-    const double t = x - i;
-    return (1 - t) * nvv[static_cast<size_t>(i)] + t * nvv[static_cast<size_t>(i) + 1];
-  };
-  const auto centre_slope = [&](double u) {
-    return (centre_v(u + width) - centre_v(u - width)) /
-           (std::min(u + width, u1) - std::max(u - width, u0));
-  };
-  // A leaf's vertices in the vine's straight frame at its attach point, as in the swatch.
-  const auto pose_leaf = [&](const Element& el, SwatchLeaf& leaf) {
-    leaf.F = el.F;
-    leaf.P.resize(el.V.rows(), 3);
-    const double ua = u0 + leaf.attach, va = centre_v(ua), t = std::atan(centre_slope(ua));
-    const double c = std::cos(t), s = std::sin(t);
-    for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
-      const Vector3d q = frame(el.V.row(i).transpose());
-      const double du = q.x() - ua, dv = q.y() - va;
-      // Heights follow the blended centreline's (the vine's lift changes little along it).
-      leaf.P.row(i) << c * du + s * dv, -s * du + c * dv, std::max(0.0, q.z() + hz(leaf.attach));
+}
+
+// Where an element meets the vine, along one swatch vine length: at its vertex nearest the
+// swatch's centreline (laterally).
+double leaf_attachment(const Element& el, const VineAxisFrame& frame, const SwatchCentreline& c) {
+  double attach = 0, nearest = kInf;
+  for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
+    const Vector3d q = frame(el.V.row(i).transpose());
+    const double d = std::abs(q.y() - c.lateral(q.x()));
+    if (d < nearest) {
+      nearest = d;
+      attach = std::clamp(q.x(), c.u0, c.u1) - c.u0;
     }
-  };
+  }
+  return attach;
+}
+
+// A leaf's vertices (el's) in the vine's straight frame at its attach point, as in the swatch:
+// relative to the swatch's centreline (before the blend) and its slope there.
+void pose_swatch_leaf(const Element& el, const VineAxisFrame& frame, const SwatchCentreline& c,
+                      const PeriodicBlend& hz, SwatchLeaf& leaf) {
+  leaf.F = el.F;
+  leaf.P.resize(el.V.rows(), 3);
+  const double ua = c.u0 + leaf.attach, va = c.lateral(ua), t = std::atan(c.slope(ua));
+  const double cs = std::cos(t), s = std::sin(t);
+  for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
+    const Vector3d q = frame(el.V.row(i).transpose());
+    const double du = q.x() - ua, dv = q.y() - va;
+    // Heights follow the blended centreline's (the vine's lift changes little along it).
+    leaf.P.row(i) << cs * du + s * dv, -s * du + cs * dv, std::max(0.0, q.z() + hz(leaf.attach));
+  }
+}
+
+// The other elements as the vine's leaves, relative to where they meet it, and the farthest
+// any reaches from the axis. detailed (optional): the lower-detail swatch, whose leaves are
+// placed where the full ones sit (the reach stays the full run's).
+void add_swatch_leaves(const PreparedSwatch& swatch, int vine_index, const VineAxisFrame& frame,
+                       const SwatchCentreline& c, const PeriodicBlend& hz,
+                       const PreparedSwatch* detailed, VineModel& m) {
   for (size_t e = 0; e < swatch.elements.size(); ++e) {
     if (static_cast<int>(e) == vine_index) continue;
     const Element& el = swatch.elements[e];
     SwatchLeaf leaf;
     leaf.kind = el.kind;
-    double nearest = kInf;
-    for (Eigen::Index i = 0; i < el.V.rows(); ++i) {
-      const Vector3d q = frame(el.V.row(i).transpose());
-      const double d = std::abs(q.y() - centre_v(q.x()));
-      if (d < nearest) {
-        nearest = d;
-        leaf.attach = std::clamp(q.x(), u0, u1) - u0;
-      }
-    }
-    pose_leaf(el, leaf);
+    leaf.attach = leaf_attachment(el, frame, c);
+    pose_swatch_leaf(el, frame, c, hz, leaf);
     m.reach = std::max(m.reach, m.pose(leaf, leaf.attach).col(1).cwiseAbs().maxCoeff());
     // At lower detail: the simplified leaf where the full one sits (the reach and the spacing
     // stay the full run's).
-    if (detailed) pose_leaf(detailed->elements[e], leaf);
+    if (detailed) pose_swatch_leaf(detailed->elements[e], frame, c, hz, leaf);
     m.leaves.push_back(std::move(leaf));
   }
+}
+
+// The vine of `swatch` (at full detail: its centreline and leaf positions are measured there).
+// detailed (optional): the swatch at lower detail (core/mesh/element_detail.h, same element
+// order): the leaves take its geometry, placed as the full ones, and the stem's tube its share
+// of faces (as many fewer sides as cross-sections).
+VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
+                       const PreparedSwatch* detailed = nullptr) {
+  const Element& vine = swatch.elements[static_cast<size_t>(vine_index)];
+  VineModel m;
+  m.kind = vine.kind;
+  const VineAxisFrame frame = vine_axis_frame(vine.V);
+  const Eigen::Index nv = vine.V.rows();
+  MatrixX3d U(nv, 3);
+  for (Eigen::Index i = 0; i < nv; ++i) U.row(i) = frame(vine.V.row(i).transpose()).transpose();
+  const double u0 = U.col(0).minCoeff(), u1 = U.col(0).maxCoeff();
+  m.period = u1 - u0;
+  MQ_CHECK(m.period > 0, InvalidInput, "the swatch's vine has no length");
+  set_vine_resolution(vine, m);
+  const SwatchCentreline centre = measure_centreline(U, u0, u1, m);
+  m.radius = tube_radius(U, centre);
+  MQ_CHECK(m.radius > 0, InvalidInput, "the swatch's vine has no thickness");
+  const PeriodicBlend hv(centre.v, centre.bins, centre.width),
+      hz(centre.z, centre.bins, centre.width);
+  set_periodic_centreline(centre, hv, hz, m);
+  add_swatch_leaves(swatch, vine_index, frame, centre, hz, detailed, m);
   if (detailed) {
     // The stem's faces go as segments / ring_spacing: both by the square root of the share.
     const double share = static_cast<double>(detailed->elements[vine_index].F.rows()) /
@@ -1030,6 +1107,351 @@ void check_options(const VineGrowthOptions& o) {
            "vines: the shortest stem must be >= 0 and finite");
 }
 
+// --- the method's steps ------------------------------------------------------------------------
+
+// The swatch as the vine method uses it: prepared at the detail given, its vine's model, and the
+// spacing between stems.
+struct VineSwatch {
+  PreparedSwatch swatch;
+  VineModel model;
+  double spacing = 0;  // between stems, for the vine at full detail (the Preview's is the same)
+};
+
+// Prepares the swatch and measures its vine. Measured at full detail, so that a Preview grows the
+// full run's stems; the model then takes the given swatch's leaves and tube resolution.
+VineSwatch analyse_vine_swatch(const SurfaceJob& job, StageTimes& times) {
+  ScopedStageTimer timer(times, Stage::Prepare);
+  VineSwatch out;
+  out.swatch = prepare_swatch(job.swatch);
+  PreparedSwatch full;
+  const PreparedSwatch& deciding = swatch_at_full_detail(job, out.swatch, full);
+  MQ_CHECK(is_vine_swatch(deciding), InvalidInput,
+           "the vine method needs a swatch of one long element (a vine) with compact elements "
+           "attached along it");
+  const int vine = find_vine(deciding, nullptr);
+  out.model = analyse_vine(deciding, vine);
+  out.spacing = parallel_spacing(out.model);
+  if (!job.full_swatch.empty()) out.model = analyse_vine(deciding, vine, &out.swatch);
+  return out;
+}
+
+// The field the stems follow: the given one at full strength, else `up` projected onto each
+// face at the length of its projection (0 where it is normal to the surface: lines run on
+// straight there). The smooth default field gives seeds there a direction. *up: the direction
+// the seeds are ordered along (the given field's area-weighted mean, when there is one).
+MatrixX3d stem_guide_field(const SurfaceJob& job, const SurfaceQuiltingOptions& options,
+                           const VineGrowthOptions& vo, const MatrixX3d& FN, Vector3d* up) {
+  const TriMesh& base = job.base;
+  const int nf = base.num_faces();
+  MatrixX3d guide(nf, 3);
+  *up = vo.up.normalized();
+  if (options.field.rows() > 0) {
+    guide = job.field;
+    Vector3d mean = Vector3d::Zero();
+    const Eigen::VectorXd area = face_areas(base.V, base.F);
+    for (int f = 0; f < nf; ++f) mean += area(f) * job.field.row(f).transpose();
+    if (mean.norm() > 0) *up = mean.normalized();  // only orders the seeds
+  } else {
+    for (int f = 0; f < nf; ++f) {
+      const Vector3d n = FN.row(f).transpose();
+      guide.row(f) = (vo.up.normalized() - vo.up.normalized().dot(n) * n).transpose();
+    }
+  }
+  return guide;
+}
+
+// The streamlines' spacing, stopping distances and step from the growth options in swatch vine
+// lengths and the stems' spacing (Jobard and Lefer's d_sep and d_test).
+StreamlineOptions stem_streamline_options(const VineGrowthOptions& vo, const VineModel& model,
+                                          double spacing, const Vector3d& up) {
+  StreamlineOptions so;
+  so.separation = vo.spacing * spacing;
+  so.stop = std::max(vo.stop_fraction * so.separation, 2 * model.extent + model.radius);
+  // Lower than Jobard and Lefer's d_sep: distances are taken straight through space, which is
+  // shorter than along the surface around a box's edge, where seeds at the spacing beside a
+  // line were refused (ivy wall: 0.9 left the edges 54% covered, 0.75 67%).
+  so.seed_clearance = std::max(0.75 * so.separation, so.stop);
+  so.step = std::min(so.separation / 8, model.period / 8);
+  so.self_gap = std::max(2 * so.separation, M_PI * vo.turn_radius * model.period);
+  so.obstacle = model.extent + model.radius;
+  so.turn_radius = vo.turn_radius * model.period;
+  so.min_length = vo.min_length * model.period;
+  so.up = up;
+  return so;
+}
+
+// The size before any work: stems at the spacing over the base's area, as many leaves as the
+// swatch's ratio gives; refused over options.max_faces. Evenly spaced streamlines end where they
+// come within stop_fraction of another and leave gaps the seeds cannot fill, so their length is
+// less than area / spacing: 0.78 of it on David's head, 0.83 on the ivy wall, 0.88 on Spot
+// (sample ivy, 2026-12-04); at 0.83 the estimate is within 6% of the faces written on the three
+// (issue 28: 20% over).
+void estimate_vine_faces(const TriMesh& base, const VineModel& model, double separation,
+                         const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
+  constexpr double kStreamlineFill = 0.83;
+  const double area = surface_area(base.V, base.F);
+  const double length = kStreamlineFill * area / separation;
+  double leaf_faces = 0;
+  for (const SwatchLeaf& l : model.leaves) leaf_faces += static_cast<double>(l.F.rows());
+  const double faces =
+      length * (2.0 * model.segments / model.ring_spacing + leaf_faces / model.period);
+  stats.estimated_faces = faces;  // the memory estimate's (--stats `memory`), not the patches'
+  MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
+           " the vines would have about ", faces, " faces, more than the limit of ",
+           options.max_faces, " (--max-faces); use a larger ",
+           options.element_size > 0 ? "--element-size" : "--scale");
+}
+
+// A stem's streamline and where the swatch's pattern starts along it (arc length).
+struct StemLine {
+  std::vector<Sample> line;
+  double phase = 0;
+};
+
+// The stems' lines over the base: evenly spaced streamlines (Streamlines above) of the guide
+// field, seeded from the lowest face along so.up first so that the stems grow from the bottom,
+// and kept off the base's boundary. *short_lines: those traced but too short to grow.
+std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& walker,
+                                  const MatrixX3d& guide, const StreamlineOptions& so,
+                                  int* short_lines, ProgressSink* progress) {
+  const TriMesh& base = job.base;
+  const int nf = base.num_faces();
+  // The base's boundary, sampled, keeps the tubes off it.
+  std::vector<Vector3d> obstacles;
+  for (int e = 0; e < job.topo.num_edges(); ++e) {
+    if (job.topo.edge_faces.degree(e) == 2) continue;
+    const Vector3d a = base.V.row(job.topo.E(e, 0)), b = base.V.row(job.topo.E(e, 1));
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * so.obstacle))));
+    for (int k = 0; k <= n; ++k) obstacles.push_back(a + (b - a) * (static_cast<double>(k) / n));
+  }
+  // Seeds lowest first (ties by face index: deterministic).
+  std::vector<std::pair<double, int>> order(static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f) order[static_cast<size_t>(f)] = {walker.centroid(f).dot(so.up), f};
+  std::sort(order.begin(), order.end());
+  std::vector<int> seeds(static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f) seeds[static_cast<size_t>(f)] = order[static_cast<size_t>(f)].second;
+  Streamlines grower(walker, guide, job.field, obstacles, so);
+  grower.grow(seeds, progress);
+  std::vector<StemLine> stems;
+  for (auto& [line, phase] : grower.lines()) stems.push_back({std::move(line), phase});
+  *short_lines = grower.short_lines();
+  return stems;
+}
+
+// A stem made along its line, and its faces that may not stay (bad: #F flags): those that
+// intersect the stem itself or dip under the base; `rings`: the arc length of each vertex's
+// cross-section, to cut it by.
+struct CheckedStem {
+  Placed placed;
+  std::vector<double> rings;
+  std::vector<char> bad;
+};
+
+// The stems and leaves laid over the base, each clear of everything placed before it (beyond the
+// paper, whose local patches (section 3.1) never join their vines: see the header), and the
+// quilt they make.
+class VinePlacement {
+ public:
+  VinePlacement(const SurfaceJob& job, const SurfaceWalker& walker, const VineModel& model,
+                const StreamlineOptions& so, double shell_height)
+      : job_(job),
+        walker_(walker),
+        model_(model),
+        so_(so),
+        shell_(job.base, shell_height),
+        placed_(std::max(0.25 * model.reach, 4 * model.radius)),
+        base_height_(job.cleaned.V, job.cleaned.F),
+        lowest_(-PlacementCheckOptions().tolerance * shell_height) {}
+
+  // Stems first, in order, then their leaves: nothing placed may intersect what is there. A
+  // stem that would intersect itself (bent over a fold of the surface too tight for its tube)
+  // or an earlier stem is cut there, and what is left on either side grown in a later round;
+  // after the last round such a stem is left out.
+  void grow_stems(std::vector<StemLine> pending, VineGrowthStats& vs) {
+    const int kRounds = 3;
+    for (int round = 0; round < kRounds && !pending.empty(); ++round) {
+      const int n = static_cast<int>(pending.size());
+      std::vector<CheckedStem> made(static_cast<size_t>(n));
+      tbb::parallel_for(0, n, [&](int l) {
+        made[static_cast<size_t>(l)] = make_checked_stem(pending[static_cast<size_t>(l)]);
+      });
+      std::vector<StemLine> next;
+      for (int l = 0; l < n; ++l) {
+        CheckedStem& c = made[static_cast<size_t>(l)];
+        placed_.mark_intersecting(c.placed.position, c.placed.element.F, c.bad);
+        if (std::find(c.bad.begin(), c.bad.end(), 1) == c.bad.end()) {
+          add(c.placed);
+          kept_.push_back(std::move(pending[static_cast<size_t>(l)]));
+          continue;
+        }
+        ++vs.stems_cut;
+        split_stem(pending[static_cast<size_t>(l)], c, next);
+      }
+      pending = std::move(next);
+    }
+    vs.stems_dropped = static_cast<int>(pending.size());
+  }
+
+  // The swatch's leaves along each kept stem at the places its vine carries them. A leaf that
+  // dips under the base is tried elsewhere along the stem, like one that meets a neighbour.
+  void place_leaves(VineGrowthStats& vs, ProgressSink* progress) {
+    const double pitch = model_.period / std::max<size_t>(1, model_.leaves.size());
+    for (size_t k = 0; k < kept_.size(); ++k) {
+      const StemFrame frame(walker_, kept_[k].line);
+      for (const auto& [x, i] : leaf_slots(model_, frame.length(), kept_[k].phase)) {
+        ++vs.leaf_slots;
+        place_leaf(model_.leaves[static_cast<size_t>(i)], frame, x, kept_[k].phase, pitch, vs);
+      }
+      report_progress(progress, Stage::Leaves, static_cast<double>(k + 1),
+                      static_cast<double>(kept_.size()));
+    }
+  }
+
+  const std::vector<StemLine>& kept() const { return kept_; }
+  SurfaceQuilt& quilt() { return quilt_; }
+
+ private:
+  // Where a stem or a leaf dips under the base as given (into a pillar beside a wall, where
+  // boxes meet), the embedding's check (core/shell/placement_check) would remove it whole: the
+  // ivy wall lost 11 stems and 247 leaves so. Stems are cut there, leaves moved.
+  bool under_base(const Vector3d& p) const { return base_height_(p) < lowest_; }
+
+  // The stem along st, its faces that intersect one another or dip under the base marked bad
+  // (placed stems are checked later, in order).
+  CheckedStem make_checked_stem(const StemLine& st) const {
+    CheckedStem out;
+    const StemFrame frame(walker_, st.line);
+    out.placed = make_stem(model_, frame, st.phase, shell_, &out.rings);
+    const Placed& p = out.placed;
+    std::vector<char>& b = out.bad;
+    b.assign(static_cast<size_t>(p.element.F.rows()), 0);
+    IntersectionOptions all;
+    all.between_components_only = false;
+    for (const auto& [f, g] : intersecting_face_pairs(p.position, p.element.F, all))
+      b[static_cast<size_t>(f)] = b[static_cast<size_t>(g)] = 1;
+    std::vector<char> under(static_cast<size_t>(p.position.rows()), 0);
+    for (Eigen::Index v = 0; v < p.position.rows(); ++v)
+      under[static_cast<size_t>(v)] = under_base(p.position.row(v).transpose());
+    for (Eigen::Index f = 0; f < p.element.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) b[static_cast<size_t>(f)] |= under[p.element.F(f, k)];
+    return out;
+  }
+
+  // The pieces of st left once the arc lengths its bad faces span, widened by the spacing, are
+  // cut out: those at least so.min_length long go to `next`, in order along it.
+  void split_stem(const StemLine& st, const CheckedStem& c, std::vector<StemLine>& next) const {
+    const Placed& p = c.placed;
+    std::vector<std::pair<double, double>> cut;
+    for (Eigen::Index f = 0; f < p.element.F.rows(); ++f) {
+      if (!c.bad[static_cast<size_t>(f)]) continue;
+      double lo = kInf, hi = -kInf;
+      for (int k = 0; k < 3; ++k) {
+        lo = std::min(lo, c.rings[static_cast<size_t>(p.element.F(f, k))]);
+        hi = std::max(hi, c.rings[static_cast<size_t>(p.element.F(f, k))]);
+      }
+      cut.emplace_back(lo - 0.5 * so_.separation, hi + 0.5 * so_.separation);
+    }
+    std::sort(cut.begin(), cut.end());
+    double from = 0;
+    const auto piece = [&](double a, double b) {
+      if (b - a < so_.min_length) return;
+      StemLine part;
+      for (const Sample& q : st.line)
+        if (q.s >= a && q.s <= b) part.line.push_back(q);
+      if (part.line.size() < 2) return;
+      const double s0 = part.line.front().s;
+      for (Sample& q : part.line) q.s -= s0;
+      part.phase = st.phase + s0;
+      next.push_back(std::move(part));
+    };
+    for (const auto& [a, b2] : cut) {
+      piece(from, a);
+      from = std::max(from, b2);
+    }
+    piece(from, st.line.back().s);
+  }
+
+  // One leaf at arc length x of its stem: tried at its place, then a little along the stem
+  // either way, then as far again from the vine's axis as the tube's radius (where the surface
+  // curves, a leaf laid rigidly from the stem can meet the stem itself); left out when no place
+  // is clear.
+  void place_leaf(const SwatchLeaf& leaf, const StemFrame& frame, double x, double phase,
+                  double pitch, VineGrowthStats& vs) {
+    const double S = frame.length();
+    for (const auto& [shift, push] : kLeafMoves) {
+      const double xs = x + shift * pitch;
+      if (xs < 0 || xs > S) continue;
+      bool whole = true;
+      Placed p = make_leaf(model_, leaf, frame, xs, phase, push * model_.radius, shell_, &whole);
+      // Whole on the base, clear of everything placed, and not folded through itself
+      // (bent over a box's edge, the displacement can fold a leaf).
+      if (!whole || placed_.intersects(p.position, p.element.F) >= 0 ||
+          (!on_one_face(job_.refinement, p.element) &&
+           !self_intersecting_components(p.position, p.element.F).empty()) ||
+          dips_under_base(p.position))
+        continue;
+      add(p);
+      ++vs.leaves;
+      vs.leaves_shifted += shift != 0 || push != 0 ? 1 : 0;
+      break;
+    }
+  }
+
+  bool dips_under_base(const MatrixX3d& P) const {
+    for (Eigen::Index v = 0; v < P.rows(); ++v)
+      if (under_base(P.row(v).transpose())) return true;
+    return false;
+  }
+
+  // An element into the quilt and its triangles into the grid of those placed.
+  void add(Placed& p) {
+    placed_.insert(p.position, p.element.F, static_cast<int>(quilt_.elements.size()));
+    quilt_.elements.push_back(std::move(p.element));
+  }
+
+  const SurfaceJob& job_;
+  const SurfaceWalker& walker_;
+  const VineModel& model_;
+  const StreamlineOptions& so_;
+  const Displacement shell_;
+  TriangleGrid placed_;
+  const SignedHeight base_height_;
+  const double lowest_;
+  SurfaceQuilt quilt_;
+  std::vector<StemLine> kept_;
+};
+
+// The stems' figures, and the quilt's base, kinds and counts, from the placement.
+SurfaceQuilt finish_vine_quilt(SurfaceJob& job, const VineSwatch& vine, VinePlacement& placement,
+                               SurfaceQuiltingStats& stats, VineGrowthStats& vs) {
+  const std::vector<StemLine>& kept = placement.kept();
+  vs.stems = static_cast<int>(kept.size());
+  std::vector<double> lengths;
+  lengths.reserve(kept.size());
+  for (const StemLine& st : kept) lengths.push_back(st.line.back().s);
+  for (const double l : lengths) vs.total_length += l;
+  if (!lengths.empty()) {
+    std::vector<double> sorted = lengths;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    vs.median_length = sorted[sorted.size() / 2] / vine.model.period;
+  }
+  SurfaceQuilt quilt = std::move(placement.quilt());
+  quilt.kinds = vine.swatch.kinds;
+  quilt.shell_height = vine.swatch.size.z();
+  quilt.base = std::move(job.base);
+  quilt.input_base = std::move(job.cleaned);
+  quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
+  stats.iterations = vs.stems;
+  stats.counts.added = static_cast<int>(quilt.elements.size());
+  stats.elements = static_cast<int>(quilt.elements.size());
+  for (const SurfaceElement& e : quilt.elements) {
+    stats.faces += static_cast<int>(e.F.rows());
+    stats.vertices += static_cast<int>(e.face.size());
+  }
+  return quilt;
+}
+
 }  // namespace
 
 bool is_vine_swatch(const PreparedSwatch& swatch) {
@@ -1072,277 +1494,38 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   check_options(vo);
   StageTimes& times = stats.times;
   VineGrowthStats vs;
-  PreparedSwatch swatch;
-  VineModel model;
-  double spacing = 0;  // between stems, for the vine at full detail (the Preview's is the same)
-  {
-    ScopedStageTimer timer(times, Stage::Prepare);
-    swatch = prepare_swatch(job.swatch);
-    // Measured at full detail, so that a Preview grows the full run's stems.
-    const PreparedSwatch full =
-        job.full_swatch.empty() ? PreparedSwatch() : prepare_swatch(job.full_swatch);
-    const PreparedSwatch& deciding = job.full_swatch.empty() ? swatch : full;
-    MQ_CHECK(is_vine_swatch(deciding), InvalidInput,
-             "the vine method needs a swatch of one long element (a vine) with compact elements "
-             "attached along it");
-    const int vine = find_vine(deciding, nullptr);
-    model = analyse_vine(deciding, vine);
-    spacing = parallel_spacing(model);
-    if (!job.full_swatch.empty()) model = analyse_vine(deciding, vine, &swatch);
-  }
-  const TriMesh& base = job.base;
-  const int nf = base.num_faces();
-  const double H = swatch.size.z();
+  const VineSwatch vine = analyse_vine_swatch(job, times);
+  const double H = vine.swatch.size.z();
   stats.shell_height = H;
-  const SurfaceWalker walker(base, job.TT);
-  const MatrixX3d& FN = walker.normals();
-
-  // The field the stems follow: the given one at full strength, else `up` projected onto each
-  // face at the length of its projection (0 where it is normal to the surface: lines run on
-  // straight there). The smooth default field gives seeds there a direction.
-  MatrixX3d guide(nf, 3);
-  Vector3d up = vo.up.normalized();
-  if (options.field.rows() > 0) {
-    guide = job.field;
-    Vector3d mean = Vector3d::Zero();
-    const Eigen::VectorXd area = face_areas(base.V, base.F);
-    for (int f = 0; f < nf; ++f) mean += area(f) * job.field.row(f).transpose();
-    if (mean.norm() > 0) up = mean.normalized();  // only orders the seeds
-  } else {
-    for (int f = 0; f < nf; ++f) {
-      const Vector3d n = FN.row(f).transpose();
-      guide.row(f) = (vo.up.normalized() - vo.up.normalized().dot(n) * n).transpose();
-    }
-  }
-
-  StreamlineOptions so;
-  so.separation = vo.spacing * spacing;
-  so.stop = std::max(vo.stop_fraction * so.separation, 2 * model.extent + model.radius);
-  // Lower than Jobard and Lefer's d_sep: distances are taken straight through space, which is
-  // shorter than along the surface around a box's edge, where seeds at the spacing beside a
-  // line were refused (ivy wall: 0.9 left the edges 54% covered, 0.75 67%).
-  so.seed_clearance = std::max(0.75 * so.separation, so.stop);
-  so.step = std::min(so.separation / 8, model.period / 8);
-  so.self_gap = std::max(2 * so.separation, M_PI * vo.turn_radius * model.period);
-  so.obstacle = model.extent + model.radius;
-  so.turn_radius = vo.turn_radius * model.period;
-  so.min_length = vo.min_length * model.period;
-  so.up = up;
-  vs.vine_length = model.period;
+  const SurfaceWalker walker(job.base, job.TT);
+  Vector3d up;
+  const MatrixX3d guide = stem_guide_field(job, options, vo, walker.normals(), &up);
+  const StreamlineOptions so = stem_streamline_options(vo, vine.model, vine.spacing, up);
+  vs.vine_length = vine.model.period;
   vs.spacing = so.separation;
-
-  // The size before any work: stems at the spacing over the base's area, as many leaves as the
-  // swatch's ratio gives. Evenly spaced streamlines end where they come within stop_fraction of
-  // another and leave gaps the seeds cannot fill, so their length is less than area / spacing:
-  // 0.78 of it on David's head, 0.83 on the ivy wall, 0.88 on Spot (sample ivy, 2026-12-04);
-  // at 0.83 the estimate is within 6% of the faces written on the three (issue 28: 20% over).
-  {
-    constexpr double kStreamlineFill = 0.83;
-    const double area = surface_area(base.V, base.F);
-    const double length = kStreamlineFill * area / so.separation;
-    double leaf_faces = 0;
-    for (const SwatchLeaf& l : model.leaves) leaf_faces += static_cast<double>(l.F.rows());
-    const double faces =
-        length * (2.0 * model.segments / model.ring_spacing + leaf_faces / model.period);
-    stats.estimated_faces = faces;  // the memory estimate's (--stats `memory`), not the patches'
-    MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
-             " the vines would have about ", faces, " faces, more than the limit of ",
-             options.max_faces, " (--max-faces); use a larger ",
-             options.element_size > 0 ? "--element-size" : "--scale");
-  }
+  estimate_vine_faces(job.base, vine.model, so.separation, options, stats);
   if (options.global.count_only) {
     if (stats_out) *stats_out = std::move(stats);
     if (vine_stats) *vine_stats = vs;
     return {};
   }
 
-  std::vector<std::vector<Sample>> lines;
-  std::vector<double> phases;  // where each line's swatch pattern starts (arc length)
+  // The header's steps: 1. the stems' lines, 2. their tubes, 3. the leaves along them.
+  std::vector<StemLine> stems;
   {
     ScopedStageTimer timer(times, Stage::Streamlines);
-    // The base's boundary, sampled, keeps the tubes off it.
-    std::vector<Vector3d> obstacles;
-    for (int e = 0; e < job.topo.num_edges(); ++e) {
-      if (job.topo.edge_faces.degree(e) == 2) continue;
-      const Vector3d a = base.V.row(job.topo.E(e, 0)), b = base.V.row(job.topo.E(e, 1));
-      const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * so.obstacle))));
-      for (int k = 0; k <= n; ++k) obstacles.push_back(a + (b - a) * (static_cast<double>(k) / n));
-    }
-    // Seeds lowest first (ties by face index: deterministic).
-    std::vector<std::pair<double, int>> order(static_cast<size_t>(nf));
-    for (int f = 0; f < nf; ++f) order[static_cast<size_t>(f)] = {walker.centroid(f).dot(up), f};
-    std::sort(order.begin(), order.end());
-    std::vector<int> seeds(static_cast<size_t>(nf));
-    for (int f = 0; f < nf; ++f)
-      seeds[static_cast<size_t>(f)] = order[static_cast<size_t>(f)].second;
-    Streamlines grower(walker, guide, job.field, obstacles, so);
-    grower.grow(seeds, progress);
-    for (auto& [line, phase] : grower.lines()) {
-      lines.push_back(std::move(line));
-      phases.push_back(phase);
-    }
-    vs.streamlines_short = grower.short_lines();
+    stems = trace_stems(job, walker, guide, so, &vs.streamlines_short, progress);
   }
-
-  const Displacement shell(job.base, H);
-  // Stems first, in order, then their leaves: nothing placed may intersect what is there. A
-  // stem that would intersect itself (bent over a fold of the surface too tight for its
-  // tube) or an earlier stem is cut there, and what is left on either side grown in a later
-  // round; after the last round such a stem is left out.
-  TriangleGrid placed(std::max(0.25 * model.reach, 4 * model.radius));
-  SurfaceQuilt quilt;
-  struct Stem {
-    std::vector<Sample> line;
-    double phase = 0;
-  };
-  std::vector<Stem> pending, kept;
-  for (size_t l = 0; l < lines.size(); ++l) pending.push_back({std::move(lines[l]), phases[l]});
-  // Where a stem or a leaf dips under the base as given (into a pillar beside a wall, where
-  // boxes meet), the embedding's check (core/shell/placement_check) would remove it whole: the
-  // ivy wall lost 11 stems and 247 leaves so. Stems are cut there, leaves moved.
-  const SignedHeight base_height(job.cleaned.V, job.cleaned.F);
-  const double lowest = -PlacementCheckOptions().tolerance * H;
-  const auto under_base = [&](const MatrixX3d& P) {
-    for (Eigen::Index v = 0; v < P.rows(); ++v)
-      if (base_height(P.row(v).transpose()) < lowest) return true;
-    return false;
-  };
+  VinePlacement placement(job, walker, vine.model, so, H);
   {
     ScopedStageTimer timer(times, Stage::Stems);
-    const int kRounds = 3;
-    for (int round = 0; round < kRounds && !pending.empty(); ++round) {
-      const int n = static_cast<int>(pending.size());
-      std::vector<Placed> made(static_cast<size_t>(n));
-      std::vector<std::vector<double>> rings(static_cast<size_t>(n));
-      std::vector<std::vector<char>> bad(static_cast<size_t>(n));
-      tbb::parallel_for(0, n, [&](int l) {
-        const Stem& st = pending[static_cast<size_t>(l)];
-        const StemFrame frame(walker, st.line);
-        made[static_cast<size_t>(l)] =
-            make_stem(model, frame, st.phase, shell, &rings[static_cast<size_t>(l)]);
-        const Placed& p = made[static_cast<size_t>(l)];
-        std::vector<char>& b = bad[static_cast<size_t>(l)];
-        b.assign(static_cast<size_t>(p.element.F.rows()), 0);
-        IntersectionOptions all;
-        all.between_components_only = false;
-        for (const auto& [f, g] : intersecting_face_pairs(p.position, p.element.F, all))
-          b[static_cast<size_t>(f)] = b[static_cast<size_t>(g)] = 1;
-        std::vector<char> under(static_cast<size_t>(p.position.rows()), 0);
-        for (Eigen::Index v = 0; v < p.position.rows(); ++v)
-          under[static_cast<size_t>(v)] = base_height(p.position.row(v).transpose()) < lowest;
-        for (Eigen::Index f = 0; f < p.element.F.rows(); ++f)
-          for (int k = 0; k < 3; ++k) b[static_cast<size_t>(f)] |= under[p.element.F(f, k)];
-      });
-      std::vector<Stem> next;
-      for (int l = 0; l < n; ++l) {
-        Placed& p = made[static_cast<size_t>(l)];
-        std::vector<char>& b = bad[static_cast<size_t>(l)];
-        placed.mark_intersecting(p.position, p.element.F, b);
-        if (std::find(b.begin(), b.end(), 1) == b.end()) {
-          placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
-          quilt.elements.push_back(std::move(p.element));
-          kept.push_back(std::move(pending[static_cast<size_t>(l)]));
-          continue;
-        }
-        ++vs.stems_cut;
-        // The arc lengths its bad faces span, widened by the spacing, are cut out.
-        const std::vector<double>& ring = rings[static_cast<size_t>(l)];
-        std::vector<std::pair<double, double>> cut;
-        for (Eigen::Index f = 0; f < p.element.F.rows(); ++f) {
-          if (!b[static_cast<size_t>(f)]) continue;
-          double lo = kInf, hi = -kInf;
-          for (int k = 0; k < 3; ++k) {
-            lo = std::min(lo, ring[static_cast<size_t>(p.element.F(f, k))]);
-            hi = std::max(hi, ring[static_cast<size_t>(p.element.F(f, k))]);
-          }
-          cut.emplace_back(lo - 0.5 * so.separation, hi + 0.5 * so.separation);
-        }
-        std::sort(cut.begin(), cut.end());
-        const Stem& st = pending[static_cast<size_t>(l)];
-        double from = 0;
-        const auto piece = [&](double a, double b) {
-          if (b - a < so.min_length) return;
-          Stem part;
-          for (const Sample& q : st.line)
-            if (q.s >= a && q.s <= b) part.line.push_back(q);
-          if (part.line.size() < 2) return;
-          const double s0 = part.line.front().s;
-          for (Sample& q : part.line) q.s -= s0;
-          part.phase = st.phase + s0;
-          next.push_back(std::move(part));
-        };
-        for (const auto& [a, b2] : cut) {
-          piece(from, a);
-          from = std::max(from, b2);
-        }
-        piece(from, st.line.back().s);
-      }
-      pending = std::move(next);
-    }
-    vs.stems_dropped = static_cast<int>(pending.size());
+    placement.grow_stems(std::move(stems), vs);
   }
   {
     ScopedStageTimer timer(times, Stage::Leaves);
-    const double pitch = model.period / std::max<size_t>(1, model.leaves.size());
-    // A leaf that dips under the base is tried elsewhere along the stem, like one that meets
-    // a neighbour.
-    for (size_t k = 0; k < kept.size(); ++k) {
-      const StemFrame frame(walker, kept[k].line);
-      const double S = frame.length();
-      const double phase = kept[k].phase;
-      for (const auto& [x, i] : leaf_slots(model, S, phase)) {
-        const SwatchLeaf& leaf = model.leaves[static_cast<size_t>(i)];
-        ++vs.leaf_slots;
-        // Tried at its place, then a little along the stem either way, then as far again from
-        // the vine's axis as the tube's radius (where the surface curves, a leaf laid rigidly
-        // from the stem can meet the stem itself).
-        for (const auto& [shift, push] : kLeafMoves) {
-          const double xs = x + shift * pitch;
-          if (xs < 0 || xs > S) continue;
-          bool whole = true;
-          Placed p = make_leaf(model, leaf, frame, xs, phase, push * model.radius, shell, &whole);
-          // Whole on the base, clear of everything placed, and not folded through itself
-          // (bent over a box's edge, the displacement can fold a leaf).
-          if (!whole || placed.intersects(p.position, p.element.F) >= 0 ||
-              (!on_one_face(job.refinement, p.element) &&
-               !self_intersecting_components(p.position, p.element.F).empty()) ||
-              under_base(p.position))
-            continue;
-          placed.insert(p.position, p.element.F, static_cast<int>(quilt.elements.size()));
-          quilt.elements.push_back(std::move(p.element));
-          ++vs.leaves;
-          vs.leaves_shifted += shift != 0 || push != 0 ? 1 : 0;
-          break;
-        }
-      }
-      report_progress(progress, Stage::Leaves, static_cast<double>(k + 1),
-                      static_cast<double>(kept.size()));
-    }
+    placement.place_leaves(vs, progress);
   }
-
-  vs.stems = static_cast<int>(kept.size());
-  std::vector<double> lengths;
-  lengths.reserve(kept.size());
-  for (const Stem& st : kept) lengths.push_back(st.line.back().s);
-  for (const double l : lengths) vs.total_length += l;
-  if (!lengths.empty()) {
-    std::vector<double> sorted = lengths;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    vs.median_length = sorted[sorted.size() / 2] / model.period;
-  }
-  quilt.kinds = swatch.kinds;
-  quilt.shell_height = H;
-  quilt.base = std::move(job.base);
-  quilt.input_base = std::move(job.cleaned);
-  quilt.refinement = std::move(job.refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
-  stats.iterations = vs.stems;
-  stats.counts.added = static_cast<int>(quilt.elements.size());
-  stats.elements = static_cast<int>(quilt.elements.size());
-  for (const SurfaceElement& e : quilt.elements) {
-    stats.faces += static_cast<int>(e.F.rows());
-    stats.vertices += static_cast<int>(e.face.size());
-  }
+  SurfaceQuilt quilt = finish_vine_quilt(job, vine, placement, stats, vs);
   report_progress(progress, Stage::Leaves, 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (vine_stats) *vine_stats = vs;
