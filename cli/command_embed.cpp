@@ -110,7 +110,10 @@ void write_stats(const std::string& path, const std::string& quilt_path,
 
 }  // namespace
 
-int run_embed(int argc, char** argv, int first) {
+namespace {
+
+// The command line of `embed`, declared.
+CommandLine declare_embed_options() {
   CommandLine cl(
       "embed", "--quilt FILE --base FILE -o OUT [options]",
       "Places a quilt saved by 'meshquilt surface --save-quilt' on its base again, the same\n"
@@ -146,17 +149,20 @@ int run_embed(int argc, char** argv, int first) {
             "3");
   add_output_options(cl);
   add_run_options(cl);
-  if (!cl.parse(argc, argv, first)) return 0;
-  if (!cl.has("quilt")) throw UsageError("--quilt FILE is required");
-  if (!cl.has("base")) throw UsageError("--base FILE is required");
-  if (!cl.has("output")) throw UsageError("-o OUT is required");
-  const WriteOptions write_options = output_options(cl);
+  return cl;
+}
+
+// The placement's options from the command line.
+FollowBaseOptions following_options(const CommandLine& cl) {
   FollowBaseOptions follow;
   follow.rigid_radius = cl.get_double("rigid-radius", 0, 0.0, 1e6);
   follow.resolve_intersections = !cl.has("keep-intersecting");
   follow.keep_elements = cl.has("keep-elements");
+  return follow;
+}
 
-  // The frames: one (the base and output as given) or a range over two patterns.
+// The frames: one (the base and output as given) or a range over two patterns.
+std::vector<FrameResult> requested_frames(const CommandLine& cl) {
   std::vector<FrameResult> frames;
   if (cl.has("frames")) {
     const std::string range = cl.get("frames");
@@ -169,6 +175,12 @@ int run_embed(int argc, char** argv, int first) {
   } else {
     frames.push_back({0, cl.get("base"), cl.get("output"), {}, 0});
   }
+  return frames;
+}
+
+// Every output's format known and no output naming an input, before any work.
+void check_embed_paths(const CommandLine& cl, const std::vector<FrameResult>& frames,
+                       const WriteOptions& write_options) {
   std::vector<std::string> outputs, inputs{cl.get("quilt")};
   for (const FrameResult& f : frames) {
     mesh_format_from_path(f.output);
@@ -177,60 +189,81 @@ int run_embed(int argc, char** argv, int first) {
   }
   outputs.push_back(cl.get("stats"));
   check_paths(outputs, inputs);
+}
+
+// A frame's base as the quilt's welded base moved; its errors name the file.
+MatrixX3d frame_positions(const SavedQuilt& saved, const FrameResult& f) {
+  try {
+    return welded_positions(saved, read_mesh(f.base));
+  } catch (const InvalidInput& e) {
+    MQ_THROW(InvalidInput, f.base, ": ", e.what());
+  }
+}
+
+// A sequence removes in every frame what any frame removes (a mesh cache keeps its faces): a
+// first pass finds them.
+std::vector<char> removed_in_any_frame(const SavedQuilt& saved,
+                                       const std::vector<FrameResult>& frames,
+                                       const FollowBaseOptions& follow) {
+  std::vector<char> removed;
+  for (const FrameResult& f : frames) {
+    FollowBaseStats pass;
+    follow_base(saved, frame_positions(saved, f), follow, &pass);
+    removed.resize(pass.removed.size(), 0);
+    for (size_t e = 0; e < removed.size(); ++e) removed[e] |= pass.removed[e];
+  }
+  return removed;
+}
+
+// One frame placed and written whole, with its summary line.
+void embed_frame(RunContext& run, const SavedQuilt& saved, const FollowBaseOptions& follow,
+                 const WriteOptions& write_options, FrameResult& f) {
+  const auto frame_start = std::chrono::steady_clock::now();
+  const MatrixX3d V = frame_positions(saved, f);
+  const TriMesh result = follow_base(saved, V, follow, &f.stats);
+  {
+    ScopedStageProgress shown(run.progress(), Stage::Writing);
+    write_output(f.output, result, write_options);
+  }
+  f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+  if (!run.quiet())
+    std::printf(
+        "wrote %s: %d faces, %d vertices, %d elements (%d moved rigidly, %d following the "
+        "surface, %d unmoved; %d pressed into a neighbour made to follow the surface, %d "
+        "shrunk, %d removed); %.2f s\n",
+        f.output.c_str(), result.num_faces(), result.num_vertices(),
+        f.stats.elements - f.stats.num_removed, f.stats.rigid, f.stats.following, f.stats.unmoved,
+        f.stats.unbent, f.stats.shrunk, f.stats.num_removed, f.seconds);
+}
+
+}  // namespace
+
+int run_embed(int argc, char** argv, int first) {
+  CommandLine cl = declare_embed_options();
+  if (!cl.parse(argc, argv, first)) return 0;
+  if (!cl.has("quilt")) throw UsageError("--quilt FILE is required");
+  if (!cl.has("base")) throw UsageError("--base FILE is required");
+  if (!cl.has("output")) throw UsageError("-o OUT is required");
+  const WriteOptions write_options = output_options(cl);
+  FollowBaseOptions follow = following_options(cl);
+  std::vector<FrameResult> frames = requested_frames(cl);
+  check_embed_paths(cl, frames, write_options);
 
   RunContext run(cl);
   const auto start = std::chrono::steady_clock::now();
   const SavedQuilt saved = read_saved_quilt(cl.get("quilt"));
-  const SavedQuiltHeader& header = saved.header;
   // Every frame's base read and checked first: a missing or mismatched frame fails the run
   // before anything is written.
   if (frames.size() > 1)
-    for (const FrameResult& f : frames) try {
-        welded_positions(saved, read_mesh(f.base));
-      } catch (const InvalidInput& e) {
-        MQ_THROW(InvalidInput, f.base, ": ", e.what());
-      }
-  // A sequence removes in every frame what any frame removes (a mesh cache keeps its faces):
-  // a first pass finds them.
-  if (frames.size() > 1 && follow.resolve_intersections && !follow.keep_elements) {
-    std::vector<char> removed;
-    for (const FrameResult& f : frames) {
-      FollowBaseStats pass;
-      follow_base(saved, welded_positions(saved, read_mesh(f.base)), follow, &pass);
-      removed.resize(pass.removed.size(), 0);
-      for (size_t e = 0; e < removed.size(); ++e) removed[e] |= pass.removed[e];
-    }
-    follow.remove = std::move(removed);
-  }
-  for (FrameResult& f : frames) {
-    const auto frame_start = std::chrono::steady_clock::now();
-    MatrixX3d V;
-    try {
-      V = welded_positions(saved, read_mesh(f.base));
-    } catch (const InvalidInput& e) {
-      MQ_THROW(InvalidInput, f.base, ": ", e.what());
-    }
-    const TriMesh result = follow_base(saved, V, follow, &f.stats);
-    {
-      ScopedStageProgress shown(run.progress(), Stage::Writing);
-      write_output(f.output, result, write_options);
-    }
-    f.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
-    if (!run.quiet())
-      std::printf(
-          "wrote %s: %d faces, %d vertices, %d elements (%d moved rigidly, %d following the "
-          "surface, %d unmoved; %d pressed into a neighbour made to follow the surface, %d "
-          "shrunk, %d removed); %.2f s\n",
-          f.output.c_str(), result.num_faces(), result.num_vertices(),
-          f.stats.elements - f.stats.num_removed, f.stats.rigid, f.stats.following, f.stats.unmoved,
-          f.stats.unbent, f.stats.shrunk, f.stats.num_removed, f.seconds);
-  }
+    for (const FrameResult& f : frames) frame_positions(saved, f);
+  if (frames.size() > 1 && follow.resolve_intersections && !follow.keep_elements)
+    follow.remove = removed_in_any_frame(saved, frames, follow);
+  for (FrameResult& f : frames) embed_frame(run, saved, follow, write_options, f);
   run.progress()->finish();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!run.stats_path().empty())
-    write_stats(run.stats_path(), cl.get("quilt"), header, frames, run.threads(), wall);
+    write_stats(run.stats_path(), cl.get("quilt"), saved.header, frames, run.threads(), wall);
   return 0;
 }
 

@@ -34,27 +34,9 @@ namespace mq::cli {
 namespace {
 
 // The --stats file's JSON (written with the mesh, as one commit).
-std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats& em,
-                       const std::string& embedding, const std::string& device, int threads,
-                       double wall, const std::string& base, const std::string& swatch,
-                       const std::string& method, const GlobalQuiltingStats* global,
-                       const StructureSummary& structure, double memory_limit_bytes,
-                       double min_coverage, double swatch_cover, const ElementDetail& detail,
-                       double detail_share) {
-  // The global layout counts its output exactly before building it; else the estimate made
-  // before any work.
-  const double estimated_faces =
-      global && global->layout_faces > 0 ? global->layout_faces : s.estimated_faces;
-  JsonWriter j;
-  j.begin_object()
-      .value("command", "surface")
-      .value("base", base)
-      .value("swatch", swatch)
-      .value("method", method)
-      .value("device", device)
-      .value("threads", threads)
-      .value("wall_seconds", wall)
-      .value("base_faces", s.base_faces)
+// The base's preparation and the synthesis's parameters (flat values of the stats object).
+void write_preparation(JsonWriter& j, const SurfaceQuiltingStats& s) {
+  j.value("base_faces", s.base_faces)
       .value("welded_vertices", s.welded_vertices)
       .value("duplicate_faces", s.duplicate_faces)
       .value("flipped_components", s.flipped_components)
@@ -68,16 +50,26 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("cell_size", s.cell_size)
       .value("iterations", s.iterations)
       .value("patches_shrunk", s.patches_shrunk)
-      .value("patch_faces", s.patch_faces)
-      .value("embedding", em.shell_map_failure.empty() ? embedding : std::string("normal"))
+      .value("patch_faces", s.patch_faces);
+}
+
+// The shell map's figures (section 3.2).
+void write_shell_map(JsonWriter& j, const QuiltEmbeddingStats& em, const std::string& embedding) {
+  j.value("embedding", em.shell_map_failure.empty() ? embedding : std::string("normal"))
       .value("shell_map_failure", em.shell_map_failure)
       .value("stretch_before", em.stretch_before)
       .value("stretch_after", em.stretch_after)
       .value("stretch_optimization_sweeps", em.optimization_sweeps)
       .value("atlas_charts", em.atlas_charts)
       .value("shell_smoothing_steps", em.shell_smoothing_steps)
-      .value("fold_repaired_vertices", em.fold_repaired_vertices)
-      .begin_object("output")
+      .value("fold_repaired_vertices", em.fold_repaired_vertices);
+}
+
+// The output's size, and the "elements" object: what the planar steps did and what the
+// embedding's repairs and post-processing did to elements.
+void write_element_figures(JsonWriter& j, const SurfaceQuiltingStats& s,
+                           const QuiltEmbeddingStats& em) {
+  j.begin_object("output")
       .value("faces", em.faces)
       .value("vertices", em.vertices)
       .value("elements", em.elements)
@@ -101,18 +93,12 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("cv", em.element_area_cv)
       .value("min", em.element_area_min)
       .value("max", em.element_area_max)
-      .end_object()
-      .value("coverage", em.coverage)
-      .begin_object("memory")
-      .value("estimated_faces", estimated_faces)
-      .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
-      .value("limit_bytes", memory_limit_bytes)
-      .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
-      .end_object()
-      .value("swatch_coverage", swatch_cover)
-      .value("min_coverage", min_coverage);
-  // The embedding's check of its own result (issue 23): where the shell map was not built,
-  // and the output's signed heights over the base as given.
+      .end_object();
+}
+
+// The embedding's check of its own result (issue 23): where the shell map was not built, and
+// the output's signed heights over the base as given.
+void write_placement(JsonWriter& j, const QuiltEmbeddingStats& em, const std::string& embedding) {
   j.begin_object("placement")
       .value("shell_map", embedding != "shell"            ? "not asked"
                           : !em.shell_map_failure.empty() ? "failed"
@@ -133,40 +119,79 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("above_shell", em.above_shell)
       .value("lowest_height", em.lowest_height)
       .end_object();
+}
+
+// The global layout's figures: its cones, cut, scale, and what it placed.
+void write_global_layout(JsonWriter& j, const GlobalQuiltingStats& g) {
+  j.begin_object("global")
+      .value("periodic", g.periodic)
+      .value("seamless", g.seamless)
+      .value("tiled", g.tiled)
+      .value("orbits", g.orbits)
+      .value("singular_vertices", g.singular_vertices)
+      .value("cancelled_cone_pairs", g.cancelled_cone_pairs)
+      .value("split_poles", g.split_poles)
+      .value("cone_moves", g.cone_moves)
+      .value("scale_energy_before", g.scale_energy_before)
+      .value("scale_energy", g.scale_energy)
+      .value("scale_exponent", g.scale_exponent)
+      .value("pinned_cones", g.pinned_cones)
+      .value("cut_edges", g.cut_edges)
+      .value("cut_paths", g.cut_paths)
+      .value("worst_transition_error", g.worst_transition_error)
+      .value("scale_correction", g.scale_correction)
+      .value("parameter_area", g.parameter_area)
+      .value("placed", g.placed)
+      .value("off_surface", g.off_surface)
+      .value("copied_elements", g.copied_elements)
+      .value("threads", g.threads)
+      .value("thread_pieces", g.thread_pieces)
+      .value("pieces_distorted", g.pieces_distorted)
+      .value("pieces_near_cones", g.pieces_near_cones)
+      .value("pieces_intersecting", g.pieces_intersecting)
+      .value("thread_welds", g.thread_welds)
+      .value("thread_ends", g.thread_ends)
+      .value("closed_threads", g.closed_threads)
+      .value("short_threads", g.short_threads)
+      .end_object();
+}
+
+std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats& em,
+                       const std::string& embedding, const std::string& device, int threads,
+                       double wall, const std::string& base, const std::string& swatch,
+                       const std::string& method, const GlobalQuiltingStats* global,
+                       const StructureSummary& structure, double memory_limit_bytes,
+                       double min_coverage, double swatch_cover, const ElementDetail& detail,
+                       double detail_share) {
+  // The global layout counts its output exactly before building it; else the estimate made
+  // before any work.
+  const double estimated_faces =
+      global && global->layout_faces > 0 ? global->layout_faces : s.estimated_faces;
+  JsonWriter j;
+  j.begin_object()
+      .value("command", "surface")
+      .value("base", base)
+      .value("swatch", swatch)
+      .value("method", method)
+      .value("device", device)
+      .value("threads", threads)
+      .value("wall_seconds", wall);
+  write_preparation(j, s);
+  write_shell_map(j, em, embedding);
+  write_element_figures(j, s, em);
+  j.value("coverage", em.coverage)
+      .begin_object("memory")
+      .value("estimated_faces", estimated_faces)
+      .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
+      .value("limit_bytes", memory_limit_bytes)
+      .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
+      .end_object()
+      .value("swatch_coverage", swatch_cover)
+      .value("min_coverage", min_coverage);
+  write_placement(j, em, embedding);
   j.value("matched_point_offsets", s.matched_point_offsets);
   write_match_counts(j, s.counts);
-  if (global)
-    j.begin_object("global")
-        .value("periodic", global->periodic)
-        .value("seamless", global->seamless)
-        .value("tiled", global->tiled)
-        .value("orbits", global->orbits)
-        .value("singular_vertices", global->singular_vertices)
-        .value("cancelled_cone_pairs", global->cancelled_cone_pairs)
-        .value("split_poles", global->split_poles)
-        .value("cone_moves", global->cone_moves)
-        .value("scale_energy_before", global->scale_energy_before)
-        .value("scale_energy", global->scale_energy)
-        .value("scale_exponent", global->scale_exponent)
-        .value("pinned_cones", global->pinned_cones)
-        .value("cut_edges", global->cut_edges)
-        .value("cut_paths", global->cut_paths)
-        .value("worst_transition_error", global->worst_transition_error)
-        .value("scale_correction", global->scale_correction)
-        .value("parameter_area", global->parameter_area)
-        .value("placed", global->placed)
-        .value("off_surface", global->off_surface)
-        .value("copied_elements", global->copied_elements)
-        .value("threads", global->threads)
-        .value("thread_pieces", global->thread_pieces)
-        .value("pieces_distorted", global->pieces_distorted)
-        .value("pieces_near_cones", global->pieces_near_cones)
-        .value("pieces_intersecting", global->pieces_intersecting)
-        .value("thread_welds", global->thread_welds)
-        .value("thread_ends", global->thread_ends)
-        .value("closed_threads", global->closed_threads)
-        .value("short_threads", global->short_threads)
-        .end_object();
+  if (global) write_global_layout(j, *global);
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
   write_detail(j, detail, detail_share);
   j.begin_object("stage_seconds");
