@@ -32,6 +32,7 @@ base = bpy.context.active_object
 s = bpy.context.scene.meshquilt
 s.base, s.sample, s.scale = base, "chainmail", 0.25
 bpy.ops.meshquilt.run()
+bpy.ops.meshquilt.estimate()  # the size line: faces, memory and time before a run
 result = bpy.data.objects[base.name + "_quilt"]
 bpy.context.view_layer.objects.active = result
 result.select_set(True)
@@ -79,4 +80,5 @@ def shoot():
 
 bpy.app.timers.register(frame, first_interval=1.0)
 bpy.app.timers.register(click_tab, first_interval=2.0)
-bpy.app.timers.register(shoot, first_interval=4.0)
+bpy.app.timers.register(click_tab, first_interval=3.0)
+bpy.app.timers.register(shoot, first_interval=6.0)
