@@ -24,7 +24,23 @@ def mesh_arrays(mesh):
     mesh.loop_triangles.foreach_get("vertices", T)
     M = np.empty(len(mesh.loop_triangles), dtype=np.int32)
     mesh.loop_triangles.foreach_get("material_index", M)
-    return V.reshape(-1, 3), T.reshape(-1, 3), M
+    T, M = canonical_triangles(T.reshape(-1, 3), M)
+    return V.reshape(-1, 3), T, M
+
+
+def canonical_triangles(T, M):
+    """The triangles (#T x 3) and their material indices in one order that depends only on the
+    set of triangles: each starts at its lowest vertex (its orientation kept), all sorted.
+    Blender's loop triangles of the same mesh came in a different order from run to run (a UV
+    sphere: 838 to 883 rings from one Run to the next), and the engine's result depends on the
+    order of the base's faces."""
+    if len(T) == 0:
+        return T, M
+    first = T.argmin(axis=1)
+    rows = np.arange(len(T))[:, None]
+    R = T[rows, (first[:, None] + np.arange(3)[None, :]) % 3]
+    order = np.lexsort((R[:, 2], R[:, 1], R[:, 0]))
+    return np.ascontiguousarray(R[order]), M[order]
 
 
 def part_face_counts(T, vertex_count):

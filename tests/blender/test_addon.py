@@ -947,6 +947,32 @@ def test_preview_then_run_leave_one_result_for_the_base():
           % results())
 
 
+
+@test
+def test_a_mesh_goes_to_the_engine_the_same_whatever_its_face_order():
+    # The same quads (each with its own material index) in two polygon orders: the triangles
+    # sent to the engine, and their materials, come out identical (Blender's loop triangles of
+    # one UV sphere came in a different order from run to run, and so did the result).
+    from meshquilt import exchange
+    verts = [(x, y, 0.1 * x * y) for y in range(4) for x in range(4)]
+    quads = [(y * 4 + x, y * 4 + x + 1, y * 4 + x + 5, y * 4 + x + 4)
+             for y in range(3) for x in range(3)]
+    arrays = []
+    for order in (list(range(9)), [4, 8, 0, 7, 2, 5, 1, 6, 3]):
+        me = bpy.data.meshes.new("order")
+        me.from_pydata(verts, [], [quads[i] for i in order])
+        me.materials.append(None)
+        me.materials.append(None)
+        for p, i in zip(me.polygons, order):
+            p.material_index = i % 2
+        arrays.append(exchange.mesh_arrays(me))
+        bpy.data.meshes.remove(me)
+    (V0, T0, M0), (V1, T1, M1) = arrays
+    check(np.array_equal(V0, V1) and np.array_equal(T0, T1) and np.array_equal(M0, M1),
+          "triangles %s / %s" % (T0[:3].tolist(), T1[:3].tolist()))
+    check(len(T0) == 18 and set(M0.tolist()) == {0, 1}, "%d triangles, materials %s"
+          % (len(T0), sorted(set(M0.tolist()))))
+
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
 if failures:
     sys.exit(1)
