@@ -83,39 +83,6 @@ int keep_in_shell(const SurfaceQuilt& quilt, const std::vector<Eigen::Index>& fi
   return count;
 }
 
-// The directions normal displacement follows, over the refined base: the shell's smoothed
-// offset directions (core/shell/offset_surface). Its plain vertex normals fan out at a spike's tip
-// (rings there pressed into each other: 72 removed on the spiky sphere against 20), and those of
-// a coarse base as given shear a box's faces (a corner's is 55 degrees off each).
-MatrixX3d shell_directions(const SurfaceQuilt& quilt) {
-  return displacement_directions(quilt.base.V, quilt.base.F, quilt.shell_height);
-}
-
-// The rows of the elements with which[k] set placed by normal displacement (the fallback where
-// the shell map is not built, or where it put an element under the base).
-void place_by_normal(const SurfaceQuilt& quilt, const LocalCoordinates& points,
-                     const std::vector<Eigen::Index>& first, const std::vector<char>& which,
-                     MatrixX3d& V) {
-  std::vector<Eigen::Index> rows;
-  for (size_t k = 0; k + 1 < first.size(); ++k)
-    if (which[k])
-      for (Eigen::Index v = first[k]; v < first[k + 1]; ++v) rows.push_back(v);
-  if (rows.empty()) return;
-  LocalCoordinates sub;
-  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
-  sub.face.resize(n);
-  sub.bary.resize(n, 3);
-  sub.height.resize(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    sub.face(i) = points.face(rows[static_cast<size_t>(i)]);
-    sub.bary.row(i) = points.bary.row(rows[static_cast<size_t>(i)]);
-    sub.height(i) = points.height(rows[static_cast<size_t>(i)]);
-  }
-  const MatrixX3d placed =
-      normal_displacement(quilt.base.V, quilt.base.F, shell_directions(quilt), sub);
-  for (Eigen::Index i = 0; i < n; ++i) V.row(rows[static_cast<size_t>(i)]) = placed.row(i);
-}
-
 // The embedding's state between its steps: every element's vertices in one matrix (element k's
 // rows [first[k], first[k + 1])), their local coordinates, and what the steps learn about each
 // element (placed by normal displacement, under the base, moved since last checked, dropped).
@@ -137,6 +104,8 @@ class QuiltEmbedder {
 
  private:
   void embed_through_map(TetStretchEvaluator& stretch);
+  const MatrixX3d& shell_directions();
+  void place_by_normal(const std::vector<char>& which);
   std::vector<char> lift_moved();
   void forget_sunk(std::vector<std::pair<int, int>>& p) const;
   void find_pairs_once();
@@ -169,6 +138,7 @@ class QuiltEmbedder {
   std::vector<char> sunk_;               // still under the base after the fallback: removed
   std::vector<char> moved_after_check_;  // moved by a repair since checked: checked again
   std::vector<char> drop_, folded_;
+  std::optional<MatrixX3d> directions_;  // shell_directions(), made once when first needed
 };
 
 QuiltEmbedder::QuiltEmbedder(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& options,
@@ -208,6 +178,40 @@ QuiltEmbedder::QuiltEmbedder(const SurfaceQuilt& quilt, const QuiltEmbeddingOpti
   folded_.assign(ne_, 0);
   check_.height = quilt.shell_height;
   check_.tolerance = stats.placement_tolerance;
+}
+
+// The directions normal displacement follows, over the refined base: the shell's smoothed
+// offset directions (core/shell/offset_surface). Its plain vertex normals fan out at a spike's tip
+// (rings there pressed into each other: 72 removed on the spiky sphere against 20), and those of
+// a coarse base as given shear a box's faces (a corner's is 55 degrees off each). Made once: the
+// embedding, the layout's versions and both fallbacks use them.
+const MatrixX3d& QuiltEmbedder::shell_directions() {
+  if (!directions_)
+    directions_ = displacement_directions(quilt_.base.V, quilt_.base.F, quilt_.shell_height);
+  return *directions_;
+}
+
+// The rows of the elements with which[k] set placed by normal displacement (the fallback where
+// the shell map is not built, or where it put an element under the base).
+void QuiltEmbedder::place_by_normal(const std::vector<char>& which) {
+  std::vector<Eigen::Index> rows;
+  for (size_t k = 0; k < ne_; ++k)
+    if (which[k])
+      for (Eigen::Index v = first_[k]; v < first_[k + 1]; ++v) rows.push_back(v);
+  if (rows.empty()) return;
+  LocalCoordinates sub;
+  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
+  sub.face.resize(n);
+  sub.bary.resize(n, 3);
+  sub.height.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    sub.face(i) = points_.face(rows[static_cast<size_t>(i)]);
+    sub.bary.row(i) = points_.bary.row(rows[static_cast<size_t>(i)]);
+    sub.height(i) = points_.height(rows[static_cast<size_t>(i)]);
+  }
+  const MatrixX3d placed =
+      normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(), sub);
+  for (Eigen::Index i = 0; i < n; ++i) all_.V.row(rows[static_cast<size_t>(i)]) = placed.row(i);
 }
 
 // The stretch-minimised shell map (section 3.2) over the refined base, whose faces are no
@@ -259,7 +263,7 @@ void QuiltEmbedder::embed(TetStretchEvaluator& stretch) {
     return;
   }
   ScopedStage stage(stats_.times, progress_, Stage::Embedding);
-  all_.V = normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(quilt_), points_);
+  all_.V = normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(), points_);
 }
 
 // The unoptimised map creates no intersections where the base is concave (the shell is valid
@@ -286,7 +290,7 @@ void QuiltEmbedder::embed_through_map(TetStretchEvaluator& stretch) {
   }
   ScopedStage stage(stats_.times, progress_, Stage::Embedding);
   all_.V = ShellEmbedding(*map_).embed(mapped_);
-  place_by_normal(quilt_, points_, first_, by_normal_, all_.V);
+  place_by_normal(by_normal_);
   if (!options_.optimize_stretch) return;
   pairs_ = all_face_pairs(all_.V, all_.F);
   known_disjoint_ = pairs_.empty();  // nothing to revert, nor for post-processing to find
@@ -331,7 +335,7 @@ void QuiltEmbedder::embed_layout_versions() {
       if (map_ && map_->shell_face(a.face[v]) < 0) alt_normal[k] = 1;
     }
   }
-  alternative_V_ = normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(quilt_), alt);
+  alternative_V_ = normal_displacement(quilt_.base.V, quilt_.base.F, shell_directions(), alt);
   if (!map_) return;
   LocalCoordinates through = alt;
   for (size_t k = 0; k < ne_; ++k)
@@ -366,7 +370,7 @@ void QuiltEmbedder::check_placement() {
     }
   stats_.replaced_below = static_cast<int>(std::count(again.begin(), again.end(), 1));
   if (stats_.replaced_below == 0) return;
-  place_by_normal(quilt_, points_, first_, again, all_.V);
+  place_by_normal(again);
   const std::vector<ElementHeights> rechecked =
       check_element_heights(*base_height_, all_.V, first_, check_, again);
   for (size_t k = 0; k < ne_; ++k)
