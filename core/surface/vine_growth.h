@@ -52,7 +52,8 @@ struct VineGrowthStats {
   int stems_cut = 0;          // would intersect an earlier stem or themselves: cut there
   int stems_dropped = 0;      // pieces still intersecting after the last round: left out
   int leaves = 0;             // compact elements placed along the stems
-  int leaf_slots = 0;         // places the swatch's ratio gives along the stems
+  int leaf_slots = 0;         // places the swatch's ratio gives along the stems (and up to
+                              // the largest move past their ends)
   int leaves_shifted = 0;     // of the placed, moved along the stem to clear a neighbour
   double vine_length = 0;     // one swatch vine's length along its axis, base units
   double spacing = 0;         // between stems, base units

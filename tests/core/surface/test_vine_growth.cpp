@@ -13,6 +13,7 @@
 #include "core/planar/translation_cost.h"
 #include "core/shell/quilt_embedding.h"
 #include "core/shell/signed_height.h"
+#include "core/shell/surface_coverage.h"
 #include "core/structure/texture_structure.h"
 #include "core/surface/global_quilting.h"
 #include "core/surface/tangent_field.h"
@@ -158,6 +159,35 @@ TEST(VineGrowth, StemsClimbAPlaneEvenlySpaced) {
   }
   std::sort(gaps.begin(), gaps.end());
   EXPECT_NEAR(gaps[gaps.size() / 2], g.stats.spacing, 0.01 * g.stats.spacing);
+}
+
+// Each stem carries its leaves to its ends: the strips along the plane's foot and top, where
+// every stem starts and ends, are covered nearly as well as its middle (a leaf whose place lies
+// just past an end is moved onto the stem, as any leaf is moved to clear its neighbours).
+TEST(VineGrowth, LeavesReachTheStemsEnds) {
+  const TriMesh plane = test::plane_grid(2, 1.5, 40, 30);
+  const Grown g = grow(plane, 0.06);
+  const int vine = kind_of(g.quilt, "vine");
+  double lo = kInf, hi = -kInf;
+  for (size_t i = 0; i < g.quilt.elements.size(); ++i)
+    if (g.quilt.elements[i].kind == vine) {
+      lo = std::min(lo, g.elements[i].V.col(1).minCoeff());
+      hi = std::max(hi, g.elements[i].V.col(1).maxCoeff());
+    }
+  const double pitch = 0.5 * g.stats.vine_length;  // two leaves per swatch vine
+  const auto strip = [&](double from, double to) {
+    std::vector<char> in(static_cast<size_t>(plane.F.rows()), 0);
+    for (Eigen::Index f = 0; f < plane.F.rows(); ++f) {
+      double y = 0;
+      for (int k = 0; k < 3; ++k) y += plane.V(plane.F(f, k), 1) / 3;
+      in[static_cast<size_t>(f)] = y >= from && y <= to;
+    }
+    return surface_coverage(plane, g.mesh, 1.5 * g.quilt.shell_height, 0, in);
+  };
+  const double foot = strip(lo, lo + pitch), top = strip(hi - pitch, hi);
+  const double middle = strip(lo + 2 * pitch, hi - 2 * pitch);
+  EXPECT_GT(foot, 0.9 * middle) << foot << " " << middle;
+  EXPECT_GT(top, 0.9 * middle) << top << " " << middle;
 }
 
 // A given field is followed: along x, the stems run across the plane.
