@@ -96,6 +96,10 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Minimise distortion", default=True,
         description="Minimise the shell map's stretch (slower, less distorted elements)")
     seed: bpy.props.IntProperty(name="Seed", default=1, min=0)
+    keep_results: bpy.props.BoolProperty(
+        name="Keep earlier results", default=False,
+        description="Run adds its result beside the base's earlier one instead of replacing "
+        "it (a Preview always replaces the base's latest result)")
     detail: bpy.props.IntProperty(
         name="Detail", default=100, min=1, max=100, subtype="PERCENTAGE",
         description="The share of each swatch element's faces kept, each element simplified "
@@ -263,7 +267,7 @@ class MeshquiltBinding(bpy.types.PropertyGroup):
     result: bpy.props.PointerProperty(
         name="Result", type=bpy.types.Object,
         description="On a base: its latest result from Run or Preview, which the next one "
-        "replaces if either is a Preview")
+        "replaces (a Run with Keep earlier results set replaces only a Preview)")
 
 
 class Run:
@@ -296,6 +300,7 @@ class Run:
         self.element_size = settings.element_size
         # Detail: the share of each swatch element's faces kept; a Preview takes less.
         self.preview = preview
+        self.keep_results = settings.keep_results
         self.detail = settings.detail / 100.0
         if preview:
             self.detail = preview_share(self.detail, element_faces(context, settings)[0])
@@ -456,10 +461,12 @@ class Run:
 
     def import_result(self, context):
         result = exchange.read_ply(self.result_path)
-        # One result per base: a Preview replaces the base's last result, a Run its Preview.
+        # One result per base: a Preview replaces the base's latest result, and so does a Run
+        # unless the artist keeps earlier results (then it replaces only a Preview).
         replaced = self.base.meshquilt.result
-        if replaced is not None and (replaced.meshquilt.base != self.base or not (
-                self.preview or replaced.get("meshquilt_preview"))):
+        if replaced is not None and (replaced.meshquilt.base != self.base or (
+                self.keep_results and not self.preview and
+                not replaced.get("meshquilt_preview"))):
             replaced = None
         name = replaced.name if replaced is not None else "%s_quilt" % self.base.name
         # The swatch's own materials for its kinds (the engine's names replace spaces).
@@ -1009,6 +1016,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             layout.prop(s, "guide_attribute")
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
+        layout.prop(s, "keep_results")
         _draw_estimate(layout, context, s)
         if "run" in _running:
             run = _running["run"]

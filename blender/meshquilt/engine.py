@@ -60,25 +60,30 @@ def killed_message(signal_number):
     return "the meshquilt engine was stopped from outside (%s)" % name
 
 
-# Typical shares of a surface job's stages, in the order the engine reports them (seconds of
-# runs on data/spot_6k.obj: chain mail at --scale 0.08 with the global layout and with the
-# patches, the sample ivy at --scale 0.05 with vines). A stage seen twice (embedding, placement
-# check) has one weight per time. The first stage names the method.
-_TAIL = [("shell map", .12), ("embedding", .04), ("stretch optimization", .33),
-         ("embedding", .49), ("placement check", .06), ("fold repair", .12),
-         ("ring separation", .68), ("element removal", .05), ("placement check", .01),
-         ("coverage", .21), ("writing", .06)]
+# Typical seconds of a surface job's stages, in the order the engine reports them, as
+# (stage, seconds at any detail, seconds more per unit of detail): a stage's weight at detail d
+# (the share of each element's faces kept, a Preview's about 0.1) is a + b d. Fitted to runs
+# on data/spot_6k.obj on 2 cores (2026-12-04; chain mail at --scale 0.08 with the global layout
+# and with the patches at --detail 1 and 0.1, the sample ivy at --scale 0.05 at 1 and 0.25),
+# each stage from its first progress line to the next stage's. A stage seen twice (embedding,
+# placement check) has one weight per time. The first stage names the method.
 STAGE_WEIGHTS = {
-    "global": [("parameterization", .31), ("tiling", .01), ("placement", .05),
-               ("quilting", .24)] + _TAIL,
-    "patches": [("quilting", 1.33), ("shell map", .09), ("embedding", .02),
-                ("stretch optimization", .31), ("embedding", .21), ("placement check", .03),
-                ("fold repair", .01), ("ring separation", .01), ("element removal", .01),
-                ("placement check", .01), ("coverage", .09), ("writing", .05)],
-    "vines": [("streamlines", .98), ("leaves", .95), ("shell map", .29), ("embedding", .07),
-              ("stretch optimization", .40), ("embedding", .82), ("placement check", .12),
-              ("fold repair", .04), ("ring separation", .02), ("element removal", .02),
-              ("placement check", .01), ("coverage", .36), ("writing", .08)],
+    "global": [("parameterization", .23, .01), ("tiling", 0, 0), ("placement", .03, .83),
+               ("quilting", .15, .87), ("shell map", .07, .44), ("embedding", .01, .33),
+               ("stretch optimization", .10, 0), ("embedding", .08, 6.96),
+               ("placement check", .07, .12), ("fold repair", .02, 1.83),
+               ("ring separation", .79, 2.69), ("element removal", .05, 1.20),
+               ("placement check", 0, 1.13), ("coverage", 0, 3.40), ("writing", .03, 2.43)],
+    "patches": [("quilting", .98, 8.90), ("shell map", .06, .28), ("embedding", .01, .16),
+                ("stretch optimization", .08, .01), ("embedding", .10, 3.37),
+                ("placement check", .04, .08), ("fold repair", .02, .03),
+                ("ring separation", 0, 0), ("element removal", .01, .01),
+                ("placement check", 0, .57), ("coverage", .06, 1.57), ("writing", .05, 1.24)],
+    "vines": [("streamlines", 1.26, 4.25), ("leaves", 1.62, 9.57), ("shell map", .19, .35),
+              ("embedding", .05, .20), ("stretch optimization", .17, .01),
+              ("embedding", .65, 4.49), ("placement check", .17, .33), ("fold repair", 2.32, .27),
+              ("ring separation", 1.84, .95), ("element removal", 1.92, .80),
+              ("placement check", 0, .77), ("coverage", .22, 1.80), ("writing", .09, 1.36)],
 }
 FIRST_STAGE = {"parameterization": "global", "tiling": "global", "quilting": "patches",
                "streamlines": "vines", "stems": "vines", "leaves": "vines"}
@@ -88,9 +93,11 @@ UNKNOWN_STAGE_SHARE = 0.03  # a stage not in the table: this share of the job
 class Progress:
     """One overall fraction of a job from the engine's per-stage progress lines: the finished
     stages' typical shares plus the current stage's share times its own fraction; it never
-    decreases, stays under 1 until the job is done (finish())."""
+    decreases, stays under 1 until the job is done (finish()). `detail`: the job's (the share
+    of each element's faces kept), which sets the stages' shares (STAGE_WEIGHTS)."""
 
-    def __init__(self):
+    def __init__(self, detail=1.0):
+        self.detail = min(1.0, max(0.0, float(detail)))
         self.sequence = None
         self.position = -1
         self.stage = None
@@ -102,7 +109,8 @@ class Progress:
     def update(self, stage, fraction):
         fraction = min(1.0, max(0.0, fraction))
         if self.sequence is None:
-            self.sequence = STAGE_WEIGHTS[FIRST_STAGE.get(stage, "global")]
+            self.sequence = [(name, fixed + per_detail * self.detail) for name, fixed, per_detail
+                             in STAGE_WEIGHTS[FIRST_STAGE.get(stage, "global")]]
             self.total = sum(w for _, w in self.sequence)
         if stage != self.stage or fraction < self.last_fraction:
             # A new stage (or the same one again: its fraction fell back).
@@ -151,7 +159,7 @@ class Job:
     describe the latest progress line; error holds the engine's message once failed.
     """
 
-    def __init__(self, engine, args, cwd=None, progress=True):
+    def __init__(self, engine, args, cwd=None, progress=True, detail=1.0):
         # --progress-lines: the synthesis commands' machine progress (the swatch generator
         # is quick and has none).
         self.args = [engine] + list(args) + (["--progress-lines"] if progress else [])
@@ -161,7 +169,7 @@ class Job:
         self.remaining = -1.0
         self.error = ""
         self.state = "running"
-        self.progress = Progress()
+        self.progress = Progress(detail)
         self._lines = queue.Queue()
         self._stderr_tail = []
         self._started = time.monotonic()
@@ -302,7 +310,8 @@ def surface_job(engine, base, swatch, output, scale, **options):
     also saves the result over the base (.mqq) for embed_job; `max_memory` (GiB) refuses a
     larger job before any work; `stats` writes the run's figures as JSON; `detail` in (0, 1]
     keeps that share of each swatch element's faces."""
-    return Job(engine, surface_args(base, swatch, output, scale, **options))
+    return Job(engine, surface_args(base, swatch, output, scale, **options),
+               detail=options.get("detail", 1.0))
 
 
 def estimate(engine, base, swatch, output, scale, timeout=60, **options):

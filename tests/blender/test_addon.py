@@ -766,6 +766,33 @@ def test_overall_progress_never_decreases_and_reaches_one():
 
 
 @test
+def test_overall_progress_follows_the_time_at_a_previews_detail():
+    from meshquilt import engine
+    # Seconds per stage as the engine reported them (scripts: first progress line of each stage
+    # to the next's) for chain mail with the global layout at --scale 0.1 on bases the weights
+    # were not fitted to, at a Preview's detail (0.1) and at full detail.
+    runs = {
+        ("bunny", 0.1): [0.16, 0, .05, .18, .08, .03, .07, .49, .07, .18, .86, .12, .01, .23, .1],
+        ("bunny", 1.0): [.15, 0, .51, .7, .35, .2, .09, 4.29, .14, 1.41, 2.84, .81, .52, 1.76,
+                         1.28],
+        ("cup", 0.1): [.24, 0, .08, .22, .11, .04, .08, .82, .1, .17, .9, .13, .03, .22, .23],
+        ("cup", 1.0): [.25, 0, .81, 1.09, .56, .33, .07, 6.71, .24, 1.66, 3.15, .78, .93, 3.42,
+                       2.27],
+    }
+    stages = [name for name, _, _ in engine.STAGE_WEIGHTS["global"]]
+    for (base, detail), seconds in runs.items():
+        p, elapsed, worst = engine.Progress(detail), 0.0, 0.0
+        for stage, t in zip(stages, seconds):
+            p.update(stage, 0.0)
+            p.update(stage, 1.0)
+            elapsed += t
+            worst = max(worst, abs(p.overall - elapsed / sum(seconds)))
+        # The full run's weights on a Preview were 0.16-0.17 off (the embedding's share).
+        check(worst < 0.08, "%s at detail %g: overall off the time by %.3f"
+              % (base, detail, worst))
+
+
+@test
 def test_run_shows_cancel_at_once_before_any_progress():
     scene = new_scene()
     s = scene.meshquilt
@@ -945,6 +972,50 @@ def test_preview_then_run_leave_one_result_for_the_base():
     check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "second preview did not finish")
     check(len(results()) == 1 and results()[0].get("meshquilt_preview"), "results %s"
           % results())
+
+
+@test
+def test_run_after_run_replaces_the_result_unless_earlier_ones_are_kept():
+    scene = new_scene()
+    s = scene.meshquilt
+    base = small_sphere()
+    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.5, 10
+
+    def results():
+        return sorted(o.name for o in bpy.data.objects if o.meshquilt.base == base)
+
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "run did not finish")
+    first = results()
+    s.seed = 2
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "second run did not finish")
+    check(results() == first, "after a second Run: %s (was %s)" % (results(), first))
+    check(not [m for m in bpy.data.meshes if m.users == 0], "the replaced mesh left behind")
+    # Kept: the next Run goes beside it and becomes the base's latest result.
+    s.keep_results = True
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "third run did not finish")
+    check(len(results()) == 2, "kept: %s" % results())
+    latest = base.meshquilt.result
+    check(latest.name not in first, "the latest result is %s" % latest.name)
+    # A Preview still replaces the latest result, never the kept one; its overall progress
+    # takes the Preview's detail.
+    import meshquilt
+    from meshquilt import engine
+    details, plain = [], engine.Progress
+
+    class Spy(plain):
+        def __init__(self, detail=1.0):
+            details.append(detail)
+            super().__init__(detail)
+
+    engine.Progress = Spy
+    try:
+        check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "preview did not finish")
+    finally:
+        engine.Progress = plain
+    check(len(results()) == 2 and base.meshquilt.result.get("meshquilt_preview") and
+          first[0] in results(), "after the preview: %s" % results())
+    low = meshquilt.preview_share(0.1, meshquilt.SAMPLE_ELEMENTS["chainmail"][0])
+    check(low < 0.1 and low in details, "preview detail %g, progress at %s" % (low, details))
 
 
 
