@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Blender add-on tested in real Blender, headless (issue 15): installs Blender (Debian's
 # package) when missing, zips the add-on and runs tests/blender/test_addon.py against the
-# engine of build/ (or $1).
+# engine of build/ (or $1). MESHQUILT_BLENDER_TESTS=word runs only the tests named with it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 engine=$(realpath "${1:-build/meshquilt}")

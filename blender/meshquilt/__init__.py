@@ -322,6 +322,8 @@ class Run:
             self._export_field(depsgraph, base, settings.guide_attribute, field_file, len(V))
         self.jobs = []
         self.material_names = {}  # the engine's kind name -> the swatch's material name
+        self.swatch_name = settings.swatch.name if settings.swatch_source == "OBJECT" else \
+            "the sample %s" % settings.sample
         if settings.swatch_source == "OBJECT":
             swatch_path = os.path.join(self.dir, "swatch.ply")
             kinds = self._export(depsgraph, settings.swatch, swatch_path, with_kinds=True)[2]
@@ -403,10 +405,10 @@ class Run:
         if state == "failed" and len(self.jobs) < self.optional_jobs:
             state = "done"  # an optional job: the run goes on without what it adds
         if state == "failed":
-            self.state, self.error = "failed", self.job.error
-            refused = engine.refusal_message(self.error, self.scale, self.max_memory)
-            if refused:
-                self.error = refused
+            self.state = "failed"
+            self.error = engine.artist_message(self.job.error, self.scale, self.max_memory,
+                                               self.base.name, self.swatch_name,
+                                               self.element_size)
         elif state == "cancelled":
             self.state = "cancelled"
         elif state == "done":
@@ -688,8 +690,13 @@ class MESHQUILT_OT_estimate(bpy.types.Operator):
             run = Run(context, s)
             e = run.estimate()
         except (engine.EngineError, OSError, ValueError) as e:
-            s.estimate_key, s.estimate_error = key, str(e)
-            self.report({"ERROR"}, str(e))
+            message = str(e)
+            if run is not None and isinstance(e, engine.EngineError):
+                message = engine.artist_message(message, run.scale, run.max_memory,
+                                                run.base.name, run.swatch_name,
+                                                run.element_size)
+            s.estimate_key, s.estimate_error = key, message
+            self.report({"ERROR"}, message)
             return {"CANCELLED"}
         finally:
             if run is not None:

@@ -350,9 +350,10 @@ def machine_memory_gib():
     return 0.0
 
 
-def refusal_message(error, scale, limit_gib):
+def refusal_message(error, scale, limit_gib, element_size=0.0):
     """The artist's words for the engine refusing a job over --max-memory or --max-faces (None
-    for any other error): what the job would need and what to change in Blender."""
+    for any other error): what the job would need and what to change in Blender (the size by
+    the panel's name for it: Element size when above 0, else Scale)."""
     if ("--max-memory" not in error and "--max-faces" not in error) or \
             "limit of" not in error:
         return None  # not a refusal (e.g. a value out of range)
@@ -365,15 +366,57 @@ def refusal_message(error, scale, limit_gib):
     need_gib = n * 400 / 2.0 ** 30 if n is not None else None
     need = (" would make about %s faces (about %.2g GiB)" % (format(int(n), ","), need_gib)
             if n is not None else " is too large")
+    knob = "Element size" if element_size > 0 else "Scale"
+    at = "at %s %g" % (knob, element_size if element_size > 0 else scale)
     if need_gib is not None and limit and need_gib <= limit_gib:
-        return ("meshquilt: at Scale %g the texture%s, more than the engine's limit of %s "
-                "faces: raise Scale in the panel (fewer, larger elements) or lower Detail "
-                "(fewer faces each)"
-                % (scale, need, format(int(float(limit.group(1))), ",")))
-    return ("meshquilt: at Scale %g the texture%s, over the memory limit of %.3g GiB: raise "
-            "Scale in the panel (fewer, larger elements) or lower Detail (fewer faces each), "
-            "or raise Memory limit in Edit > Preferences > Add-ons > meshquilt"
-            % (scale, need, limit_gib))
+        return ("meshquilt: %s the texture%s, more than the engine's limit of %s faces: raise "
+                "%s in the panel (fewer, larger elements) or lower Detail (fewer faces each)"
+                % (at, need, format(int(float(limit.group(1))), ","), knob))
+    return ("meshquilt: %s the texture%s, over the memory limit of %.3g GiB: raise %s in the "
+            "panel (fewer, larger elements) or lower Detail (fewer faces each), or raise Memory "
+            "limit in Edit > Preferences > Add-ons > meshquilt" % (at, need, limit_gib, knob))
+
+
+def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch",
+                   element_size=0.0):
+    """The artist's words for the engine's refusals that the panel's settings can cause: what
+    is wrong with which object and what to change in the panel (refusal_message for the size
+    and memory limits). Any other error is the engine's own line without its prefix. The size
+    is named as the panel sets it: Element size when it is above 0, else Scale."""
+    refused = refusal_message(error, scale, limit_gib, element_size)
+    if refused:
+        return refused
+    import re
+    text = error.split(": error: ", 1)[-1]
+    knob = "Element size" if element_size > 0 else "Scale"
+    at = "at %s %g" % (knob, element_size if element_size > 0 else scale)
+    smaller = "lower %s in the panel (smaller elements)" % knob
+    if "has zero size" in text:
+        return ("meshquilt: the base %s has zero size (all its vertices at one point): pick "
+                "another base, or give it a size" % base)
+    if "has no area" in text:
+        return ("meshquilt: the base %s has no area (its faces are flat to lines or points): "
+                "pick a base whose faces enclose area" % base)
+    if "the swatch is flat" in text:
+        return ("meshquilt: the swatch %s is flat: give it thickness (for example a Solidify "
+                "modifier); the texture grows in a shell as thick as the swatch" % swatch)
+    covered = re.match(r"only ([0-9.e+-]+)% of the base is covered, below ([0-9.e+-]+)%", text)
+    if covered:
+        got, needed = float(covered.group(1)), float(covered.group(2))
+        if "elements were removed" in text:
+            cause = "many elements met others or went inside it where its parts come close"
+        elif "shell map was not built" in text:
+            cause = "its shell could not be built over most of it"
+        else:
+            cause = "the elements are too large for its parts"
+        return ("meshquilt: %s only %.0f%% of %s would be covered (%.0f%% needed): %s; %s; "
+                "nothing was added" % (at, got, base, needed, cause, smaller))
+    if text.startswith("no element of the swatch could be placed"):
+        return "meshquilt: %s no element of the swatch fits on %s: %s" % (at, base, smaller)
+    if re.match(r"all [0-9]+ elements placed were removed", text):
+        return ("meshquilt: %s every element placed on %s met another or went inside it: %s"
+                % (at, base, smaller))
+    return text
 
 
 def info_job(engine, result, swatch, base, elements_csv, scale):

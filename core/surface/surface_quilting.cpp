@@ -52,6 +52,11 @@ void validate_base(const TriMesh& base) {
     MQ_CHECK(a != b && b != c && a != c, InvalidInput, "base face ", f,
              " repeats a vertex (a degenerate face); remove it from the base mesh");
   }
+  // Faces of no area (vertices on a line) leave no surface to grow on; the first step to
+  // notice was the direction field's solve, failing in its own words (issue 26).
+  const double area = face_areas(base.V, base.F).sum();
+  MQ_CHECK(area > 1e-12 * extent.squaredNorm(), InvalidInput,
+           "the base mesh has no area (its faces are flat to lines or points)");
 }
 
 // The mesh without faces that repeat an earlier one (the same three vertices in the same

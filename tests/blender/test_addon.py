@@ -48,6 +48,10 @@ def reported(operator, **properties):
 
 
 def test(fn):
+    # MESHQUILT_BLENDER_TESTS=word: only the tests whose names contain it (and the install).
+    only = os.environ.get("MESHQUILT_BLENDER_TESTS", "")
+    if only and only not in fn.__name__ and fn.__name__ != "test_installs_and_registers":
+        return fn
     start = time.monotonic()
     try:
         fn()
@@ -317,6 +321,68 @@ def test_engine_error_is_reported():
 
 
 @test
+def test_refusals_the_panel_can_cause_are_in_the_artists_words():
+    import meshquilt
+
+    def refused(settings):
+        run = meshquilt.Run(bpy.context, settings)
+        try:
+            start = time.monotonic()
+            while run.step() == "running":
+                check(time.monotonic() - start < 60, "no answer within 60 s")
+                time.sleep(0.05)
+            check(run.state == "failed", "state %s" % run.state)
+            return run.error
+        finally:
+            run.cleanup()
+
+    scene = new_scene()
+    s = scene.meshquilt
+    bpy.ops.mesh.primitive_plane_add()
+    line = bpy.context.active_object
+    line.name = "Flattened"
+    for i, v in enumerate(line.data.vertices):
+        v.co = (float(i), 0.0, 0.0)  # every face flat to a line
+    s.base, s.sample, s.scale = line, "chainmail", 0.3
+    message = refused(s)
+    check("Flattened has no area" in message and "pick a base" in message, message)
+    # A flat swatch object (a plane has no thickness).
+    bpy.ops.mesh.primitive_plane_add()
+    flat = bpy.context.active_object
+    flat.name = "FlatSwatch"
+    s.base, s.swatch_source, s.swatch = small_sphere(), "OBJECT", flat
+    message = refused(s)
+    check("FlatSwatch is flat" in message and "Solidify" in message, message)
+    # On a strip narrower than a ring none fits: the fix is a smaller Scale, in the panel's
+    # word, not the engine's --scale.
+    s.swatch_source = "SAMPLE"
+    bpy.ops.mesh.primitive_plane_add()
+    strip = bpy.context.active_object
+    strip.name = "Strip"
+    for v in strip.data.vertices:
+        v.co.y *= 0.05
+    s.base, s.scale = strip, 0.5
+    message = refused(s)
+    check("fits on Strip" in message and "lower Scale" in message and "--" not in message,
+          message)
+    # Ivy as large as a tetrahedron leaves it mostly bare (the engine's own refusal).
+    from meshquilt import engine
+    tet = os.path.join(WORK, "tet.obj")
+    with open(tet, "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
+    swatch = os.path.join(WORK, "ivy_for_tet.obj")  # the command line's default seed
+    job = engine.Job(ENGINE, ["swatch", "ivy", "-o", swatch, "--quiet"], progress=False)
+    check(job.wait(60) == "done", "no swatch: %s" % job.error)
+    job = engine.Job(ENGINE, ["surface", "--base", tet, "--swatch", swatch, "--scale", "0.9",
+                              "-o", os.path.join(WORK, "tet_out.ply")])
+    check(job.wait(120) == "failed" and "covered" in job.error, "%s: %s" % (job.state, job.error))
+    message = engine.artist_message(job.error, 0.9, 8.0, "Tetrahedron")
+    import re
+    check(re.search(r"only [0-9]+% of Tetrahedron would be covered", message) and
+          "lower Scale" in message and "--" not in message, message)
+
+
+@test
 def test_a_killed_or_crashed_engine_is_reported_in_words():
     """An engine ended by a signal (the kernel's out-of-memory killer sends SIGKILL) is reported
     as killed, with what to change, not as "exited with code -9" (issue 26)."""
@@ -422,6 +488,13 @@ def test_memory_limit_refuses_the_job_in_the_artists_words():
         check("limit of 20,000,000 faces" in faces and "lower Detail" in faces and
               "Memory limit" not in faces,
               "reported: %s" % faces)
+        # Sized by Element size: that is the setting named.
+        sized = meshquilt.engine.artist_message(
+            "meshquilt surface: error: at --element-size 0.05 the texture would have about "
+            "2.5e+07 faces, more than the limit of 2e+07 (--max-faces, or --max-memory at 400 "
+            "bytes a face); use a larger --element-size", 0.01, 12.0, element_size=0.05)
+        check("at Element size 0.05" in sized and "raise Element size" in sized and
+              "Scale" not in sized, "reported: %s" % sized)
     finally:
         enable_addon()
         prefs.max_memory = meshquilt._DEFAULT_LIMIT_GIB

@@ -148,6 +148,10 @@ TEST_F(Reliability, NoGeometryIsAnErrorNotAnEmptyFile) {
   expect_refused("surface --base degenerate.off --swatch sw.obj -o o.obj", "repeats a vertex");
   spit(dir_ + "/point.off", "OFF\n3 1 0\n1 1 1\n1 1 1\n1 1 1\n3 0 1 2\n");
   expect_refused("surface --base point.off --swatch sw.obj -o o.obj", "zero size");
+  // Distinct vertices on a line (a mesh flattened to an edge): no area, said so, not the
+  // direction field's failed solve.
+  spit(dir_ + "/line.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n2 0 0\n3 0 0\n3 0 1 2\n3 1 3 2\n");
+  expect_refused("surface --base line.off --swatch sw.obj -o o.obj", "has no area");
   expect_refused("surface --base grid.off --swatch sw.obj --scale 10 -o o.obj --quiet",
                  "nothing written");
 }
