@@ -175,7 +175,10 @@ def build_mesh(bpy, name, result, material_for):
     me.loops.foreach_set("vertex_index", result.F.ravel())
     me.polygons.add(nf)
     me.polygons.foreach_set("loop_start", np.arange(0, 3 * nf, 3, dtype=np.int32))
-    me.polygons.foreach_set("loop_total", np.full(nf, 3, dtype=np.int32))
+    # MeshPolygon.loop_total is read-only from Blender 4.0 (a face's size follows from the next
+    # face's loop_start); before 4.0 it must be set.
+    if bpy.app.version < (4, 0, 0):
+        me.polygons.foreach_set("loop_total", np.full(nf, 3, dtype=np.int32))
     for name_k in result.kinds:
         me.materials.append(material_for(name_k, result.looks.get(name_k)))
     me.polygons.foreach_set("material_index", result.face_kind.astype(np.int32))
@@ -185,12 +188,13 @@ def build_mesh(bpy, name, result, material_for):
     ids.data.foreach_set("value", result.face_element.astype(np.int32))
     kinds = me.attributes.new("kind", "INT", "FACE")
     kinds.data.foreach_set("value", result.face_kind.astype(np.int32))
-    # Mesh.use_auto_smooth and auto_smooth_angle were removed in Blender 4.1 (sharp edges by
-    # angle became the "Smooth by Angle" modifier); checked with bpy.app.version, so 3.4 to
-    # 4.0 keep the 60 degrees and 4.1 and later only lose that setting.
+    # Mesh.use_auto_smooth and auto_smooth_angle were removed in Blender 4.1: there, edges over
+    # 60 degrees are marked sharp once instead (Mesh.set_sharp_from_angle, new in 4.1).
     if bpy.app.version < (4, 1, 0):
         me.use_auto_smooth = True
         me.auto_smooth_angle = math.radians(60)
+    elif hasattr(me, "set_sharp_from_angle"):
+        me.set_sharp_from_angle(angle=math.radians(60))
     return me
 
 

@@ -1093,6 +1093,65 @@ def test_run_after_run_replaces_the_result_unless_earlier_ones_are_kept():
 
 
 @test
+def test_results_are_built_with_the_mesh_apis_of_blender_4():
+    # What 4.x changed in what build_mesh uses (checked against the 4.0-4.3 API references):
+    # MeshPolygon.loop_total read-only from 4.0 (sizes follow from loop_start), and
+    # Mesh.use_auto_smooth / auto_smooth_angle removed in 4.1, where Mesh.set_sharp_from_angle
+    # marks the sharp edges instead. A stand-in for those APIs over this Blender's mesh.
+    import types
+    from meshquilt import exchange, material_for
+    sharp = []
+
+    class Polygons:
+        def __init__(self, real):
+            self.real = real
+
+        def foreach_set(self, name, values):
+            check(name != "loop_total", "loop_total set: read-only in Blender 4")
+            self.real.foreach_set(name, values)
+            if name == "loop_start":  # as 4.x derives the sizes
+                sizes = np.diff(np.append(values, 3 * len(values)))
+                self.real.foreach_set("loop_total", sizes.astype(np.int32))
+
+        def __getattr__(self, name):
+            return getattr(self.real, name)
+
+    class Mesh:
+        def __init__(self, real):
+            object.__setattr__(self, "real", real)
+
+        def __getattr__(self, name):
+            check(name not in ("use_auto_smooth", "auto_smooth_angle"), name + " read")
+            return Polygons(self.real.polygons) if name == "polygons" else \
+                getattr(self.real, name)
+
+        def __setattr__(self, name, value):
+            check(name not in ("use_auto_smooth", "auto_smooth_angle"), name + " set")
+            setattr(self.real, name, value)
+
+        def set_sharp_from_angle(self, angle):
+            sharp.append(angle)
+
+    made = []
+
+    def new_mesh(name):
+        made.append(bpy.data.meshes.new(name))
+        return Mesh(made[-1])
+
+    fake = types.SimpleNamespace(
+        app=types.SimpleNamespace(version=(4, 2, 0)),
+        data=types.SimpleNamespace(meshes=types.SimpleNamespace(new=new_mesh)))
+    result = exchange.read_ply(small_chainmail_path())
+    me = exchange.build_mesh(fake, "mail4", result, material_for)
+    real = made[0]
+    check(real.validate() is False, "the mesh built the 4.x way is invalid")
+    check(len(real.polygons) == len(result.F) and all(p.loop_total == 3 for p in real.polygons),
+          "faces %d of %d" % (len(real.polygons), len(result.F)))
+    check(sharp == [math.radians(60)], "sharp edges by angle: %s" % sharp)
+    check(me.real is real, "not the mesh made")
+
+
+@test
 def test_a_mesh_goes_to_the_engine_the_same_whatever_its_face_order():
     # The same quads (each with its own material index) in two polygon orders: the triangles
     # sent to the engine, and their materials, come out identical (Blender's loop triangles of
