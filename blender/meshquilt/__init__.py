@@ -96,6 +96,10 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Minimise distortion", default=True,
         description="Minimise the shell map's stretch (slower, less distorted elements)")
     seed: bpy.props.IntProperty(name="Seed", default=1, min=0)
+    mask_group: bpy.props.StringProperty(
+        name="Mask", default="",
+        description="A vertex group of the base: texture only where its weight is 0.5 or more, "
+        "whole elements kept at the border (empty: the whole base)")
     keep_results: bpy.props.BoolProperty(
         name="Keep earlier results", default=False,
         description="Run adds its result beside the base's earlier one instead of replacing "
@@ -115,8 +119,8 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
 
 def estimate_key(context, settings):
     """The settings an estimate depends on, as a string cheap enough for draw(): the base (its
-    mesh's size, modifiers and placement), the swatch, scale, seed, guidance, detail and the
-    limit."""
+    mesh's size, modifiers and placement), the swatch, scale, seed, guidance, detail, mask and
+    the limit."""
     base = settings.base
     if base is None or base.type != "MESH":
         return ""
@@ -129,7 +133,7 @@ def estimate_key(context, settings):
     else:
         parts += ["sample", settings.sample]
     parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed,
-              settings.stretch, settings.guidance, settings.detail]
+              settings.stretch, settings.guidance, settings.detail, settings.mask_group]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -320,6 +324,10 @@ class Run:
         elif settings.guidance == "ATTRIBUTE":
             field_file = os.path.join(self.dir, "field.txt")
             self._export_field(depsgraph, base, settings.guide_attribute, field_file, len(V))
+        mask_file = None
+        if settings.mask_group:
+            mask_file = os.path.join(self.dir, "mask.txt")
+            self._export_mask(depsgraph, base, settings.mask_group, mask_file, len(V))
         self.jobs = []
         self.material_names = {}  # the engine's kind name -> the swatch's material name
         self.swatch_name = settings.swatch.name if settings.swatch_source == "OBJECT" else \
@@ -338,7 +346,7 @@ class Run:
         self.elements_path = os.path.join(self.dir, "elements.csv")
         self.options = dict(seed=settings.seed, stretch=settings.stretch, field=field,
                             field_file=field_file, max_memory=self.max_memory,
-                            element_size=self.element_size, detail=self.detail)
+                            element_size=self.element_size, detail=self.detail, mask=mask_file)
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.result_path, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
@@ -394,6 +402,35 @@ class Run:
             raise engine.EngineError("the guidance attribute has %d values for %d vertices"
                                      % (len(vectors), count))
         np.savetxt(path, vectors, fmt="%.9g")
+
+    @staticmethod
+    def _export_mask(depsgraph, obj, name, path, count):
+        """The weights of the vertex group `name` of the evaluated base, one per exported
+        vertex (0 where a vertex is not in the group), as the engine's --mask file."""
+        group = obj.vertex_groups.get(name)
+        if group is None:
+            raise engine.EngineError("%s has no vertex group named '%s' (the Mask)"
+                                     % (obj.name, name))
+        evaluated = obj.evaluated_get(depsgraph)
+        me = evaluated.to_mesh()
+        try:
+            weights = np.zeros(len(me.vertices))
+            for v in me.vertices:
+                for g in v.groups:
+                    if g.group == group.index:
+                        weights[v.index] = g.weight
+                        break
+        finally:
+            evaluated.to_mesh_clear()
+        if len(weights) != count:
+            raise engine.EngineError("the Mask has %d weights for %d vertices"
+                                     % (len(weights), count))
+        if not (weights >= 0.5).any():
+            raise engine.EngineError(
+                "the Mask '%s' sets no vertex of %s (no weight of 0.5 or more): assign vertices "
+                "to it with a weight of 0.5 or more, or clear Mask" % (name, obj.name))
+        np.savetxt(path, np.clip(weights, 0.0, 1.0), fmt="%.6g",
+                   header="meshquilt mask: vertex group '%s' of %s" % (name, obj.name))
 
     def step(self):
         """Advances the run; returns its state ("running", "done", "failed", "cancelled")."""
@@ -1021,6 +1058,8 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             row.prop(s, "guide_axis", text="")
         elif s.guidance == "ATTRIBUTE":
             layout.prop(s, "guide_attribute")
+        if s.base is not None and s.base.type == "MESH":
+            layout.prop_search(s, "mask_group", s.base, "vertex_groups")
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
         layout.prop(s, "keep_results")

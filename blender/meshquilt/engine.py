@@ -279,7 +279,7 @@ def swatch_job(engine, kind, output, seed=1):
 
 def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
                  field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None,
-                 element_size=0.0, detail=1.0):
+                 element_size=0.0, detail=1.0, mask=None):
     """The arguments of a surface job (surface_job; estimate with the same settings); an
     element_size > 0 (the swatch's longer side in the base's units) replaces the scale; a
     detail below 1 keeps that share of each swatch element's faces (the same layout)."""
@@ -301,6 +301,8 @@ def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
         args += ["--field"] + [repr(float(c)) for c in field]
     if field_file:
         args += ["--field-file", field_file]
+    if mask:
+        args += ["--mask", mask]
     return args
 
 
@@ -309,7 +311,8 @@ def surface_job(engine, base, swatch, output, scale, **options):
     or `field_file` a file of one vector per base vertex (at most one of them); `save_quilt`
     also saves the result over the base (.mqq) for embed_job; `max_memory` (GiB) refuses a
     larger job before any work; `stats` writes the run's figures as JSON; `detail` in (0, 1]
-    keeps that share of each swatch element's faces."""
+    keeps that share of each swatch element's faces; `mask` a file of one weight per base
+    vertex (the texture only where it is 0.5 or more)."""
     return Job(engine, surface_args(base, swatch, output, scale, **options),
                detail=options.get("detail", 1.0))
 

@@ -107,6 +107,7 @@ class FakeLayout:
         return self
 
     column = box = row
+    prop_search = prop
 
 
 def drawn_panel():
@@ -1090,6 +1091,57 @@ def test_run_after_run_replaces_the_result_unless_earlier_ones_are_kept():
     low = meshquilt.preview_share(0.1, meshquilt.SAMPLE_ELEMENTS["chainmail"][0])
     check(low < 0.1 and low in details, "preview detail %g, progress at %s" % (low, details))
 
+
+
+@test
+def test_a_vertex_group_masks_the_texture():
+    scene = new_scene()
+    s = scene.meshquilt
+    base = small_sphere("Masked")
+    # The top cap in a group, through a Subdivision modifier (the evaluated mesh's weights).
+    group = base.vertex_groups.new(name="Top")
+    group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
+    base.modifiers.new("Subdivision", "SUBSURF").levels = 1
+    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
+    import meshquilt
+
+    def elements():
+        obj = base.meshquilt.result
+        me = obj.data
+        centres = np.empty(3 * len(me.polygons))
+        me.polygons.foreach_get("center", centres)
+        ids = face_ids(obj)
+        centres = centres.reshape(-1, 3)
+        n = int(ids.max()) + 1
+        z = np.bincount(ids, centres[:, 2], n) / np.maximum(np.bincount(ids, minlength=n), 1)
+        return z[np.bincount(ids, minlength=n) > 0]
+
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "unmasked run did not finish")
+    everywhere = elements()
+    s.mask_group = "Top"
+    check("op:meshquilt.run" in drawn_panel(), "panel: %s" % drawn_panel())
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "masked run did not finish")
+    masked = elements()
+    ring = 0.25 * 2 * math.sqrt(3) / 3  # the 3 x 3 sample's side at Scale 0.25, over 3
+    # Whole elements kept by where most of their vertices lie: none beyond about one ring
+    # below the group's border (z 0.2, pulled in a little by the subdivision).
+    check(masked.min() > 0.1 - ring, "an element at z %.2f (ring %.2f)" % (masked.min(), ring))
+    # The cap above z 0.2 is 40% of a sphere's area.
+    share = len(masked) / len(everywhere)
+    print("[blender]   mask: %d of %d elements, lowest at z %.2f (ring %.2f)"
+          % (len(masked), len(everywhere), masked.min(), ring), flush=True)
+    check(0.3 < share < 0.6, "%d of %d elements kept" % (len(masked), len(everywhere)))
+    check(np.sum(everywhere < -0.5) > 10, "the unmasked run did not cover the bottom")
+    # A missing group and a group that sets nothing: said before any work, in the panel's terms.
+    s.mask_group = "Nope"
+    message = reported(bpy.ops.meshquilt.run)
+    check("no vertex group named 'Nope'" in message, message)
+    weak = base.vertex_groups.new(name="Weak")
+    weak.add([0, 1, 2], 0.3, "REPLACE")
+    s.mask_group = "Weak"
+    message = reported(bpy.ops.meshquilt.run)
+    check("sets no vertex" in message and "clear Mask" in message, message)
+    s.mask_group = ""
 
 
 @test
