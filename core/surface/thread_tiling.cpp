@@ -109,15 +109,16 @@ std::vector<int> half_edge_order(const ThreadPiece& p, int loop) {
   return r;
 }
 
-// Cuts one period of thread element e, between planes orthogonal to the lattice vector along
-// it. False when e is not such a thread (see thread_tiling).
-bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& symmetry,
-               const Eigen::Matrix2d& basis, double tol, ThreadPiece& out) {
-  const Element& e = swatch.elements[static_cast<size_t>(index)];
-  const MatrixX3d& V = e.V;
-  const MatrixX3i& F = e.F;
-  const FootprintAxis axis = footprint_axis(V);
-  const double margin = std::max(axis.across, tol);
+// The shortest lattice vector along a thread (its footprint's axis) that maps every vertex
+// with room for it onto another, and the vertices' positions t along it, lo to hi.
+struct ThreadPeriod {
+  Vector2d period = Vector2d::Zero();
+  std::vector<double> t;  // #V(e), along period
+  double lo = 0, hi = 0;
+};
+
+bool find_thread_period(const MatrixX3d& V, const FootprintAxis& axis, double margin,
+                        const Eigen::Matrix2d& basis, double tol, ThreadPeriod& out) {
   // Lattice vectors along the thread, shortest first.
   const Vector2d a = basis.col(0), b = basis.col(1);
   const double row = std::abs(basis.determinant()) / std::max(a.norm(), b.norm());
@@ -136,11 +137,12 @@ bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& sy
     return std::make_pair(p.second.x(), p.second.y()) < std::make_pair(q.second.x(), q.second.y());
   });
   const EndGrid grid(V, std::max(tol, 1e-300));
-  Vector2d period = Vector2d::Zero();
-  double lo = 0, hi = 0;
-  std::vector<double> t(static_cast<size_t>(V.rows()));
+  std::vector<double>& t = out.t;
+  t.assign(static_cast<size_t>(V.rows()), 0.0);
   for (const auto& [len, L] : candidates) {
     const Vector2d d = L / len;
+    double& lo = out.lo;
+    double& hi = out.hi;
     lo = std::numeric_limits<double>::infinity();
     hi = -lo;
     for (Eigen::Index v = 0; v < V.rows(); ++v) {
@@ -159,179 +161,240 @@ bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& sy
       periodic = grid.nearest(q, tol) >= 0;
     }
     if (periodic && tested > 0) {
-      period = L;
-      break;
+      out.period = L;
+      return true;
     }
   }
-  if (period.squaredNorm() == 0) return false;
-  const double len = period.norm();
+  return false;
+}
 
-  // A cut at c: the faces whose centroids lie between c and c + len, when their boundary is
-  // two simple loops a period apart vertex for vertex.
-  std::vector<double> tf(static_cast<size_t>(F.rows()));
-  for (Eigen::Index f = 0; f < F.rows(); ++f) tf[f] = (t[F(f, 0)] + t[F(f, 1)] + t[F(f, 2)]) / 3;
-  const auto try_cut = [&](double c0, ThreadPiece& out) {
-    const double c1 = c0 + len;
-    std::vector<int> local(static_cast<size_t>(V.rows()), -1), global;
-    std::vector<Eigen::Vector3i> faces;
-    for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      if (!(tf[f] > c0 && tf[f] < c1)) continue;
-      Eigen::Vector3i g;
-      for (int k = 0; k < 3; ++k) {
-        int& l = local[static_cast<size_t>(F(f, k))];
-        if (l < 0) {
-          l = static_cast<int>(global.size());
-          global.push_back(F(f, k));
-        }
-        g(k) = l;
+// The faces of F whose centroids (tf, along the period) lie strictly between c0 and c1, in
+// their own vertex numbering: global[l] is the element vertex of piece vertex l.
+void faces_between(const MatrixX3i& F, const std::vector<double>& tf, double c0, double c1,
+                   Eigen::Index num_vertices, std::vector<Eigen::Vector3i>& faces,
+                   std::vector<int>& global) {
+  std::vector<int> local(static_cast<size_t>(num_vertices), -1);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (!(tf[f] > c0 && tf[f] < c1)) continue;
+    Eigen::Vector3i g;
+    for (int k = 0; k < 3; ++k) {
+      int& l = local[static_cast<size_t>(F(f, k))];
+      if (l < 0) {
+        l = static_cast<int>(global.size());
+        global.push_back(F(f, k));
       }
-      faces.push_back(g);
+      g(k) = l;
     }
-    const int nv = static_cast<int>(global.size());
-    if (faces.empty()) return false;
-    // Boundary half-edges (an edge used once), as the faces run.
-    std::unordered_map<long long, int> uses;
-    const auto edge_key = [nv](int p, int q) {
-      return static_cast<long long>(std::min(p, q)) * nv + std::max(p, q);
-    };
-    for (const Eigen::Vector3i& g : faces)
-      for (int k = 0; k < 3; ++k) ++uses[edge_key(g(k), g((k + 1) % 3))];
-    std::vector<int> next(static_cast<size_t>(nv), -1);
-    for (const Eigen::Vector3i& g : faces)
-      for (int k = 0; k < 3; ++k) {
-        const int p = g(k), q = g((k + 1) % 3);
-        if (uses[edge_key(p, q)] != 1) continue;
-        if (next[p] >= 0) return false;  // two boundary edges leave p: no simple loop
-        next[p] = q;
-      }
-    std::vector<std::vector<int>> loops;
-    std::vector<char> seen(static_cast<size_t>(nv), 0);
-    for (int v = 0; v < nv; ++v) {
-      if (next[v] < 0 || seen[v]) continue;
-      std::vector<int> loop;
-      int w = v;
-      while (w >= 0 && !seen[w]) {
-        seen[w] = 1;
-        loop.push_back(w);
-        w = next[w];
-      }
-      if (w != v) return false;  // open chain
-      loops.push_back(std::move(loop));
-    }
-    if (loops.size() != 2 || loops[0].size() != loops[1].size() || loops[0].size() < 3)
-      return false;
-    const auto mean_t = [&](const std::vector<int>& loop) {
-      double m = 0;
-      for (const int v : loop) m += t[global[v]];
-      return m / static_cast<double>(loop.size());
-    };
-    const int s = mean_t(loops[0]) < mean_t(loops[1]) ? 0 : 1;
-    std::vector<int> start = loops[static_cast<size_t>(s)];
-    const std::vector<int>& end_loop = loops[static_cast<size_t>(1 - s)];
-    std::rotate(start.begin(), std::min_element(start.begin(), start.end()), start.end());
-    // end[i]: the end loop's vertex one period from start[i].
-    const size_t n = start.size();
-    std::vector<int> end(n, -1);
-    std::vector<char> taken(static_cast<size_t>(nv), 0);
-    for (size_t i = 0; i < n; ++i) {
-      const Vector3d q = V.row(global[start[i]]).transpose() + Vector3d(period.x(), period.y(), 0);
-      for (const int w : end_loop)
-        if ((V.row(global[w]).transpose() - q).norm() <= tol) {
-          if (end[i] >= 0 || taken[w]) return false;
-          end[i] = w;
-        }
-      if (end[i] < 0) return false;
-      taken[end[i]] = 1;
-    }
-    // The end loop runs the other way round: end[i + 1] -> end[i] are its boundary edges.
-    for (size_t i = 0; i < n; ++i)
-      if (next[end[(i + 1) % n]] != end[i]) return false;
-    out = ThreadPiece();
-    out.V.resize(nv + 2, 3);
-    for (int v = 0; v < nv; ++v) out.V.row(v) = V.row(global[v]);
-    out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
-    for (size_t f = 0; f < faces.size(); ++f) out.F.row(static_cast<Eigen::Index>(f)) = faces[f];
-    Vector3d cs = Vector3d::Zero(), ce = Vector3d::Zero();
-    for (size_t i = 0; i < n; ++i) {
-      cs += out.V.row(start[i]).transpose();
-      ce += out.V.row(end[i]).transpose();
-    }
-    out.start_centre = nv;
-    out.end_centre = nv + 1;
-    out.V.row(nv) = (cs / static_cast<double>(n)).transpose();
-    out.V.row(nv + 1) = (ce / static_cast<double>(n)).transpose();
-    out.start = std::move(start);
-    out.end = std::move(end);
-    out.kind = e.kind;
-    out.period = period;
-    out.centre = out.V.topRows(nv).leftCols<2>().colwise().mean().transpose();
-    out.source = index;
-    return true;
+    faces.push_back(g);
+  }
+}
+
+// The boundary of faces (over nv vertices) as simple closed loops, each in the order of its
+// half-edges (next[v]: the boundary half-edge from v). False when a vertex has two boundary
+// edges leaving it or a chain does not close.
+bool simple_boundary_loops(const std::vector<Eigen::Vector3i>& faces, int nv,
+                           std::vector<int>& next, std::vector<std::vector<int>>& loops) {
+  // Boundary half-edges (an edge used once), as the faces run.
+  std::unordered_map<long long, int> uses;
+  const auto edge_key = [nv](int p, int q) {
+    return static_cast<long long>(std::min(p, q)) * nv + std::max(p, q);
   };
-  // Candidate cuts: planes through a loop of vertices that no face straddles, here and a period
-  // on (a swept tube's ring where the tube runs level; a sloping ring leans off such a plane).
-  const auto straddled = [&](double c) {
-    for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      double fmin = std::numeric_limits<double>::infinity(), fmax = -fmin;
-      for (int k = 0; k < 3; ++k) {
-        fmin = std::min(fmin, t[F(f, k)]);
-        fmax = std::max(fmax, t[F(f, k)]);
-      }
-      if (fmin < c - tol && fmax > c + tol) return true;
+  for (const Eigen::Vector3i& g : faces)
+    for (int k = 0; k < 3; ++k) ++uses[edge_key(g(k), g((k + 1) % 3))];
+  next.assign(static_cast<size_t>(nv), -1);
+  for (const Eigen::Vector3i& g : faces)
+    for (int k = 0; k < 3; ++k) {
+      const int p = g(k), q = g((k + 1) % 3);
+      if (uses[edge_key(p, q)] != 1) continue;
+      if (next[p] >= 0) return false;  // two boundary edges leave p: no simple loop
+      next[p] = q;
     }
+  std::vector<char> seen(static_cast<size_t>(nv), 0);
+  for (int v = 0; v < nv; ++v) {
+    if (next[v] < 0 || seen[v]) continue;
+    std::vector<int> loop;
+    int w = v;
+    while (w >= 0 && !seen[w]) {
+      seen[w] = 1;
+      loop.push_back(w);
+      w = next[w];
+    }
+    if (w != v) return false;  // open chain
+    loops.push_back(std::move(loop));
+  }
+  return true;
+}
+
+// end[i]: the vertex of end_loop one period from start[i] (positions V of the element, piece
+// vertices mapped to it by global), each taken once; the end loop must run the other way round
+// (end[i + 1] -> end[i] its boundary edges). False when it does not pair so.
+bool pair_end_loop(const MatrixX3d& V, const std::vector<int>& global,
+                   const std::vector<int>& start, const std::vector<int>& end_loop,
+                   const std::vector<int>& next, const Vector2d& period, double tol,
+                   std::vector<int>& end) {
+  const size_t n = start.size();
+  end.assign(n, -1);
+  std::vector<char> taken(global.size(), 0);
+  for (size_t i = 0; i < n; ++i) {
+    const Vector3d q = V.row(global[start[i]]).transpose() + Vector3d(period.x(), period.y(), 0);
+    for (const int w : end_loop)
+      if ((V.row(global[w]).transpose() - q).norm() <= tol) {
+        if (end[i] >= 0 || taken[w]) return false;
+        end[i] = w;
+      }
+    if (end[i] < 0) return false;
+    taken[end[i]] = 1;
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (next[end[(i + 1) % n]] != end[i]) return false;
+  return true;
+}
+
+// The piece cut at c0: the faces whose centroids lie between c0 and c0 + one period, when their
+// boundary is two simple loops a period apart vertex for vertex.
+bool cut_at(const Element& e, int index, const ThreadPeriod& p, const std::vector<double>& tf,
+            double c0, double tol, ThreadPiece& out) {
+  const MatrixX3d& V = e.V;
+  const std::vector<double>& t = p.t;
+  const double len = p.period.norm();
+  std::vector<int> global;
+  std::vector<Eigen::Vector3i> faces;
+  faces_between(e.F, tf, c0, c0 + len, V.rows(), faces, global);
+  const int nv = static_cast<int>(global.size());
+  if (faces.empty()) return false;
+  std::vector<int> next;
+  std::vector<std::vector<int>> loops;
+  if (!simple_boundary_loops(faces, nv, next, loops)) return false;
+  if (loops.size() != 2 || loops[0].size() != loops[1].size() || loops[0].size() < 3) return false;
+  const auto mean_t = [&](const std::vector<int>& loop) {
+    double m = 0;
+    for (const int v : loop) m += t[global[v]];
+    return m / static_cast<double>(loop.size());
+  };
+  const int s = mean_t(loops[0]) < mean_t(loops[1]) ? 0 : 1;
+  std::vector<int> start = loops[static_cast<size_t>(s)];
+  std::rotate(start.begin(), std::min_element(start.begin(), start.end()), start.end());
+  std::vector<int> end;
+  if (!pair_end_loop(V, global, start, loops[static_cast<size_t>(1 - s)], next, p.period, tol, end))
     return false;
-  };
+  const size_t n = start.size();
+  out = ThreadPiece();
+  out.V.resize(nv + 2, 3);
+  for (int v = 0; v < nv; ++v) out.V.row(v) = V.row(global[v]);
+  out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) out.F.row(static_cast<Eigen::Index>(f)) = faces[f];
+  Vector3d cs = Vector3d::Zero(), ce = Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    cs += out.V.row(start[i]).transpose();
+    ce += out.V.row(end[i]).transpose();
+  }
+  out.start_centre = nv;
+  out.end_centre = nv + 1;
+  out.V.row(nv) = (cs / static_cast<double>(n)).transpose();
+  out.V.row(nv + 1) = (ce / static_cast<double>(n)).transpose();
+  out.start = std::move(start);
+  out.end = std::move(end);
+  out.kind = e.kind;
+  out.period = p.period;
+  out.centre = out.V.topRows(nv).leftCols<2>().colwise().mean().transpose();
+  out.source = index;
+  return true;
+}
+
+// Whether a face of F (positions t along the period) straddles the plane at c.
+bool straddled(const MatrixX3i& F, const std::vector<double>& t, double c, double tol) {
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    double fmin = std::numeric_limits<double>::infinity(), fmax = -fmin;
+    for (int k = 0; k < 3; ++k) {
+      fmin = std::min(fmin, t[F(f, k)]);
+      fmax = std::max(fmax, t[F(f, k)]);
+    }
+    if (fmin < c - tol && fmax > c + tol) return true;
+  }
+  return false;
+}
+
+// Candidate cuts: planes through a loop of vertices, here and a period on (a swept tube's ring
+// where the tube runs level; a sloping ring leans off such a plane): the vertices' distinct
+// positions with room for a period after them.
+std::vector<double> cut_levels(const ThreadPeriod& p, double margin, double tol) {
+  const double len = p.period.norm();
   std::vector<double> levels;
-  for (Eigen::Index v = 0; v < V.rows(); ++v)
-    if (t[v] >= lo + margin && t[v] <= hi - margin - len) levels.push_back(t[v]);
+  for (const double tv : p.t)
+    if (tv >= p.lo + margin && tv <= p.hi - margin - len) levels.push_back(tv);
   std::sort(levels.begin(), levels.end());
   std::vector<double> cuts;
   for (const double c : levels)
     if (cuts.empty() || c > cuts.back() + tol) cuts.push_back(c);
-  // Whether the half turn maps the piece onto a lattice copy of itself. Where the layout's
-  // transition across a cut is a half turn, only then do the pieces on its two sides meet end
-  // to end (a plain weave: at its crossings, not between them).
-  const auto half_turn_consistent = [&](const ThreadPiece& p) {
-    if (!symmetry.half_turn) return true;
-    const Eigen::Index nv = p.V.rows() - 2;
-    const MatrixX3d tube = p.V.topRows(nv);
-    const EndGrid grid(tube, std::max(tol, 1e-300));
-    const auto image = [&](Eigen::Index v) {
-      return Vector3d(symmetry.c.x() - p.V(v, 0), symmetry.c.y() - p.V(v, 1), p.V(v, 2));
-    };
-    const Eigen::Matrix2d inv = basis.inverse();
-    for (Eigen::Index w = 0; w < nv; ++w) {
-      const Vector3d shift = image(0) - tube.row(w).transpose();
-      const Vector2d k = inv * shift.head<2>();
-      const Vector2d L = basis * Vector2d(std::round(k.x()), std::round(k.y()));
-      if ((L - shift.head<2>()).norm() > tol || std::abs(shift.z()) > tol) continue;
-      bool all = true;
-      for (Eigen::Index v = 0; v < nv && all; ++v)
-        all = grid.nearest(image(v) - Vector3d(L.x(), L.y(), 0), tol) >= 0;
-      if (all) return true;
-    }
-    return false;
+  return cuts;
+}
+
+// Whether the half turn maps the piece onto a lattice copy of itself. Where the layout's
+// transition across a cut is a half turn, only then do the pieces on its two sides meet end to
+// end (a plain weave: at its crossings, not between them).
+bool half_turn_consistent(const ThreadPiece& p, const SwatchSymmetry& symmetry,
+                          const Eigen::Matrix2d& basis, double tol) {
+  if (!symmetry.half_turn) return true;
+  const Eigen::Index nv = p.V.rows() - 2;
+  const MatrixX3d tube = p.V.topRows(nv);
+  const EndGrid grid(tube, std::max(tol, 1e-300));
+  const auto image = [&](Eigen::Index v) {
+    return Vector3d(symmetry.c.x() - p.V(v, 0), symmetry.c.y() - p.V(v, 1), p.V(v, 2));
   };
+  const Eigen::Matrix2d inv = basis.inverse();
+  for (Eigen::Index w = 0; w < nv; ++w) {
+    const Vector3d shift = image(0) - tube.row(w).transpose();
+    const Vector2d k = inv * shift.head<2>();
+    const Vector2d L = basis * Vector2d(std::round(k.x()), std::round(k.y()));
+    if ((L - shift.head<2>()).norm() > tol || std::abs(shift.z()) > tol) continue;
+    bool all = true;
+    for (Eigen::Index v = 0; v < nv && all; ++v)
+      all = grid.nearest(image(v) - Vector3d(L.x(), L.y(), 0), tol) >= 0;
+    if (all) return true;
+  }
+  return false;
+}
+
+// The squared distance from p to the nearest vertex of the swatch's other elements.
+double clearance_to_others(const PreparedSwatch& swatch, int index, const Vector3d& p) {
+  double clearance = std::numeric_limits<double>::infinity();
+  for (size_t o = 0; o < swatch.elements.size(); ++o) {
+    if (static_cast<int>(o) == index) continue;
+    const MatrixX3d& W = swatch.elements[o].V;
+    for (Eigen::Index w = 0; w < W.rows(); ++w)
+      clearance = std::min(clearance, (W.row(w).transpose() - p).squaredNorm());
+  }
+  return clearance;
+}
+
+// Cuts one period of thread element e, between planes orthogonal to the lattice vector along
+// it. False when e is not such a thread (see thread_tiling).
+bool cut_piece(const PreparedSwatch& swatch, int index, const SwatchSymmetry& symmetry,
+               const Eigen::Matrix2d& basis, double tol, ThreadPiece& out) {
+  const Element& e = swatch.elements[static_cast<size_t>(index)];
+  const MatrixX3i& F = e.F;
+  const FootprintAxis axis = footprint_axis(e.V);
+  const double margin = std::max(axis.across, tol);
+  ThreadPeriod p;
+  if (!find_thread_period(e.V, axis, margin, basis, tol, p)) return false;
+  const double len = p.period.norm();
+  std::vector<double> tf(static_cast<size_t>(F.rows()));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    tf[f] = (p.t[F(f, 0)] + p.t[F(f, 1)] + p.t[F(f, 2)]) / 3;
   // Of the clean cuts, one consistent with the half turn if any is, and of those the one whose
   // loop's centre keeps farthest from the other elements: an end left there is capped where no
   // crossing thread presses on the cap (its centre, not its vertices: a coarse tube's vertices
   // miss the point where another passes closest).
   double best_clearance = -1;
   bool best_consistent = false;
-  for (const double c : cuts) {
-    if (straddled(c) || straddled(c + len)) continue;
+  for (const double c : cut_levels(p, margin, tol)) {
+    if (straddled(F, p.t, c, tol) || straddled(F, p.t, c + len, tol)) continue;
     ThreadPiece piece;
-    if (!try_cut(c, piece)) continue;
-    const bool consistent = half_turn_consistent(piece);
+    if (!cut_at(e, index, p, tf, c, tol, piece)) continue;
+    const bool consistent = half_turn_consistent(piece, symmetry, basis, tol);
     if (best_consistent && !consistent) continue;
-    const Vector3d centre = piece.V.row(piece.start_centre).transpose();
-    double clearance = std::numeric_limits<double>::infinity();
-    for (size_t o = 0; o < swatch.elements.size(); ++o) {
-      if (static_cast<int>(o) == index) continue;
-      const MatrixX3d& W = swatch.elements[o].V;
-      for (Eigen::Index w = 0; w < W.rows(); ++w)
-        clearance = std::min(clearance, (W.row(w).transpose() - centre).squaredNorm());
-    }
+    const double clearance =
+        clearance_to_others(swatch, index, piece.V.row(piece.start_centre).transpose());
     if ((consistent && !best_consistent) || clearance > best_clearance * (1 + 1e-9) + 1e-300) {
       best_clearance = clearance;
       best_consistent = consistent;
