@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <tuple>
 #include <unordered_map>
@@ -582,6 +583,194 @@ std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed
   return out;
 }
 
+namespace {
+
+// partner[2k + l]: the weld at piece k's loop l, between pieces both kept (-1: none).
+std::vector<int> weld_partners(int n, const std::vector<ThreadWeld>& welds,
+                               const std::function<bool(int)>& is_dropped) {
+  std::vector<int> partner(static_cast<size_t>(2 * n), -1);
+  for (size_t w = 0; w < welds.size(); ++w) {
+    const ThreadWeld& x = welds[w];
+    if (is_dropped(x.a) || is_dropped(x.b)) continue;
+    partner[static_cast<size_t>(2 * x.a + x.loop_a)] = static_cast<int>(w);
+    partner[static_cast<size_t>(2 * x.b + x.loop_b)] = static_cast<int>(w);
+  }
+  return partner;
+}
+
+// The pieces of thread `id` that starts at `first`: along its end loop's welds, then along its
+// start loop's, each marked in thread_of; a chain stops where it closes on itself.
+std::vector<int> thread_chain(int first, int id, const std::vector<int>& partner,
+                              const std::vector<ThreadWeld>& welds, std::vector<int>& thread_of) {
+  std::vector<int> chain{first};
+  thread_of[first] = id;
+  for (int loop = 1; loop >= 0; --loop) {
+    int k = first, l = loop;
+    while (true) {
+      const int w = partner[static_cast<size_t>(2 * k + l)];
+      if (w < 0) break;
+      const ThreadWeld& x = welds[static_cast<size_t>(w)];
+      const bool from_a = x.a == k && x.loop_a == l;
+      const int next = from_a ? x.b : x.a, next_loop = from_a ? x.loop_b : x.loop_a;
+      if (thread_of[next] >= 0) break;  // closed on itself
+      thread_of[next] = id;
+      chain.push_back(next);
+      k = next;
+      l = 1 - next_loop;
+    }
+  }
+  return chain;
+}
+
+// One thread assembled from a chain of welded pieces: its vertices (base face, barycentric
+// coordinates, height), faces and each face's piece. map[k] is the thread vertex each vertex of
+// piece k became (shared across the welds).
+class ThreadAssembly {
+ public:
+  ThreadAssembly(const std::vector<PlacedPiece>& placed, const ThreadTiling& tiling,
+                 const std::vector<ThreadWeld>& welds, const std::vector<int>& partner,
+                 std::vector<std::vector<int>>& map)
+      : placed_(placed), tiling_(tiling), welds_(welds), partner_(partner), map_(map) {}
+
+  // Piece k's faces; a loop welded to a piece already in the thread shares its vertices.
+  void add_piece(int k) {
+    const ThreadPiece& piece = piece_of(k);
+    const SurfaceElement& s = placed_[k].element;
+    std::vector<int>& mk = map_[static_cast<size_t>(k)];
+    mk.assign(static_cast<size_t>(piece.V.rows()), -1);
+    for (int l = 0; l < 2; ++l) {
+      const int w = partner_[static_cast<size_t>(2 * k + l)];
+      if (w < 0) continue;
+      const ThreadWeld& x = welds_[static_cast<size_t>(w)];
+      const bool from_a = x.a == k && x.loop_a == l;
+      const int other = from_a ? x.b : x.a, other_loop = from_a ? x.loop_b : x.loop_a;
+      if (map_[static_cast<size_t>(other)].empty() || (other == k && other_loop == l)) continue;
+      const std::vector<int> mine = half_edge_order(piece, l);
+      const std::vector<int> theirs = half_edge_order(piece_of(other), other_loop);
+      const int m = static_cast<int>(mine.size());
+      const std::vector<int>& mo = map_[static_cast<size_t>(other)];
+      for (int i = 0; i < m; ++i) {
+        const int target =
+            mo[static_cast<size_t>(theirs[static_cast<size_t>(((x.offset - i) % m + m) % m)])];
+        if (target >= 0) mk[static_cast<size_t>(mine[static_cast<size_t>(i)])] = target;
+      }
+    }
+    const int tube = static_cast<int>(piece.V.rows()) - 2;
+    for (int v = 0; v < tube; ++v)
+      if (mk[static_cast<size_t>(v)] < 0) mk[static_cast<size_t>(v)] = add_vertex(s, v);
+    for (Eigen::Index f = 0; f < piece.F.rows(); ++f) {
+      F_.emplace_back(mk[piece.F(f, 0)], mk[piece.F(f, 1)], mk[piece.F(f, 2)]);
+      faces_of_.push_back(k);
+    }
+  }
+
+  // A thread closed on itself through one piece: its last weld joins two loops already given
+  // vertices of their own; the cycle closes by merging them.
+  void close_cycle(const std::vector<int>& chain) {
+    for (const int k : chain)
+      for (int l = 0; l < 2; ++l) {
+        const int w = partner_[static_cast<size_t>(2 * k + l)];
+        if (w < 0) continue;
+        const ThreadWeld& x = welds_[static_cast<size_t>(w)];
+        if (!(x.a == k && x.loop_a == l)) continue;
+        const std::vector<int> ra = half_edge_order(piece_of(x.a), x.loop_a),
+                               rb = half_edge_order(piece_of(x.b), x.loop_b);
+        const int m = static_cast<int>(ra.size());
+        std::vector<int> remap;
+        for (int i = 0; i < m; ++i) {
+          const int va =
+              map_[static_cast<size_t>(x.a)][static_cast<size_t>(ra[static_cast<size_t>(i)])];
+          const int vb =
+              map_[static_cast<size_t>(x.b)]
+                  [static_cast<size_t>(rb[static_cast<size_t>(((x.offset - i) % m + m) % m)])];
+          if (va != vb) {
+            if (remap.empty()) remap.resize(face_.size());
+            for (size_t q = 0; q < remap.size(); ++q) remap[q] = static_cast<int>(q);
+            remap[static_cast<size_t>(std::max(va, vb))] = std::min(va, vb);
+            for (Eigen::Vector3i& g : F_)
+              for (int c = 0; c < 3; ++c) g(c) = remap[static_cast<size_t>(g(c))];
+          }
+        }
+      }
+  }
+
+  // Caps on the loops left open (a fan from the loop's centre); returns how many.
+  int cap_open_loops(const std::vector<int>& chain) {
+    int caps = 0;
+    for (const int k : chain) {
+      const ThreadPiece& piece = piece_of(k);
+      for (int l = 0; l < 2; ++l) {
+        if (partner_[static_cast<size_t>(2 * k + l)] >= 0) continue;
+        const std::vector<int> ring = half_edge_order(piece, l);
+        const std::vector<int>& mk = map_[static_cast<size_t>(k)];
+        const int c =
+            add_vertex(placed_[k].element, l == 0 ? piece.start_centre : piece.end_centre);
+        const int m = static_cast<int>(ring.size());
+        for (int i = 0; i < m; ++i) {
+          F_.emplace_back(c, mk[static_cast<size_t>(ring[static_cast<size_t>((i + 1) % m)])],
+                          mk[static_cast<size_t>(ring[static_cast<size_t>(i)])]);
+          faces_of_.push_back(k);
+        }
+        ++caps;
+      }
+    }
+    return caps;
+  }
+
+  // The thread as one element of `kind`; vertices no face uses any more (merged when a cycle
+  // closed) are dropped.
+  SurfaceElement element(int kind) const {
+    std::vector<int> used(face_.size(), -1);
+    int nv = 0;
+    for (const Eigen::Vector3i& g : F_)
+      for (int c = 0; c < 3; ++c)
+        if (used[static_cast<size_t>(g(c))] < 0) used[static_cast<size_t>(g(c))] = nv++;
+    SurfaceElement e;
+    e.kind = kind;
+    e.F.resize(static_cast<Eigen::Index>(F_.size()), 3);
+    for (size_t f = 0; f < F_.size(); ++f)
+      for (int c = 0; c < 3; ++c)
+        e.F(static_cast<Eigen::Index>(f), c) = used[static_cast<size_t>(F_[f](c))];
+    e.face.resize(static_cast<size_t>(nv));
+    e.barycentric.resize(nv, 3);
+    e.height.resize(nv);
+    for (size_t v = 0; v < face_.size(); ++v) {
+      const int u = used[v];
+      if (u < 0) continue;
+      e.face[static_cast<size_t>(u)] = face_[v];
+      e.barycentric.row(u) = bary_[v].transpose();
+      e.height(u) = height_[v];
+    }
+    return e;
+  }
+
+  std::vector<int>& faces_of() { return faces_of_; }
+
+ private:
+  const ThreadPiece& piece_of(int k) const {
+    return tiling_.pieces[static_cast<size_t>(placed_[k].piece)];
+  }
+  int add_vertex(const SurfaceElement& s, int v) {
+    face_.push_back(s.face[static_cast<size_t>(v)]);
+    bary_.push_back(s.barycentric.row(v).transpose());
+    height_.push_back(s.height(v));
+    return static_cast<int>(face_.size()) - 1;
+  }
+
+  const std::vector<PlacedPiece>& placed_;
+  const ThreadTiling& tiling_;
+  const std::vector<ThreadWeld>& welds_;
+  const std::vector<int>& partner_;
+  std::vector<std::vector<int>>& map_;
+  std::vector<int> faces_of_;
+  std::vector<Eigen::Vector3i> F_;
+  std::vector<int> face_;
+  std::vector<Vector3d> bary_;
+  std::vector<double> height_;
+};
+
+}  // namespace
+
 std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
                                          const ThreadTiling& tiling,
                                          const std::vector<ThreadWeld>& welds,
@@ -592,14 +781,7 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
   const auto is_dropped = [&](int k) {
     return !dropped.empty() && dropped[static_cast<size_t>(k)] != 0;
   };
-  // partner[2k + l]: the weld at piece k's loop l, between pieces both kept (-1: none).
-  std::vector<int> partner(static_cast<size_t>(2 * n), -1);
-  for (size_t w = 0; w < welds.size(); ++w) {
-    const ThreadWeld& x = welds[w];
-    if (is_dropped(x.a) || is_dropped(x.b)) continue;
-    partner[static_cast<size_t>(2 * x.a + x.loop_a)] = static_cast<int>(w);
-    partner[static_cast<size_t>(2 * x.b + x.loop_b)] = static_cast<int>(w);
-  }
+  const std::vector<int> partner = weld_partners(n, welds, is_dropped);
   ThreadWeldStats st;
   std::vector<SurfaceElement> out;
   if (face_piece) face_piece->clear();
@@ -610,146 +792,21 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
   for (int first = 0; first < n; ++first) {
     if (is_dropped(first) || thread_of[first] >= 0) continue;
     const int id = static_cast<int>(out.size());
-    // The chain: from `first` along its end loop's welds, then along its start loop's.
-    std::vector<int> chain{first};
-    thread_of[first] = id;
-    for (int loop = 1; loop >= 0; --loop) {
-      int k = first, l = loop;
-      while (true) {
-        const int w = partner[static_cast<size_t>(2 * k + l)];
-        if (w < 0) break;
-        const ThreadWeld& x = welds[static_cast<size_t>(w)];
-        const bool from_a = x.a == k && x.loop_a == l;
-        const int next = from_a ? x.b : x.a, next_loop = from_a ? x.loop_b : x.loop_a;
-        if (thread_of[next] >= 0) break;  // closed on itself
-        thread_of[next] = id;
-        chain.push_back(next);
-        k = next;
-        l = 1 - next_loop;
-      }
-    }
+    const std::vector<int> chain = thread_chain(first, id, partner, welds, thread_of);
     if (static_cast<int>(chain.size()) < min_pieces) {
       ++st.short_threads;
       continue;
     }
     for (const int k : chain) kept[static_cast<size_t>(k)] = 1;
-    std::vector<int> faces_of;
-    std::vector<Eigen::Vector3i> F;
-    std::vector<int> face;
-    std::vector<Vector3d> bary;
-    std::vector<double> height;
-    const auto add_vertex = [&](const SurfaceElement& s, int v) {
-      face.push_back(s.face[static_cast<size_t>(v)]);
-      bary.push_back(s.barycentric.row(v).transpose());
-      height.push_back(s.height(v));
-      return static_cast<int>(face.size()) - 1;
-    };
-    for (const int k : chain) {
-      const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(placed[k].piece)];
-      const SurfaceElement& s = placed[k].element;
-      std::vector<int>& mk = map[static_cast<size_t>(k)];
-      mk.assign(static_cast<size_t>(piece.V.rows()), -1);
-      // A loop welded to a piece already in the thread shares that piece's vertices.
-      for (int l = 0; l < 2; ++l) {
-        const int w = partner[static_cast<size_t>(2 * k + l)];
-        if (w < 0) continue;
-        const ThreadWeld& x = welds[static_cast<size_t>(w)];
-        const bool from_a = x.a == k && x.loop_a == l;
-        const int other = from_a ? x.b : x.a, other_loop = from_a ? x.loop_b : x.loop_a;
-        if (map[static_cast<size_t>(other)].empty() || (other == k && other_loop == l)) continue;
-        const std::vector<int> mine = half_edge_order(piece, l);
-        const std::vector<int> theirs =
-            half_edge_order(tiling.pieces[static_cast<size_t>(placed[other].piece)], other_loop);
-        const int m = static_cast<int>(mine.size());
-        const std::vector<int>& mo = map[static_cast<size_t>(other)];
-        for (int i = 0; i < m; ++i) {
-          const int target =
-              mo[static_cast<size_t>(theirs[static_cast<size_t>(((x.offset - i) % m + m) % m)])];
-          if (target >= 0) mk[static_cast<size_t>(mine[static_cast<size_t>(i)])] = target;
-        }
-      }
-      const int tube = static_cast<int>(piece.V.rows()) - 2;
-      for (int v = 0; v < tube; ++v)
-        if (mk[static_cast<size_t>(v)] < 0) mk[static_cast<size_t>(v)] = add_vertex(s, v);
-      for (Eigen::Index f = 0; f < piece.F.rows(); ++f) {
-        F.emplace_back(mk[piece.F(f, 0)], mk[piece.F(f, 1)], mk[piece.F(f, 2)]);
-        faces_of.push_back(k);
-      }
-    }
-    // A thread closed on itself through one piece: its last weld joins two loops already
-    // given vertices of their own; the cycle closes by merging them.
-    for (const int k : chain)
-      for (int l = 0; l < 2; ++l) {
-        const int w = partner[static_cast<size_t>(2 * k + l)];
-        if (w < 0) continue;
-        const ThreadWeld& x = welds[static_cast<size_t>(w)];
-        if (!(x.a == k && x.loop_a == l)) continue;
-        const ThreadPiece& pa = tiling.pieces[static_cast<size_t>(placed[x.a].piece)];
-        const ThreadPiece& pb = tiling.pieces[static_cast<size_t>(placed[x.b].piece)];
-        const std::vector<int> ra = half_edge_order(pa, x.loop_a),
-                               rb = half_edge_order(pb, x.loop_b);
-        const int m = static_cast<int>(ra.size());
-        std::vector<int> remap;
-        for (int i = 0; i < m; ++i) {
-          const int va =
-              map[static_cast<size_t>(x.a)][static_cast<size_t>(ra[static_cast<size_t>(i)])];
-          const int vb =
-              map[static_cast<size_t>(x.b)]
-                 [static_cast<size_t>(rb[static_cast<size_t>(((x.offset - i) % m + m) % m)])];
-          if (va != vb) {
-            if (remap.empty()) remap.resize(face.size());
-            for (size_t q = 0; q < remap.size(); ++q) remap[q] = static_cast<int>(q);
-            remap[static_cast<size_t>(std::max(va, vb))] = std::min(va, vb);
-            for (Eigen::Vector3i& g : F)
-              for (int c = 0; c < 3; ++c) g(c) = remap[static_cast<size_t>(g(c))];
-          }
-        }
-      }
-    // Caps on the loops left open.
-    bool capped = false;
-    for (const int k : chain) {
-      const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(placed[k].piece)];
-      for (int l = 0; l < 2; ++l) {
-        if (partner[static_cast<size_t>(2 * k + l)] >= 0) continue;
-        const std::vector<int> ring = half_edge_order(piece, l);
-        const std::vector<int>& mk = map[static_cast<size_t>(k)];
-        const int c = add_vertex(placed[k].element, l == 0 ? piece.start_centre : piece.end_centre);
-        const int m = static_cast<int>(ring.size());
-        for (int i = 0; i < m; ++i) {
-          F.emplace_back(c, mk[static_cast<size_t>(ring[static_cast<size_t>((i + 1) % m)])],
-                         mk[static_cast<size_t>(ring[static_cast<size_t>(i)])]);
-          faces_of.push_back(k);
-        }
-        ++st.caps;
-        capped = true;
-      }
-    }
-    // Vertices no face uses any more (merged when a cycle closed) are dropped.
-    std::vector<int> used(face.size(), -1);
-    int nv = 0;
-    for (const Eigen::Vector3i& g : F)
-      for (int c = 0; c < 3; ++c)
-        if (used[static_cast<size_t>(g(c))] < 0) used[static_cast<size_t>(g(c))] = nv++;
-    SurfaceElement e;
-    e.kind = tiling.pieces[static_cast<size_t>(placed[first].piece)].kind;
-    e.F.resize(static_cast<Eigen::Index>(F.size()), 3);
-    for (size_t f = 0; f < F.size(); ++f)
-      for (int c = 0; c < 3; ++c)
-        e.F(static_cast<Eigen::Index>(f), c) = used[static_cast<size_t>(F[f](c))];
-    e.face.resize(static_cast<size_t>(nv));
-    e.barycentric.resize(nv, 3);
-    e.height.resize(nv);
-    for (size_t v = 0; v < face.size(); ++v) {
-      const int u = used[v];
-      if (u < 0) continue;
-      e.face[static_cast<size_t>(u)] = face[v];
-      e.barycentric.row(u) = bary[v].transpose();
-      e.height(u) = height[v];
-    }
-    out.push_back(std::move(e));
-    if (face_piece) face_piece->push_back(std::move(faces_of));
+    ThreadAssembly thread(placed, tiling, welds, partner, map);
+    for (const int k : chain) thread.add_piece(k);
+    thread.close_cycle(chain);
+    const int caps = thread.cap_open_loops(chain);
+    st.caps += caps;
+    out.push_back(thread.element(tiling.pieces[static_cast<size_t>(placed[first].piece)].kind));
+    if (face_piece) face_piece->push_back(std::move(thread.faces_of()));
     ++st.threads;
-    st.closed_threads += capped ? 0 : 1;
+    st.closed_threads += caps > 0 ? 0 : 1;
     for (const int k : chain) std::vector<int>().swap(map[static_cast<size_t>(k)]);
   }
   for (const ThreadWeld& x : welds)
