@@ -19,6 +19,69 @@ int crossing_sign(const EdgeTopology& topo, int e, int from) {
   return topo.edge_faces.begin(e)[0] == from ? 1 : -1;
 }
 
+// The dual spanning tree of tree-cotree over the faces, across the interior edges not in the
+// primal tree: each face's parent, the edge to it and its depth (roots: -1 and 0).
+struct DualTree {
+  std::vector<int> parent_edge, parent, depth;
+  std::vector<char> in_cotree;  // #E
+};
+
+DualTree cotree(const EdgeTopology& topo, const MatrixX3i& TT, const std::vector<char>& in_tree) {
+  const int nf = static_cast<int>(TT.rows());
+  DualTree d;
+  d.parent_edge.assign(static_cast<size_t>(nf), -1);
+  d.parent.assign(static_cast<size_t>(nf), -1);
+  d.depth.assign(static_cast<size_t>(nf), 0);
+  d.in_cotree.assign(static_cast<size_t>(topo.num_edges()), 0);
+  std::vector<char> seen(static_cast<size_t>(nf), 0);
+  for (int s = 0; s < nf; ++s) {
+    if (seen[s]) continue;
+    seen[s] = 1;
+    std::queue<int> q;
+    q.push(s);
+    while (!q.empty()) {
+      const int f = q.front();
+      q.pop();
+      for (int k = 0; k < 3; ++k) {
+        const int g = TT(f, k), e = topo.FE(f, k);
+        if (g < 0 || seen[g] || in_tree[e]) continue;
+        seen[g] = 1;
+        d.in_cotree[e] = 1;
+        d.parent[g] = f;
+        d.parent_edge[g] = e;
+        d.depth[g] = d.depth[f] + 1;
+        q.push(g);
+      }
+    }
+  }
+  return d;
+}
+
+// The dual loop interior edge e closes: across e from its first face f to g, then back from g
+// to f through the dual tree, as (edge, crossing sign); empty when f and g are not joined.
+std::vector<std::pair<int, int>> generator_loop(const EdgeTopology& topo, const DualTree& d,
+                                                int e) {
+  const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
+  std::vector<std::pair<int, int>> loop{{e, 1}};  // (edge, crossing sign)
+  std::vector<std::pair<int, int>> down;          // f's side, reversed afterwards
+  int a = g, b = f;
+  while (a != b) {
+    if (d.depth[a] >= d.depth[b]) {
+      // Up from a to its parent.
+      loop.emplace_back(d.parent_edge[a], crossing_sign(topo, d.parent_edge[a], a));
+      a = d.parent[a];
+    } else {
+      // From b's parent down to b (walked later, in order).
+      down.emplace_back(d.parent_edge[b], crossing_sign(topo, d.parent_edge[b], d.parent[b]));
+      b = d.parent[b];
+    }
+    if (a < 0 || b < 0) break;  // different dual components: not a loop (cannot happen)
+  }
+  if (a != b || a < 0) return {};
+  loop.insert(loop.end(), down.rbegin(), down.rend());
+  return loop;
+}
+
 }  // namespace
 
 TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
@@ -27,80 +90,95 @@ TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
   MQ_CHECK(N >= 1 && N <= 4, InvalidInput, "trivial connection: N must be in [1, 4], got ", N);
   MQ_CHECK(TT.rows() == F.rows(), InvalidInput,
            "trivial connection: the face adjacency does not match the faces");
-  const int nv = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
-  const int ne = topo.num_edges();
-  const double unit = kTwoPi / N;
-  const FaceFrames fr = face_frames(V, F);
+  mark_interior_vertices();
+  measure_metric();
+  find_components();
+  std::vector<Eigen::Triplet<double>> t = vertex_rows();
+  const int rows = add_generator_rows(primal_tree(), t);
+  factorise(t, rows);
+}
 
-  // Interior vertices: referenced, every edge manifold, one fan (a bow tie's star is no loop).
+// Interior vertices: referenced, every edge manifold, one fan (a bow tie's star is no loop).
+void TrivialConnection::mark_interior_vertices() {
+  const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
   interior_.assign(static_cast<size_t>(nv), 0);
   for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) interior_[F(f, k)] = 1;
-  for (int e = 0; e < ne; ++e)
-    if (!interior_edge(topo, e)) interior_[topo.E(e, 0)] = interior_[topo.E(e, 1)] = 0;
-  const std::vector<char> multi = multi_fan_vertices(F, nv, topo);
+    for (int k = 0; k < 3; ++k) interior_[F_(f, k)] = 1;
+  for (int e = 0; e < topo_.num_edges(); ++e)
+    if (!interior_edge(topo_, e)) interior_[topo_.E(e, 0)] = interior_[topo_.E(e, 1)] = 0;
+  const std::vector<char> multi = multi_fan_vertices(F_, nv, topo_);
   for (int v = 0; v < nv; ++v)
     if (multi[v]) interior_[v] = 0;
+}
 
-  // Angle defects, vertex areas, cotangent weights.
+// Angle defects, vertex areas, cotangent weights, Levi-Civita transport across edges.
+void TrivialConnection::measure_metric() {
+  const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
+  const int ne = topo_.num_edges();
   K_ = Eigen::VectorXd::Zero(nv);
   area_ = Eigen::VectorXd::Zero(nv);
   Eigen::VectorXd angle_sum = Eigen::VectorXd::Zero(nv);
   weight_ = Eigen::VectorXd::Zero(ne);
   for (int f = 0; f < nf; ++f) {
-    const Vector3d x[3] = {V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2))};
+    const Vector3d x[3] = {V_.row(F_(f, 0)), V_.row(F_(f, 1)), V_.row(F_(f, 2))};
     const double twice_area = (x[1] - x[0]).cross(x[2] - x[0]).norm();
     for (int c = 0; c < 3; ++c) {
       const Vector3d a = x[(c + 1) % 3] - x[c], b = x[(c + 2) % 3] - x[c];
       const double s = a.cross(b).norm(), d = a.dot(b);
-      angle_sum(F(f, c)) += std::atan2(s, d);
-      area_(F(f, c)) += twice_area / 6;
+      angle_sum(F_(f, c)) += std::atan2(s, d);
+      area_(F_(f, c)) += twice_area / 6;
       // The angle at corner c faces the edge from corner c+1 to c+2.
-      if (s > 0) weight_(topo.FE(f, (c + 1) % 3)) += 0.5 * d / s;
+      if (s > 0) weight_(topo_.FE(f, (c + 1) % 3)) += 0.5 * d / s;
     }
   }
   // Obtuse pairs give non-positive weights, which would leave the Laplacian indefinite; a
   // small positive floor keeps it definite and changes the metric only on such slivers.
-  for (int e = 0; e < ne; ++e) weight_(e) = interior_edge(topo, e) ? std::max(weight_(e), 1e-3) : 0;
+  for (int e = 0; e < ne; ++e)
+    weight_(e) = interior_edge(topo_, e) ? std::max(weight_(e), 1e-3) : 0;
   for (int v = 0; v < nv; ++v) K_(v) = interior_[v] ? kTwoPi - angle_sum(v) : 0.0;
+  const FaceFrames fr = face_frames(V_, F_);
   transport_ = Eigen::VectorXd::Zero(ne);
   for (int e = 0; e < ne; ++e)
-    if (interior_edge(topo, e)) transport_(e) = transport_angle(V, topo, fr, e);
+    if (interior_edge(topo_, e)) transport_(e) = transport_angle(V_, topo_, fr, e);
+}
 
-  // Components (through edges), and which are closed.
+// Components (through edges), and which are closed.
+void TrivialConnection::find_components() {
+  const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
   component_.assign(static_cast<size_t>(nv), -1);
-  {
-    const Adjacency adj = vertex_adjacency(F, nv);
-    int n = 0;
-    for (int s = 0; s < nv; ++s) {
-      if (component_[s] >= 0) continue;
-      component_[s] = n;
-      std::vector<int> stack{s};
-      while (!stack.empty()) {
-        const int v = stack.back();
-        stack.pop_back();
-        for (const int* w = adj.begin(v); w != adj.end(v); ++w)
-          if (component_[*w] < 0) {
-            component_[*w] = n;
-            stack.push_back(*w);
-          }
-      }
-      ++n;
+  const Adjacency adj = vertex_adjacency(F_, nv);
+  int n = 0;
+  for (int s = 0; s < nv; ++s) {
+    if (component_[s] >= 0) continue;
+    component_[s] = n;
+    std::vector<int> stack{s};
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (const int* w = adj.begin(v); w != adj.end(v); ++w)
+        if (component_[*w] < 0) {
+          component_[*w] = n;
+          stack.push_back(*w);
+        }
     }
-    closed_.assign(static_cast<size_t>(n), 1);
-    component_vertices_.assign(static_cast<size_t>(n), {});
-    std::vector<char> used(static_cast<size_t>(nv), 0);
-    for (int f = 0; f < nf; ++f)
-      for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
-    for (int v = 0; v < nv; ++v) {
-      if (!used[v]) continue;
-      component_vertices_[component_[v]].push_back(v);
-      if (!interior_[v]) closed_[component_[v]] = 0;
-    }
+    ++n;
   }
+  closed_.assign(static_cast<size_t>(n), 1);
+  component_vertices_.assign(static_cast<size_t>(n), {});
+  std::vector<char> used(static_cast<size_t>(nv), 0);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) used[F_(f, k)] = 1;
+  for (int v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    component_vertices_[component_[v]].push_back(v);
+    if (!interior_[v]) closed_[component_[v]] = 0;
+  }
+}
 
-  // Vertex rows: every interior vertex but, on a closed component, its last one (the rows of a
-  // closed component sum to zero; the dropped one is implied).
+// Vertex rows: every interior vertex but, on a closed component, its last one (the rows of a
+// closed component sum to zero; the dropped one is implied); their signed edge incidence.
+std::vector<Eigen::Triplet<double>> TrivialConnection::vertex_rows() {
+  const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
   row_of_vertex_.assign(static_cast<size_t>(nv), -1);
   std::vector<int> last(closed_.size(), -1);
   for (int v = 0; v < nv; ++v)
@@ -111,98 +189,65 @@ TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
   std::vector<Eigen::Triplet<double>> t;
   for (int f = 0; f < nf; ++f)
     for (int c = 0; c < 3; ++c) {
-      const int v = F(f, c), row = row_of_vertex_[v];
+      const int v = F_(f, c), row = row_of_vertex_[v];
       if (row < 0) continue;
       // Counter-clockwise around v, the next face lies across the edge from corner c+2 to c.
-      const int e = topo.FE(f, (c + 2) % 3);
-      t.emplace_back(row, e, crossing_sign(topo, e, f));
+      const int e = topo_.FE(f, (c + 2) % 3);
+      t.emplace_back(row, e, crossing_sign(topo_, e, f));
     }
+  return t;
+}
 
-  // Generators (tree-cotree, Eppstein 2003): a primal spanning tree grown from every
-  // non-interior vertex of a component at once (its boundary loops contracted to one root), a
-  // dual spanning tree over the interior edges left, and each interior edge in neither closes
-  // one dual loop: 2g + b - 1 per component.
+// Generators (tree-cotree, Eppstein 2003): a primal spanning tree grown from every
+// non-interior vertex of a component at once (its boundary loops contracted to one root), a
+// dual spanning tree over the interior edges left, and each interior edge in neither closes
+// one dual loop: 2g + b - 1 per component. This is the primal tree.
+std::vector<char> TrivialConnection::primal_tree() const {
+  const int nv = static_cast<int>(V_.rows()), ne = topo_.num_edges();
   std::vector<char> in_tree(static_cast<size_t>(ne), 0);
-  {
-    std::vector<std::vector<std::pair<int, int>>> star(static_cast<size_t>(nv));
-    for (int e = 0; e < ne; ++e) {
-      star[topo.E(e, 0)].emplace_back(topo.E(e, 1), e);
-      star[topo.E(e, 1)].emplace_back(topo.E(e, 0), e);
-    }
-    std::vector<char> seen(static_cast<size_t>(nv), 0);
-    std::queue<int> q;
-    for (size_t c = 0; c < component_vertices_.size(); ++c) {
-      if (component_vertices_[c].empty()) continue;
-      if (closed_[c]) {
-        seen[component_vertices_[c][0]] = 1;
-        q.push(component_vertices_[c][0]);
-      } else {
-        for (const int v : component_vertices_[c])
-          if (!interior_[v]) {
-            seen[v] = 1;
-            q.push(v);
-          }
-      }
-    }
-    while (!q.empty()) {
-      const int v = q.front();
-      q.pop();
-      for (const auto& [w, e] : star[v]) {
-        if (seen[w] || !interior_edge(topo, e)) continue;
-        seen[w] = 1;
-        in_tree[e] = 1;
-        q.push(w);
-      }
-    }
-  }
-  std::vector<int> parent_edge(static_cast<size_t>(nf), -1), parent(static_cast<size_t>(nf), -1),
-      depth(static_cast<size_t>(nf), 0);
-  std::vector<char> in_cotree(static_cast<size_t>(ne), 0);
-  {
-    std::vector<char> seen(static_cast<size_t>(nf), 0);
-    for (int s = 0; s < nf; ++s) {
-      if (seen[s]) continue;
-      seen[s] = 1;
-      std::queue<int> q;
-      q.push(s);
-      while (!q.empty()) {
-        const int f = q.front();
-        q.pop();
-        for (int k = 0; k < 3; ++k) {
-          const int g = TT(f, k), e = topo.FE(f, k);
-          if (g < 0 || seen[g] || in_tree[e]) continue;
-          seen[g] = 1;
-          in_cotree[e] = 1;
-          parent[g] = f;
-          parent_edge[g] = e;
-          depth[g] = depth[f] + 1;
-          q.push(g);
-        }
-      }
-    }
-  }
-  int rows = vertex_rows_;
+  std::vector<std::vector<std::pair<int, int>>> star(static_cast<size_t>(nv));
   for (int e = 0; e < ne; ++e) {
-    if (!interior_edge(topo, e) || in_tree[e] || in_cotree[e]) continue;
-    // The loop: across e from its first face f to g, then back from g to f through the cotree.
-    const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
-    std::vector<std::pair<int, int>> loop{{e, 1}};  // (edge, crossing sign)
-    std::vector<std::pair<int, int>> down;          // f's side, reversed afterwards
-    int a = g, b = f;
-    while (a != b) {
-      if (depth[a] >= depth[b]) {
-        // Up from a to its parent.
-        loop.emplace_back(parent_edge[a], crossing_sign(topo, parent_edge[a], a));
-        a = parent[a];
-      } else {
-        // From b's parent down to b (walked later, in order).
-        down.emplace_back(parent_edge[b], crossing_sign(topo, parent_edge[b], parent[b]));
-        b = parent[b];
-      }
-      if (a < 0 || b < 0) break;  // different dual components: not a loop (cannot happen)
+    star[topo_.E(e, 0)].emplace_back(topo_.E(e, 1), e);
+    star[topo_.E(e, 1)].emplace_back(topo_.E(e, 0), e);
+  }
+  std::vector<char> seen(static_cast<size_t>(nv), 0);
+  std::queue<int> q;
+  for (size_t c = 0; c < component_vertices_.size(); ++c) {
+    if (component_vertices_[c].empty()) continue;
+    if (closed_[c]) {
+      seen[component_vertices_[c][0]] = 1;
+      q.push(component_vertices_[c][0]);
+    } else {
+      for (const int v : component_vertices_[c])
+        if (!interior_[v]) {
+          seen[v] = 1;
+          q.push(v);
+        }
     }
-    if (a != b || a < 0) continue;
-    loop.insert(loop.end(), down.rbegin(), down.rend());
+  }
+  while (!q.empty()) {
+    const int v = q.front();
+    q.pop();
+    for (const auto& [w, e] : star[v]) {
+      if (seen[w] || !interior_edge(topo_, e)) continue;
+      seen[w] = 1;
+      in_tree[e] = 1;
+      q.push(w);
+    }
+  }
+  return in_tree;
+}
+
+// One row per generator loop (the interior edges in neither tree), with its Levi-Civita
+// holonomy.
+int TrivialConnection::add_generator_rows(const std::vector<char>& in_tree,
+                                          std::vector<Eigen::Triplet<double>>& t) {
+  const DualTree dual = cotree(topo_, TT_, in_tree);
+  int rows = vertex_rows_;
+  for (int e = 0; e < topo_.num_edges(); ++e) {
+    if (!interior_edge(topo_, e) || in_tree[e] || dual.in_cotree[e]) continue;
+    const std::vector<std::pair<int, int>> loop = generator_loop(topo_, dual, e);
+    if (loop.empty()) continue;
     double holonomy = 0;
     for (const auto& [edge, sign] : loop) {
       holonomy += sign * transport_(edge);
@@ -211,6 +256,12 @@ TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
     generator_holonomy_.push_back(holonomy);
     ++rows;
   }
+  return rows;
+}
+
+// The cotangent Laplacian of the vertex rows and the system augmented by the generators.
+void TrivialConnection::factorise(const std::vector<Eigen::Triplet<double>>& t, int rows) {
+  const int ne = topo_.num_edges();
   A_.resize(rows, ne);
   A_.setFromTriplets(t.begin(), t.end());
   const Eigen::SparseMatrix<double> W = [&] {
@@ -231,7 +282,6 @@ TrivialConnection::TrivialConnection(const MatrixX3d& V, const MatrixX3i& F,
   augmented_.compute(M);
   MQ_CHECK(augmented_.info() == Eigen::Success, SolverFailure,
            "trivial connection: the generator system could not be factorised");
-  (void)unit;
 }
 
 int TrivialConnection::unbalanced_component(const std::vector<int>& index) const {

@@ -12,6 +12,7 @@
 // keeps near 1 (core/surface/cone_placement).
 #pragma once
 
+#include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <vector>
 
@@ -75,6 +76,16 @@ class TrivialConnection {
   ConeMetric solve(const std::vector<int>& index, const MatrixX3d& guidance) const;
 
  private:
+  // The constructor's steps, in order.
+  void mark_interior_vertices();
+  void measure_metric();  // K_, area_, weight_, transport_
+  void find_components();
+  std::vector<Eigen::Triplet<double>> vertex_rows();  // row_of_vertex_, their incidence
+  std::vector<char> primal_tree() const;              // #E: in the tree of tree-cotree
+  int add_generator_rows(const std::vector<char>& in_tree,
+                         std::vector<Eigen::Triplet<double>>& t);  // returns all rows
+  void factorise(const std::vector<Eigen::Triplet<double>>& t, int rows);
+
   MatrixX3d V_;
   MatrixX3i F_;
   EdgeTopology topo_;
