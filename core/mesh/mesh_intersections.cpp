@@ -145,6 +145,138 @@ bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
          segment_triangle_intersect(P(g, ga), P(g, gb), P(f, 0), P(f, 1), P(f, 2));
 }
 
+// What the narrow phase reads of a candidate, in one cache line: its box rounded outward to
+// float (a quick, conservative rejection; the exact test decides), its first and last cells,
+// its label.
+struct FaceBox {
+  float lo[3], hi[3];
+  int c0[3], c1[3];
+  int label;
+};
+
+// The broad phase: every face's FaceBox on a uniform grid whose cells are about the mean face
+// box, and the faces bucketed by cell (with an active set only the active faces).
+struct FaceGrid {
+  std::vector<FaceBox> box;  // #F
+  std::array<int, 3> n{};    // cells per axis
+  std::vector<int> offsets;  // #cells + 1, into members
+  std::vector<int> members;  // faces by cell, ascending in each
+  int cell_index(int i, int j, int k) const { return (k * n[1] + j) * n[0] + i; }
+};
+
+// The boxes are made first (cells 0), in one pass that also sums their sizes and bounds per
+// block (in block order: the same cell size whatever the threads); no double-precision box
+// arrays (2 x 24 bytes a face, freshly mapped pages on every call). Returns the bounds and the
+// summed size.
+struct BoxSum {
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Vector3d hi = Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  double size = 0;
+};
+
+BoxSum candidate_boxes(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int>* label,
+                       std::vector<FaceBox>& box) {
+  const int nf = static_cast<int>(F.rows());
+  box.resize(static_cast<size_t>(nf));
+  constexpr int kBoxBlock = 16384;
+  std::vector<BoxSum> block_sum(static_cast<size_t>((nf + kBoxBlock - 1) / kBoxBlock));
+  tbb::parallel_for(0, static_cast<int>(block_sum.size()), [&](int b) {
+    BoxSum& sum = block_sum[static_cast<size_t>(b)];
+    for (int f = b * kBoxBlock, end = std::min(nf, f + kBoxBlock); f < end; ++f) {
+      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
+      sum.lo = sum.lo.cwiseMin(lo);
+      sum.hi = sum.hi.cwiseMax(hi);
+      sum.size += (hi - lo).maxCoeff();
+      FaceBox& c = box[static_cast<size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        float l = static_cast<float>(lo[k]), u = static_cast<float>(hi[k]);
+        if (static_cast<double>(l) > lo[k])
+          l = std::nextafter(l, -std::numeric_limits<float>::infinity());
+        if (static_cast<double>(u) < hi[k])
+          u = std::nextafter(u, std::numeric_limits<float>::infinity());
+        c.lo[k] = l;
+        c.hi[k] = u;
+      }
+      c.label = label ? (*label)[static_cast<size_t>(f)] : 0;
+    }
+  });
+  BoxSum all;
+  for (const BoxSum& b : block_sum) {
+    all.lo = all.lo.cwiseMin(b.lo);
+    all.hi = all.hi.cwiseMax(b.hi);
+    all.size += b.size;
+  }
+  return all;
+}
+
+FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int>* label,
+                   const std::vector<char>* active) {
+  const int nf = static_cast<int>(F.rows());
+  FaceGrid grid;
+  std::vector<FaceBox>& box = grid.box;
+  const BoxSum all = candidate_boxes(V, F, label, box);
+  const Vector3d gmin = all.lo;
+  const Vector3d gext = all.hi - all.lo;
+
+  // Cell size: the mean face box size, enlarged if the grid would have too many cells.
+  double h = all.size / nf;
+  if (!(h > 0)) h = std::max(gext.maxCoeff(), 1.0);
+  const double max_cells = 4.0 * nf + 64.0;
+  std::array<int, 3>& n = grid.n;
+  for (;;) {
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      n[k] = std::max(1, static_cast<int>(std::ceil(gext[k] / h)));
+      cells *= n[k];
+    }
+    if (cells <= max_cells) break;
+    h *= 1.25;
+  }
+  const auto cell_coord = [&](double x, int k) {
+    return std::clamp(static_cast<int>(std::floor((x - gmin[k]) / h)), 0, n[k] - 1);
+  };
+  // The cells from the exact (double) box, as the grid's bounds are exact.
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
+    for (int f = r.begin(); f != r.end(); ++f) {
+      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
+      FaceBox& c = box[static_cast<size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        c.c0[k] = cell_coord(lo[k], k);
+        c.c1[k] = cell_coord(hi[k], k);
+      }
+    }
+  });
+
+  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order). With
+  // an active set only the active faces: every pair to test has one, and the rest (60% of the
+  // faces in the fold repair's updates) need not be sorted into the grid.
+  const auto bucketed = [&](int f) { return !active || (*active)[f]; };
+  const int num_cells = n[0] * n[1] * n[2];
+  std::vector<int>& offsets = grid.offsets;
+  offsets.assign(static_cast<size_t>(num_cells) + 1, 0);
+  for (int f = 0; f < nf; ++f) {
+    if (!bucketed(f)) continue;
+    const FaceBox& c = box[static_cast<size_t>(f)];
+    for (int k = c.c0[2]; k <= c.c1[2]; ++k)
+      for (int j = c.c0[1]; j <= c.c1[1]; ++j)
+        for (int i = c.c0[0]; i <= c.c1[0]; ++i) ++offsets[grid.cell_index(i, j, k) + 1];
+  }
+  for (int c = 0; c < num_cells; ++c) offsets[c + 1] += offsets[c];
+  grid.members.resize(static_cast<size_t>(offsets.back()));
+  std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
+  for (int f = 0; f < nf; ++f) {
+    if (!bucketed(f)) continue;
+    const FaceBox& c = box[static_cast<size_t>(f)];
+    for (int k = c.c0[2]; k <= c.c1[2]; ++k)
+      for (int j = c.c0[1]; j <= c.c1[1]; ++j)
+        for (int i = c.c0[0]; i <= c.c1[0]; ++i)
+          grid.members[cursor[grid.cell_index(i, j, k)]++] = f;
+  }
+  return grid;
+}
+
 // Shared implementation: when label is given, only pairs with different labels are tested, or
 // with same_label only pairs with the same label.
 // active (optional, #F): only pairs with at least one active face are tested.
@@ -158,111 +290,9 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(V.allFinite(), InvalidInput, "intersection test: vertex positions are not finite");
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
-
-  // What the narrow phase reads of a candidate, in one cache line: its box rounded outward to
-  // float (a quick, conservative rejection; the exact test decides), its first and last cells,
-  // its label. The boxes are made first (cells 0), in one pass that also sums their sizes and
-  // bounds per block (in block order: the same cell size whatever the threads); no
-  // double-precision box arrays (2 x 24 bytes a face, freshly mapped pages on every call).
-  struct Candidate {
-    float lo[3], hi[3];
-    int c0[3], c1[3];
-    int label;
-  };
-  std::vector<Candidate> box(static_cast<size_t>(nf));
-  constexpr int kBoxBlock = 16384;
-  struct BlockSum {
-    Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Vector3d hi = Vector3d::Constant(-std::numeric_limits<double>::infinity());
-    double size = 0;
-  };
-  std::vector<BlockSum> block_sum(static_cast<size_t>((nf + kBoxBlock - 1) / kBoxBlock));
-  tbb::parallel_for(0, static_cast<int>(block_sum.size()), [&](int b) {
-    BlockSum& sum = block_sum[static_cast<size_t>(b)];
-    for (int f = b * kBoxBlock, end = std::min(nf, f + kBoxBlock); f < end; ++f) {
-      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
-      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
-      sum.lo = sum.lo.cwiseMin(lo);
-      sum.hi = sum.hi.cwiseMax(hi);
-      sum.size += (hi - lo).maxCoeff();
-      Candidate& c = box[static_cast<size_t>(f)];
-      for (int k = 0; k < 3; ++k) {
-        float l = static_cast<float>(lo[k]), u = static_cast<float>(hi[k]);
-        if (static_cast<double>(l) > lo[k])
-          l = std::nextafter(l, -std::numeric_limits<float>::infinity());
-        if (static_cast<double>(u) < hi[k])
-          u = std::nextafter(u, std::numeric_limits<float>::infinity());
-        c.lo[k] = l;
-        c.hi[k] = u;
-      }
-      c.label = label ? (*label)[static_cast<size_t>(f)] : 0;
-    }
-  });
-  BlockSum all;
-  for (const BlockSum& b : block_sum) {
-    all.lo = all.lo.cwiseMin(b.lo);
-    all.hi = all.hi.cwiseMax(b.hi);
-    all.size += b.size;
-  }
-  const Vector3d gmin = all.lo;
-  const Vector3d gext = all.hi - all.lo;
-
-  // Cell size: the mean face box size, enlarged if the grid would have too many cells.
-  double h = all.size / nf;
-  if (!(h > 0)) h = std::max(gext.maxCoeff(), 1.0);
-  const double max_cells = 4.0 * nf + 64.0;
-  std::array<int, 3> n{};
-  for (;;) {
-    double cells = 1;
-    for (int k = 0; k < 3; ++k) {
-      n[k] = std::max(1, static_cast<int>(std::ceil(gext[k] / h)));
-      cells *= n[k];
-    }
-    if (cells <= max_cells) break;
-    h *= 1.25;
-  }
-  const auto cell_coord = [&](double x, int k) {
-    return std::clamp(static_cast<int>(std::floor((x - gmin[k]) / h)), 0, n[k] - 1);
-  };
-  const auto cell_index = [&](int i, int j, int k) { return (k * n[1] + j) * n[0] + i; };
-  // The cells from the exact (double) box, as the grid's bounds are exact.
-  tbb::parallel_for(tbb::blocked_range<int>(0, nf), [&](const tbb::blocked_range<int>& r) {
-    for (int f = r.begin(); f != r.end(); ++f) {
-      const Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
-      const Vector3d lo = p0.cwiseMin(p1).cwiseMin(p2), hi = p0.cwiseMax(p1).cwiseMax(p2);
-      Candidate& c = box[static_cast<size_t>(f)];
-      for (int k = 0; k < 3; ++k) {
-        c.c0[k] = cell_coord(lo[k], k);
-        c.c1[k] = cell_coord(hi[k], k);
-      }
-    }
-  });
-
-  // Bucket faces by cell (counting sort, so each bucket lists faces in ascending order). With
-  // an active set only the active faces: every pair to test has one, and the rest (60% of the
-  // faces in the fold repair's updates) need not be sorted into the grid.
+  const FaceGrid grid = face_grid(V, F, label, active);
+  const std::vector<FaceBox>& box = grid.box;
   const auto bucketed = [&](int f) { return !active || (*active)[f]; };
-  const int num_cells = n[0] * n[1] * n[2];
-  std::vector<int> offsets(num_cells + 1, 0);
-  for (int f = 0; f < nf; ++f) {
-    if (!bucketed(f)) continue;
-    const Candidate& c = box[static_cast<size_t>(f)];
-    for (int k = c.c0[2]; k <= c.c1[2]; ++k)
-      for (int j = c.c0[1]; j <= c.c1[1]; ++j)
-        for (int i = c.c0[0]; i <= c.c1[0]; ++i) ++offsets[cell_index(i, j, k) + 1];
-  }
-  for (int c = 0; c < num_cells; ++c) offsets[c + 1] += offsets[c];
-  std::vector<int> members(offsets.back());
-  {
-    std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
-    for (int f = 0; f < nf; ++f) {
-      if (!bucketed(f)) continue;
-      const Candidate& c = box[static_cast<size_t>(f)];
-      for (int k = c.c0[2]; k <= c.c1[2]; ++k)
-        for (int j = c.c0[1]; j <= c.c1[1]; ++j)
-          for (int i = c.c0[0]; i <= c.c1[0]; ++i) members[cursor[cell_index(i, j, k)]++] = f;
-    }
-  }
 
   // Narrow phase per face f against the bucketed faces g, each pair once: g later than f, or
   // with an active set g active and f inactive or earlier. A pair is tested only in the cell
@@ -279,18 +309,18 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     for (int f = block * kBlock, end = std::min(nf, f + kBlock); f < end; ++f) {
       const bool f_first = bucketed(f);
       hits.clear();
-      const Candidate a = box[static_cast<size_t>(f)];
+      const FaceBox a = box[static_cast<size_t>(f)];
       for (int k = a.c0[2]; k <= a.c1[2]; ++k)
         for (int j = a.c0[1]; j <= a.c1[1]; ++j)
           for (int i = a.c0[0]; i <= a.c1[0]; ++i) {
-            const int c = cell_index(i, j, k);
+            const int c = grid.cell_index(i, j, k);
             // Buckets are ascending: the faces after f start at its upper bound.
-            const int* const first = members.data() + offsets[c];
-            const int* const last = members.data() + offsets[c + 1];
+            const int* const first = grid.members.data() + grid.offsets[c];
+            const int* const last = grid.members.data() + grid.offsets[c + 1];
             for (const int* m = f_first ? std::upper_bound(first, last, f) : first; m != last;
                  ++m) {
               const int g = *m;
-              const Candidate& b = box[static_cast<size_t>(g)];
+              const FaceBox& b = box[static_cast<size_t>(g)];
               if (label && (a.label == b.label) != same_label) continue;
               if (a.lo[0] > b.hi[0] || b.lo[0] > a.hi[0] || a.lo[1] > b.hi[1] ||
                   b.lo[1] > a.hi[1] || a.lo[2] > b.hi[2] || b.lo[2] > a.hi[2])
