@@ -133,6 +133,14 @@ class ShellMap {
   const FoldRepair& fold_repair() const { return repair_; }
 
  private:
+  // The constructor's steps, in order (V, F as given).
+  void build_offset(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions& options);
+  void exclude_until_valid(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions& options,
+                           const OffsetOptions& oo, OffsetFailure& failure);
+  void number_shell_faces(Eigen::Index num_faces);
+  void build_problem(int num_vertices);
+  void mark_fixed_corners(int num_vertices);
+
   MatrixX3d base_V_;
   MatrixX3i F_;
   std::vector<int> input_face_, shell_face_;
