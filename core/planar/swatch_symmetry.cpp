@@ -115,84 +115,92 @@ std::vector<size_t> nearest_centres(const std::vector<Vector2d>& c, size_t k, si
   return order;
 }
 
-}  // namespace
-
 // Shifts a grid search may evaluate (each 128 nearest-face queries): beyond it the search tries
 // the shifts that map one element onto another, or a coarser grid. The Table 1 swatches need
 // at most a few thousand.
 constexpr double kMaxGridShifts = 16384;
 
-SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
-                                      double cell, double tolerance) {
-  SwatchSymmetry out;
-  const MatrixX3d& V = swatch.mesh.V;
-  const MatrixX3i& F = swatch.mesh.F;
-  const Vector2d size = swatch.size.head<2>();
-  double max_element = 0, min_element = std::numeric_limits<double>::infinity();
-  for (const Element& e : swatch.elements) {
-    max_element = std::max(max_element, e.footprint_diameter());
-    min_element = std::min(min_element, e.footprint_diameter());
-  }
-  const double margin = 0.1 * max_element;
-  if (!(cell > 0) || size.x() <= 2 * margin || size.y() <= 2 * margin) return out;
-  const Sample s = strided_sample(V, F, 128);
-  const size_t min_points = std::max<size_t>(16, s.p.size() / 5);
-  const double lambda = 1.0 / cell;
-  const double step = 0.5 * cell;
-  const std::vector<Vector2d> centre = element_box_centres(swatch);
-  const size_t middle = centre.empty() ? 0 : nearest_centre(centre, 0.5 * size);
+using ShiftMatch = std::pair<double, Vector2d>;  // (mean cost, shift)
+
+// The maps x -> sign * x + t of the swatch onto itself (sign 1: periods, -1: half turns about
+// t / 2) over a range of shifts t: matches of mean Eq. (1) cost within 1 + tolerance.
+class SymmetrySearch {
+ public:
+  SymmetrySearch(const PreparedSwatch& swatch, const SwatchFaceTree& faces, double cell,
+                 double tolerance, double margin)
+      : faces_(faces),
+        sample_(strided_sample(swatch.mesh.V, swatch.mesh.F, 128)),
+        size_(swatch.size.head<2>()),
+        margin_(margin),
+        min_points_(std::max<size_t>(16, sample_.p.size() / 5)),
+        lambda_(1.0 / cell),
+        step_(0.5 * cell),
+        cell_(cell),
+        tolerance_(tolerance),
+        centre_(element_box_centres(swatch)),
+        middle_(centre_.empty() ? 0 : nearest_centre(centre_, 0.5 * size_)) {}
 
   // Whole-step shifts in both directions for the periods, shifts over [0, 2 size] for the half
   // turn (which maps [0, size] to [-size, 0] before the shift).
-  auto search = [&](double sign, const Vector2d& from, const Vector2d& to,
-                    std::vector<std::pair<double, Vector2d>>& found) {
+  std::vector<ShiftMatch> search(double sign, const Vector2d& from, const Vector2d& to) const {
     const double grid_shifts =
-        std::floor((to.x() - from.x()) / step + 1) * std::floor((to.y() - from.y()) / step + 1);
-    if (grid_shifts > kMaxGridShifts && centre.size() >= 2) {
-      // Many small elements (a 20 x 20 swatch of boxes: 260,000 shifts, minutes): a symmetry
-      // maps the middle element onto another one, so only such shifts are tried, refined as
-      // below, instead of a grid over the footprint (issue 28).
-      // The shortest periods, and half turns about the nearest centres, map it onto one of its
-      // nearest elements: the 64 nearest are tried.
-      std::vector<Vector2d> tries;
-      for (const size_t j : nearest_centres(centre, middle, 64, sign < 0)) {
-        const Vector2d t =
-            sign > 0 ? Vector2d(centre[j] - centre[middle]) : Vector2d(centre[j] + centre[middle]);
-        if ((t.array() < from.array()).any() || (t.array() > to.array()).any()) continue;
-        if (sign > 0 && t.norm() < 0.5 * cell) continue;
-        tries.push_back(t);
-      }
-      std::vector<std::pair<double, Vector2d>> refined(tries.size());
-      tbb::parallel_for(size_t(0), tries.size(), [&](size_t i) {
-        double c = mean_cost(faces, s, sign, tries[i], size, margin, lambda, min_points);
-        Vector2d t = tries[i];
-        if (c < 2.0)
-          t = refine(faces, s, sign, t, size, margin, lambda, min_points, 0.5 * step, 1e-7 * cell,
-                     c);
-        refined[i] = {c, t};
-      });
-      for (const auto& [c, t] : refined)
-        if (c <= 1 + tolerance) found.emplace_back(c, t);
-      return;
-    }
+        std::floor((to.x() - from.x()) / step_ + 1) * std::floor((to.y() - from.y()) / step_ + 1);
+    if (grid_shifts > kMaxGridShifts && centre_.size() >= 2) return element_shifts(sign, from, to);
     // One large element on a fine grid: the grid coarsened to the budget.
     const double grid_step =
-        grid_shifts > kMaxGridShifts ? step * std::sqrt(grid_shifts / kMaxGridShifts) : step;
+        grid_shifts > kMaxGridShifts ? step_ * std::sqrt(grid_shifts / kMaxGridShifts) : step_;
+    return grid_search(sign, from, to, grid_step);
+  }
+
+ private:
+  double cost(double sign, const Vector2d& t) const {
+    return mean_cost(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_);
+  }
+  Vector2d refined(double sign, const Vector2d& t, double step, double& c) const {
+    return refine(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_, step,
+                  1e-7 * cell_, c);
+  }
+
+  // Many small elements (a 20 x 20 swatch of boxes: 260,000 shifts, minutes): a symmetry maps
+  // the middle element onto another one, so only such shifts are tried, refined as below,
+  // instead of a grid over the footprint (issue 28). The shortest periods, and half turns about
+  // the nearest centres, map it onto one of its nearest elements: the 64 nearest are tried.
+  std::vector<ShiftMatch> element_shifts(double sign, const Vector2d& from,
+                                         const Vector2d& to) const {
+    std::vector<Vector2d> tries;
+    for (const size_t j : nearest_centres(centre_, middle_, 64, sign < 0)) {
+      const Vector2d t = sign > 0 ? Vector2d(centre_[j] - centre_[middle_])
+                                  : Vector2d(centre_[j] + centre_[middle_]);
+      if ((t.array() < from.array()).any() || (t.array() > to.array()).any()) continue;
+      if (sign > 0 && t.norm() < 0.5 * cell_) continue;
+      tries.push_back(t);
+    }
+    std::vector<ShiftMatch> matches(tries.size());
+    tbb::parallel_for(size_t(0), tries.size(), [&](size_t i) {
+      double c = cost(sign, tries[i]);
+      Vector2d t = tries[i];
+      if (c < 2.0) t = refined(sign, t, 0.5 * step_, c);
+      matches[i] = {c, t};
+    });
+    return exact(matches);
+  }
+
+  // Every shift on a grid, then its local minima under a loose bound refined.
+  std::vector<ShiftMatch> grid_search(double sign, const Vector2d& from, const Vector2d& to,
+                                      double grid_step) const {
     const int nx = static_cast<int>(std::floor((to.x() - from.x()) / grid_step)) + 1;
     const int ny = static_cast<int>(std::floor((to.y() - from.y()) / grid_step)) + 1;
-    if (nx <= 0 || ny <= 0) return;
-    std::vector<double> cost(static_cast<size_t>(nx) * ny);
+    if (nx <= 0 || ny <= 0) return {};
+    std::vector<double> costs(static_cast<size_t>(nx) * ny);
     tbb::parallel_for(0, nx * ny, [&](int k) {
       const Vector2d t = from + grid_step * Vector2d(k % nx, k / nx);
-      cost[static_cast<size_t>(k)] =
-          (sign > 0 && t.norm() < 0.5 * cell)
-              ? std::numeric_limits<double>::infinity()
-              : mean_cost(faces, s, sign, t, size, margin, lambda, min_points);
+      costs[static_cast<size_t>(k)] = (sign > 0 && t.norm() < 0.5 * cell_)
+                                          ? std::numeric_limits<double>::infinity()
+                                          : cost(sign, t);
     });
-    // Local minima under a loose bound, refined; exact matches kept.
     std::vector<int> seeds;
     for (int k = 0; k < nx * ny; ++k) {
-      const double c = cost[static_cast<size_t>(k)];
+      const double c = costs[static_cast<size_t>(k)];
       if (!(c < 2.0)) continue;
       const int x = k % nx, y = k / nx;
       bool minimum = true;
@@ -200,28 +208,43 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
         for (int dx = -1; dx <= 1 && minimum; ++dx) {
           const int xx = x + dx, yy = y + dy;
           if ((dx || dy) && xx >= 0 && yy >= 0 && xx < nx && yy < ny &&
-              cost[static_cast<size_t>(yy) * nx + xx] < c)
+              costs[static_cast<size_t>(yy) * nx + xx] < c)
             minimum = false;
         }
       if (minimum) seeds.push_back(k);
     }
-    std::vector<std::pair<double, Vector2d>> refined(seeds.size());
+    std::vector<ShiftMatch> matches(seeds.size());
     tbb::parallel_for(size_t(0), seeds.size(), [&](size_t i) {
       const int k = seeds[i];
       const Vector2d t0 = from + grid_step * Vector2d(k % nx, k / nx);
       double c = 0;
-      const Vector2d t = refine(faces, s, sign, t0, size, margin, lambda, min_points,
-                                0.5 * grid_step, 1e-7 * cell, c);
-      refined[i] = {c, t};
+      const Vector2d t = refined(sign, t0, 0.5 * grid_step, c);
+      matches[i] = {c, t};
     });
-    for (const auto& [c, t] : refined) {
-      if (c <= 1 + tolerance) found.emplace_back(c, t);
-    }
-  };
+    return exact(matches);
+  }
 
-  std::vector<std::pair<double, Vector2d>> periods;
-  const Vector2d reach = size - Vector2d::Constant(2 * margin);
-  search(1.0, -reach, reach, periods);
+  // The matches within the tolerance, in order.
+  std::vector<ShiftMatch> exact(const std::vector<ShiftMatch>& matches) const {
+    std::vector<ShiftMatch> found;
+    for (const auto& [c, t] : matches)
+      if (c <= 1 + tolerance_) found.emplace_back(c, t);
+    return found;
+  }
+
+  const SwatchFaceTree& faces_;
+  const Sample sample_;
+  const Vector2d size_;
+  const double margin_;
+  const size_t min_points_;
+  const double lambda_, step_, cell_, tolerance_;
+  const std::vector<Vector2d> centre_;
+  const size_t middle_;
+};
+
+// The lattice of the periods found: the shortest as a, the shortest not parallel to it (over
+// 0.2 of a right angle's sine) as b, in the conventional signs (a along +x, b with positive y).
+void lattice_from_periods(std::vector<ShiftMatch> periods, double cell, SwatchSymmetry& out) {
   // Shortest first (ties by coordinates, deterministic).
   std::sort(periods.begin(), periods.end(), [](const auto& p, const auto& q) {
     const double a = p.second.norm(), b = q.second.norm();
@@ -242,12 +265,27 @@ SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const Swatch
     }
   }
   if (out.periodic) {
-    // Conventional signs: a along +x, b with positive y (the lattice is the same).
     if (out.a.x() < 0 || (out.a.x() == 0 && out.a.y() < 0)) out.a = -out.a;
     if (out.a.x() * out.b.y() - out.a.y() * out.b.x() < 0) out.b = -out.b;
   }
-  std::vector<std::pair<double, Vector2d>> turns;
-  search(-1.0, Vector2d::Constant(2 * margin), 2 * size - Vector2d::Constant(2 * margin), turns);
+}
+
+}  // namespace
+
+SwatchSymmetry detect_swatch_symmetry(const PreparedSwatch& swatch, const SwatchFaceTree& faces,
+                                      double cell, double tolerance) {
+  SwatchSymmetry out;
+  const Vector2d size = swatch.size.head<2>();
+  double max_element = 0;
+  for (const Element& e : swatch.elements)
+    max_element = std::max(max_element, e.footprint_diameter());
+  const double margin = 0.1 * max_element;
+  if (!(cell > 0) || size.x() <= 2 * margin || size.y() <= 2 * margin) return out;
+  const SymmetrySearch search(swatch, faces, cell, tolerance, margin);
+  const Vector2d reach = size - Vector2d::Constant(2 * margin);
+  lattice_from_periods(search.search(1.0, -reach, reach), cell, out);
+  const std::vector<ShiftMatch> turns = search.search(-1.0, Vector2d::Constant(2 * margin),
+                                                      2 * size - Vector2d::Constant(2 * margin));
   if (!turns.empty()) {
     const auto best = *std::min_element(
         turns.begin(), turns.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
