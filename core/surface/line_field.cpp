@@ -127,6 +127,127 @@ DirectionField direction_field_matching(const MatrixX3d& V, const MatrixX3i& F,
   return out;
 }
 
+namespace {
+
+// The smoothness energy of an N-direction field, sum over interior edges of w |z_g - R z_f|^2,
+// as a real 2 #F system in z = (x, y) per face: off-diagonal triplets, and the diagonal (the
+// smoothness degree; the guidance adds to diag, not to degree).
+struct SmoothnessSystem {
+  std::vector<Eigen::Triplet<double>> t;
+  Eigen::VectorXd diag, degree, rhs;  // 2 #F each
+};
+
+SmoothnessSystem smoothness_system(const MatrixX3d& V, const EdgeTopology& topo,
+                                   const FaceFrames& fr, const std::vector<double>& area, int N) {
+  const int nf = static_cast<int>(area.size());
+  SmoothnessSystem sys;
+  sys.rhs = Eigen::VectorXd::Zero(2 * nf);
+  sys.diag = Eigen::VectorXd::Zero(2 * nf);
+  sys.degree = Eigen::VectorXd::Zero(2 * nf);
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    if (!interior(topo, e)) continue;
+    const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
+    const double r = N * transport(V, topo, fr, e), c = std::cos(r), s = std::sin(r);
+    // w |z_g - R z_f|^2: blocks (f,f) w I, (g,g) w I, (g,f) -w R, (f,g) -w R^T. The weight
+    // |e|^2 / (A_f + A_g) (about the ratio of the dual edge to the edge) makes the energy a
+    // discretisation of the field's Dirichlet energy, independent of the triangulation: with
+    // unit weights the slivers a bisected base has gathered singularities.
+    const double len2 = (V.row(topo.E(e, 1)) - V.row(topo.E(e, 0))).squaredNorm();
+    const double w = area[f] + area[g] > 0 ? len2 / (area[f] + area[g]) : 1.0;
+    sys.diag(2 * f) += w, sys.diag(2 * f + 1) += w, sys.diag(2 * g) += w, sys.diag(2 * g + 1) += w;
+    sys.degree(2 * f) += w, sys.degree(2 * f + 1) += w;
+    sys.degree(2 * g) += w, sys.degree(2 * g + 1) += w;
+    const double R[2][2] = {{c, -s}, {s, c}};
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        sys.t.emplace_back(2 * g + i, 2 * f + j, -w * R[i][j]);
+        sys.t.emplace_back(2 * f + j, 2 * g + i, -w * R[i][j]);
+      }
+  }
+  return sys;
+}
+
+// The guidance's pull: w |z_f - e^(i N theta_f)|^2 per face with guidance, w its weight times
+// the face's share of the mean area.
+void add_guidance(SmoothnessSystem& sys, const MatrixX3d& guidance, const FaceFrames& fr,
+                  const std::vector<double>& area, double mean_area, int N, double weight) {
+  for (int f = 0; f < static_cast<int>(area.size()); ++f) {
+    const Vector3d q = guidance.row(f).transpose();
+    const double len = std::hypot(q.dot(fr.b1.row(f).transpose()), q.dot(fr.b2.row(f).transpose()));
+    // The guidance's weight scales with its length's presence only (unit weight where defined).
+    const double w = weight * area[f] / mean_area * (len > 0 ? 1.0 : 0.0);
+    const double theta = len > 0 ? angle_of(q, fr, f) : 0.0;
+    sys.diag(2 * f) += w + 1e-9, sys.diag(2 * f + 1) += w + 1e-9;
+    sys.rhs(2 * f) += w * std::cos(N * theta);
+    sys.rhs(2 * f + 1) += w * std::sin(N * theta);
+  }
+}
+
+// The field that minimises smoothness plus guidance.
+Eigen::VectorXd fitted_field(SmoothnessSystem& sys) {
+  const Eigen::Index n = sys.rhs.size();
+  for (int i = 0; i < n; ++i) sys.t.emplace_back(i, i, sys.diag(i));
+  Eigen::SparseMatrix<double> M(n, n);
+  M.setFromTriplets(sys.t.begin(), sys.t.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
+  MQ_CHECK(ldlt.info() == Eigen::Success, SolverFailure,
+           "direction field: the smoothness system could not be factorised");
+  Eigen::VectorXd z = ldlt.solve(sys.rhs);
+  MQ_CHECK(ldlt.info() == Eigen::Success && z.allFinite(), SolverFailure,
+           "direction field: the smoothness solve failed");
+  return z;
+}
+
+// The smoothest field (Knoeppel et al. 2013): the smallest eigenvector of the smoothness energy
+// against the area, by inverse iteration from the guidance, then turned as a whole to agree best
+// with the guidance. Its singularities are the fewest and mildest the surface allows (on a
+// sphere, four half-turn cones, where a weighted fit to a guidance with two poles can keep the
+// poles).
+Eigen::VectorXd smoothest_field(const SmoothnessSystem& sys, const std::vector<double>& area,
+                                double mean_area) {
+  const int nf = static_cast<int>(area.size());
+  Eigen::VectorXd mass(2 * nf);
+  for (int f = 0; f < nf; ++f) mass(2 * f) = mass(2 * f + 1) = area[f] / mean_area;
+  const double shift = 1e-8 * std::max(1.0, sys.degree.sum() / (2 * nf));
+  std::vector<Eigen::Triplet<double>> ts;
+  ts.reserve(sys.t.size() + 2 * nf);
+  for (const auto& e : sys.t) ts.push_back(e);
+  // diag holds the smoothness degree plus the guidance weight; the weight is not part of the
+  // energy whose eigenvector is sought.
+  for (int f = 0; f < nf; ++f)
+    for (int c = 0; c < 2; ++c)
+      ts.emplace_back(2 * f + c, 2 * f + c, sys.degree(2 * f + c) + shift * mass(2 * f + c));
+  Eigen::SparseMatrix<double> M(2 * nf, 2 * nf);
+  M.setFromTriplets(ts.begin(), ts.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
+  MQ_CHECK(ldlt.info() == Eigen::Success, SolverFailure,
+           "direction field: the smoothness system could not be factorised");
+  Eigen::VectorXd z = sys.rhs;
+  if (!(z.norm() > 0)) z.setOnes();
+  for (int it = 0; it < 30; ++it) {
+    z = ldlt.solve(mass.cwiseProduct(z)).eval();
+    MQ_CHECK(ldlt.info() == Eigen::Success && z.allFinite(), SolverFailure,
+             "direction field: the smoothness solve failed");
+    z /= std::sqrt(z.dot(mass.cwiseProduct(z)));
+  }
+  // Global phase: maximise Re sum A conj(zhat) z over a common turn of every z.
+  double re = 0, im = 0;
+  for (int f = 0; f < nf; ++f) {
+    const double gx = sys.rhs(2 * f), gy = sys.rhs(2 * f + 1), x = z(2 * f), y = z(2 * f + 1);
+    re += gx * x + gy * y;
+    im += gx * y - gy * x;
+  }
+  const double phase = -std::atan2(im, re), c = std::cos(phase), sn = std::sin(phase);
+  for (int f = 0; f < nf; ++f) {
+    const double x = z(2 * f), y = z(2 * f + 1);
+    z(2 * f) = c * x - sn * y;
+    z(2 * f + 1) = sn * x + c * y;
+  }
+  return z;
+}
+
+}  // namespace
+
 DirectionField smooth_direction_field(const MatrixX3d& V, const MatrixX3i& F,
                                       const EdgeTopology& topo, const MatrixX3i& TT,
                                       const MatrixX3d& guidance, const LineFieldOptions& options) {
@@ -147,96 +268,10 @@ DirectionField smooth_direction_field(const MatrixX3d& V, const MatrixX3i& F,
   }
   mean_area = nf > 0 ? mean_area / nf : 1;
   if (!(mean_area > 0)) mean_area = 1;
-  // Real 2 #F system in z = (x, y) per face.
-  std::vector<Eigen::Triplet<double>> t;
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nf);
-  Eigen::VectorXd diag = Eigen::VectorXd::Zero(2 * nf);
-  Eigen::VectorXd smooth_degree = Eigen::VectorXd::Zero(2 * nf);
-  for (int e = 0; e < topo.num_edges(); ++e) {
-    if (!interior(topo, e)) continue;
-    const int f = topo.edge_faces.begin(e)[0], g = topo.edge_faces.begin(e)[1];
-    const double r = N * transport(V, topo, fr, e), c = std::cos(r), s = std::sin(r);
-    // w |z_g - R z_f|^2: blocks (f,f) w I, (g,g) w I, (g,f) -w R, (f,g) -w R^T. The weight
-    // |e|^2 / (A_f + A_g) (about the ratio of the dual edge to the edge) makes the energy a
-    // discretisation of the field's Dirichlet energy, independent of the triangulation: with
-    // unit weights the slivers a bisected base has gathered singularities.
-    const double len2 = (V.row(topo.E(e, 1)) - V.row(topo.E(e, 0))).squaredNorm();
-    const double w = area[f] + area[g] > 0 ? len2 / (area[f] + area[g]) : 1.0;
-    diag(2 * f) += w, diag(2 * f + 1) += w, diag(2 * g) += w, diag(2 * g + 1) += w;
-    smooth_degree(2 * f) += w, smooth_degree(2 * f + 1) += w;
-    smooth_degree(2 * g) += w, smooth_degree(2 * g + 1) += w;
-    const double R[2][2] = {{c, -s}, {s, c}};
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        t.emplace_back(2 * g + i, 2 * f + j, -w * R[i][j]);
-        t.emplace_back(2 * f + j, 2 * g + i, -w * R[i][j]);
-      }
-  }
-  for (int f = 0; f < nf; ++f) {
-    const Vector3d q = guidance.row(f).transpose();
-    const double len = std::hypot(q.dot(fr.b1.row(f).transpose()), q.dot(fr.b2.row(f).transpose()));
-    // The guidance's weight scales with its length's presence only (unit weight where defined).
-    const double w = options.guidance_weight * area[f] / mean_area * (len > 0 ? 1.0 : 0.0);
-    const double theta = len > 0 ? angle_of(q, fr, f) : 0.0;
-    diag(2 * f) += w + 1e-9, diag(2 * f + 1) += w + 1e-9;
-    rhs(2 * f) += w * std::cos(N * theta);
-    rhs(2 * f + 1) += w * std::sin(N * theta);
-  }
-  Eigen::VectorXd z;
-  if (!options.smoothest) {
-    for (int i = 0; i < 2 * nf; ++i) t.emplace_back(i, i, diag(i));
-    Eigen::SparseMatrix<double> M(2 * nf, 2 * nf);
-    M.setFromTriplets(t.begin(), t.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
-    MQ_CHECK(ldlt.info() == Eigen::Success, SolverFailure,
-             "direction field: the smoothness system could not be factorised");
-    z = ldlt.solve(rhs);
-    MQ_CHECK(ldlt.info() == Eigen::Success && z.allFinite(), SolverFailure,
-             "direction field: the smoothness solve failed");
-  } else {
-    // The smoothest field (Knoeppel et al. 2013): the smallest eigenvector of the smoothness
-    // energy against the area, by inverse iteration from the guidance, then turned as a whole
-    // to agree best with the guidance. Its singularities are the fewest and mildest the
-    // surface allows (on a sphere, four half-turn cones, where a weighted fit to a guidance
-    // with two poles can keep the poles).
-    Eigen::VectorXd mass(2 * nf);
-    for (int f = 0; f < nf; ++f) mass(2 * f) = mass(2 * f + 1) = area[f] / mean_area;
-    const double shift = 1e-8 * std::max(1.0, smooth_degree.sum() / (2 * nf));
-    std::vector<Eigen::Triplet<double>> ts;
-    ts.reserve(t.size() + 2 * nf);
-    for (const auto& e : t) ts.push_back(e);
-    // diag holds the smoothness degree plus the guidance weight; the weight is not part of
-    // the energy whose eigenvector is sought.
-    for (int f = 0; f < nf; ++f)
-      for (int c = 0; c < 2; ++c)
-        ts.emplace_back(2 * f + c, 2 * f + c, smooth_degree(2 * f + c) + shift * mass(2 * f + c));
-    Eigen::SparseMatrix<double> M(2 * nf, 2 * nf);
-    M.setFromTriplets(ts.begin(), ts.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(M);
-    MQ_CHECK(ldlt.info() == Eigen::Success, SolverFailure,
-             "direction field: the smoothness system could not be factorised");
-    z = rhs;
-    if (!(z.norm() > 0)) z.setOnes();
-    for (int it = 0; it < 30; ++it) {
-      z = ldlt.solve(mass.cwiseProduct(z)).eval();
-      MQ_CHECK(ldlt.info() == Eigen::Success && z.allFinite(), SolverFailure,
-               "direction field: the smoothness solve failed");
-      z /= std::sqrt(z.dot(mass.cwiseProduct(z)));
-    }
-    // Global phase: maximise Re sum A conj(zhat) z over a common turn of every z.
-    double re = 0, im = 0;
-    for (int f = 0; f < nf; ++f) {
-      const double gx = rhs(2 * f), gy = rhs(2 * f + 1), x = z(2 * f), y = z(2 * f + 1);
-      re += gx * x + gy * y;
-      im += gx * y - gy * x;
-    }
-    const double phase = -std::atan2(im, re), c = std::cos(phase), sn = std::sin(phase);
-    for (int f = 0; f < nf; ++f) {
-      const double x = z(2 * f), y = z(2 * f + 1);
-      z(2 * f) = c * x - sn * y;
-      z(2 * f + 1) = sn * x + c * y;
-    }
-  }
+  SmoothnessSystem sys = smoothness_system(V, topo, fr, area, N);
+  add_guidance(sys, guidance, fr, area, mean_area, N, options.guidance_weight);
+  const Eigen::VectorXd z =
+      options.smoothest ? smoothest_field(sys, area, mean_area) : fitted_field(sys);
   std::vector<double> theta(static_cast<size_t>(nf));
   for (int f = 0; f < nf; ++f) {
     if (std::hypot(z(2 * f), z(2 * f + 1)) > 1e-12) {
