@@ -181,9 +181,9 @@ std::optional<MatrixX2d> developable_unfolding(const MatrixX3d& V, const MatrixX
   }
   return out;
 }
-}  // namespace
 
-MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
+// Every face of three distinct vertices, every vertex on a face, positions finite.
+void validate_patch(const MatrixX3d& V, const MatrixX3i& F) {
   const int n = static_cast<int>(V.rows());
   const int nf = static_cast<int>(F.rows());
   MQ_CHECK(nf > 0, InvalidInput, "lscm: the patch has no faces");
@@ -197,10 +197,10 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
   }
   for (int v = 0; v < n; ++v)
     MQ_CHECK(used[v], InvalidInput, "lscm: vertex ", v, " is used by no face");
-  const EdgeTopology topo = edge_topology(F, n);
-  const std::vector<int> boundary = disk_boundary(F, n, topo);
+}
 
-  // Pins: double sweep over the boundary for a far-apart pair (first farthest point wins ties).
+// Pins: double sweep over the boundary for a far-apart pair (first farthest point wins ties).
+std::pair<int, int> far_pins(const MatrixX3d& V, const std::vector<int>& boundary) {
   auto farthest = [&](int from) {
     int best = boundary[0];
     double best_d = -1;
@@ -211,57 +211,29 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
     return best;
   };
   const int pin1 = farthest(boundary[0]);
-  const int pin0 = farthest(pin1);
-  const double pin_distance = (vertex_row(V, pin1) - vertex_row(V, pin0)).norm();
-  MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
+  return {farthest(pin1), pin1};
+}
 
-  // Total 3D area, summed in face order (the scale both paths below are normalised to).
-  double area3d = 0;
-  {
-    const Eigen::VectorXd A = face_areas(V, F);
-    for (Eigen::Index f = 0; f < A.size(); ++f) area3d += A(f);
+// The energy sum_T A_T |grad v - rot90(grad u)|^2 splits into the Dirichlet energies of u and v
+// (cotangent weights) minus twice the signed area of the image, and that area is a sum over the
+// boundary edges alone (Levy et al. 2002; Desbrun et al. 2002). Assembled that way u and v are
+// coupled on the boundary only: the factor of the 2n x 2n system fills in like two Laplacians
+// instead of a system coupled at every vertex, which is what made a large patch (a fine base,
+// issue 14) cost several times more per face than a small one. Unknowns: u and v of every
+// vertex but the two pins, whose values go to the right-hand side.
+class ConformalSystem {
+ public:
+  ConformalSystem(int n, int pin0, int pin1, double pin_distance)
+      : unknown_(static_cast<size_t>(n), -1), pin0_(pin0), pin1_(pin1) {
+    for (int v = 0; v < n; ++v)
+      if (v != pin0 && v != pin1) unknown_[v] = nu_++;
+    pinned_[0] = Vector2d::Zero();
+    pinned_[1] = Vector2d(pin_distance, 0);
+    rhs_ = Eigen::VectorXd::Zero(2 * nu_);
   }
-  // A developable patch (a wall's panel, the folded sides of a pillar) has a zero-energy
-  // conformal map, its isometric unfolding: up to the similarity the pins and the area fix, the
-  // solution of the system below (unique for a connected disk with two pins), without a solve.
-  if (const std::optional<MatrixX2d> flat = developable_unfolding(V, F, topo, pin0, pin1))
-    return rescaled_to_3d_area(*flat, F, area3d);
-  // Unknowns: u and v of every free vertex; pinned values go to the right-hand side.
-  std::vector<int> unknown(n, -1);
-  int nu = 0;
-  for (int v = 0; v < n; ++v)
-    if (v != pin0 && v != pin1) unknown[v] = nu++;
-  Vector2d pinned[2] = {Vector2d::Zero(), Vector2d(pin_distance, 0)};
-  auto pinned_uv = [&](int v) { return v == pin0 ? pinned[0] : pinned[1]; };
 
-  // The energy sum_T A_T |grad v - rot90(grad u)|^2 splits into the Dirichlet energies of u and
-  // v (cotangent weights) minus twice the signed area of the image, and that area is a sum over
-  // the boundary edges alone (Levy et al. 2002; Desbrun et al. 2002). Assembled that way u and v
-  // are coupled on the boundary only: the factor of the 2n x 2n system fills in like two
-  // Laplacians instead of a system coupled at every vertex, which is what made a large patch
-  // (a fine base, issue 14) cost several times more per face than a small one.
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<size_t>(nf) * 24);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * nu);
-  // E(z) = z^T Q z over z = (u, v): adds q to Q(a, b) and Q(b, a), moving pinned terms to the
-  // right-hand side of Q_ff z_f = -Q_fp z_p.
-  auto value = [&](int vertex, int coord) {
-    const Vector2d q = pinned_uv(vertex);
-    return coord == 0 ? q.x() : q.y();
-  };
-  auto add = [&](int va, int ca, int vb, int cb, double q) {
-    const bool fa = unknown[va] >= 0, fb = unknown[vb] >= 0;
-    const int ia = fa ? ca * nu + unknown[va] : -1, ib = fb ? cb * nu + unknown[vb] : -1;
-    if (fa && fb) {
-      triplets.emplace_back(ia, ib, q);
-      triplets.emplace_back(ib, ia, q);
-    } else if (fa) {
-      rhs(ia) -= q * value(vb, cb);
-    } else if (fb) {
-      rhs(ib) -= q * value(va, ca);
-    }
-  };
-  for (int f = 0; f < nf; ++f) {
+  // Face f's Dirichlet terms, and its boundary edges' signed-area terms.
+  void add_face(const MatrixX3d& V, const MatrixX3i& F, const EdgeTopology& topo, int f) {
     const Vector3d P[3] = {vertex_row(V, F(f, 0)), vertex_row(V, F(f, 1)), vertex_row(V, F(f, 2))};
     const double twice_area = (P[1] - P[0]).cross(P[2] - P[0]).norm();
     MQ_CHECK(twice_area > 0 && std::isfinite(twice_area), InvalidInput, "lscm: face ", f,
@@ -286,23 +258,84 @@ MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
       add(j, 0, i, 1, 0.5);
     }
   }
-  MatrixX2d UV(n, 2);
-  UV.row(pin0) = pinned[0].transpose();
-  UV.row(pin1) = pinned[1].transpose();
-  if (nu > 0) {
-    Eigen::SparseMatrix<double> Q(2 * nu, 2 * nu);
-    Q.setFromTriplets(triplets.begin(), triplets.end());
+
+  // The minimiser: #V by 2, the pins at their values.
+  MatrixX2d solve() const {
+    const int n = static_cast<int>(unknown_.size());
+    MatrixX2d UV(n, 2);
+    UV.row(pin0_) = pinned_[0].transpose();
+    UV.row(pin1_) = pinned_[1].transpose();
+    if (nu_ == 0) return UV;
+    Eigen::SparseMatrix<double> Q(2 * nu_, 2 * nu_);
+    Q.setFromTriplets(triplets_.begin(), triplets_.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(Q);
     MQ_CHECK(solver.info() == Eigen::Success, SolverFailure,
              "lscm: factorisation of the conformal energy failed");
-    const Eigen::VectorXd x = solver.solve(rhs);
+    const Eigen::VectorXd x = solver.solve(rhs_);
     MQ_CHECK(solver.info() == Eigen::Success && x.allFinite(), SolverFailure,
              "lscm: the conformal solve failed");
     for (int v = 0; v < n; ++v)
-      if (unknown[v] >= 0) UV.row(v) << x(unknown[v]), x(nu + unknown[v]);
+      if (unknown_[v] >= 0) UV.row(v) << x(unknown_[v]), x(nu_ + unknown_[v]);
+    return UV;
   }
 
-  return rescaled_to_3d_area(UV, F, area3d);
+  void reserve(size_t triplets) { triplets_.reserve(triplets); }
+
+ private:
+  double value(int vertex, int coord) const {
+    const Vector2d q = vertex == pin0_ ? pinned_[0] : pinned_[1];
+    return coord == 0 ? q.x() : q.y();
+  }
+  // E(z) = z^T Q z over z = (u, v): adds q to Q(a, b) and Q(b, a), moving pinned terms to the
+  // right-hand side of Q_ff z_f = -Q_fp z_p.
+  void add(int va, int ca, int vb, int cb, double q) {
+    const bool fa = unknown_[va] >= 0, fb = unknown_[vb] >= 0;
+    const int ia = fa ? ca * nu_ + unknown_[va] : -1, ib = fb ? cb * nu_ + unknown_[vb] : -1;
+    if (fa && fb) {
+      triplets_.emplace_back(ia, ib, q);
+      triplets_.emplace_back(ib, ia, q);
+    } else if (fa) {
+      rhs_(ia) -= q * value(vb, cb);
+    } else if (fb) {
+      rhs_(ib) -= q * value(va, ca);
+    }
+  }
+
+  std::vector<int> unknown_;
+  int nu_ = 0;
+  const int pin0_, pin1_;
+  Vector2d pinned_[2];
+  std::vector<Eigen::Triplet<double>> triplets_;
+  Eigen::VectorXd rhs_;
+};
+
+}  // namespace
+
+MatrixX2d lscm(const MatrixX3d& V, const MatrixX3i& F) {
+  validate_patch(V, F);
+  const int n = static_cast<int>(V.rows());
+  const int nf = static_cast<int>(F.rows());
+  const EdgeTopology topo = edge_topology(F, n);
+  const std::vector<int> boundary = disk_boundary(F, n, topo);
+  const auto [pin0, pin1] = far_pins(V, boundary);
+  const double pin_distance = (vertex_row(V, pin1) - vertex_row(V, pin0)).norm();
+  MQ_CHECK(pin_distance > 0, InvalidInput, "lscm: the patch boundary has zero extent");
+
+  // Total 3D area, summed in face order (the scale both paths below are normalised to).
+  double area3d = 0;
+  {
+    const Eigen::VectorXd A = face_areas(V, F);
+    for (Eigen::Index f = 0; f < A.size(); ++f) area3d += A(f);
+  }
+  // A developable patch (a wall's panel, the folded sides of a pillar) has a zero-energy
+  // conformal map, its isometric unfolding: up to the similarity the pins and the area fix, the
+  // solution of the system below (unique for a connected disk with two pins), without a solve.
+  if (const std::optional<MatrixX2d> flat = developable_unfolding(V, F, topo, pin0, pin1))
+    return rescaled_to_3d_area(*flat, F, area3d);
+  ConformalSystem system(n, pin0, pin1, pin_distance);
+  system.reserve(static_cast<size_t>(nf) * 24);
+  for (int f = 0; f < nf; ++f) system.add_face(V, F, topo, f);
+  return rescaled_to_3d_area(system.solve(), F, area3d);
 }
 
 Eigen::VectorXd face_area_distortion(const MatrixX3d& V, const MatrixX3i& F, const MatrixX2d& UV) {
