@@ -25,6 +25,18 @@ class EndGrid {
     for (Eigen::Index i = 0; i < V.rows(); ++i)
       cells_[key(cell_of(V.row(i).transpose()))].push_back(static_cast<int>(i));
   }
+  // The points in p's cell and the 26 around it (every point within a cell of p).
+  std::vector<int> near(const Vector3d& p) const {
+    const std::array<long long, 3> c = cell_of(p);
+    std::vector<int> out;
+    for (long long x = c[0] - 1; x <= c[0] + 1; ++x)
+      for (long long y = c[1] - 1; y <= c[1] + 1; ++y)
+        for (long long z = c[2] - 1; z <= c[2] + 1; ++z) {
+          const auto it = cells_.find(key({x, y, z}));
+          if (it != cells_.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+        }
+    return out;
+  }
   // The nearest point within tol of p, ties to the lower index; -1 when none.
   int nearest(const Vector3d& p, double tol) const {
     const std::array<long long, 3> c = cell_of(p);
@@ -476,22 +488,26 @@ ThreadTiling thread_tiling(const PreparedSwatch& swatch, const SwatchSymmetry& s
   return out;
 }
 
-std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed,
-                                          const ThreadTiling& tiling,
-                                          const std::function<Vector3d(int, int)>& position,
-                                          double tolerance) {
-  // Every loop: its vertices' positions in half-edge order, centre and shortest edge.
-  struct Loop {
-    std::vector<Vector3d> p;
-    Vector3d centre = Vector3d::Zero();
-    double edge = 0;
-  };
+namespace {
+
+// A piece's loop as placed: its vertices' positions in half-edge order, centre and shortest
+// edge (infinite when it has none).
+struct PlacedLoop {
+  std::vector<Vector3d> p;
+  Vector3d centre = Vector3d::Zero();
+  double edge = 0;
+};
+
+// Loop 2k + l is placed piece k's loop l.
+std::vector<PlacedLoop> placed_loops(const std::vector<PlacedPiece>& placed,
+                                     const ThreadTiling& tiling,
+                                     const std::function<Vector3d(int, int)>& position) {
   const int n = static_cast<int>(placed.size());
-  std::vector<Loop> loops(static_cast<size_t>(2 * n));
+  std::vector<PlacedLoop> loops(static_cast<size_t>(2 * n));
   tbb::parallel_for(0, 2 * n, [&](int i) {
     const PlacedPiece& pp = placed[static_cast<size_t>(i / 2)];
     const std::vector<int> ring = half_edge_order(tiling.pieces[pp.piece], i % 2);
-    Loop& l = loops[static_cast<size_t>(i)];
+    PlacedLoop& l = loops[static_cast<size_t>(i)];
     for (const int v : ring) l.p.push_back(position(i / 2, v));
     for (const Vector3d& q : l.p) l.centre += q;
     l.centre /= static_cast<double>(std::max<size_t>(1, l.p.size()));
@@ -499,75 +515,43 @@ std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed
     for (size_t k = 0; k < l.p.size(); ++k)
       l.edge = std::min(l.edge, (l.p[(k + 1) % l.p.size()] - l.p[k]).norm());
   });
-  double cell = 0;
-  for (const Loop& l : loops)
-    if (std::isfinite(l.edge)) cell = std::max(cell, tolerance * l.edge);
-  if (!(cell > 0)) return {};
-  MatrixX3d centres(2 * n, 3);
-  for (int i = 0; i < 2 * n; ++i) centres.row(i) = loops[static_cast<size_t>(i)].centre.transpose();
-  // Candidates: loops whose centres lie within the tolerance, tested vertex for vertex.
-  std::unordered_map<unsigned long long, std::vector<int>> grid;
-  const auto cell_of = [&](const Vector3d& p) {
-    return std::array<long long, 3>{static_cast<long long>(std::floor(p.x() / cell)),
-                                    static_cast<long long>(std::floor(p.y() / cell)),
-                                    static_cast<long long>(std::floor(p.z() / cell))};
-  };
-  const auto key = [](const std::array<long long, 3>& c) {
-    return static_cast<unsigned long long>(c[0]) * 73856093ULL ^
-           static_cast<unsigned long long>(c[1]) * 19349663ULL ^
-           static_cast<unsigned long long>(c[2]) * 83492791ULL;
-  };
-  for (int i = 0; i < 2 * n; ++i)
-    grid[key(cell_of(loops[static_cast<size_t>(i)].centre))].push_back(i);
-  std::vector<std::vector<ThreadWeld>> found(static_cast<size_t>(2 * n));
-  tbb::parallel_for(0, 2 * n, [&](int i) {
-    const Loop& A = loops[static_cast<size_t>(i)];
-    const size_t m = A.p.size();
-    if (m < 3 || !std::isfinite(A.edge)) return;
-    const std::array<long long, 3> c = cell_of(A.centre);
-    for (long long x = c[0] - 1; x <= c[0] + 1; ++x)
-      for (long long y = c[1] - 1; y <= c[1] + 1; ++y)
-        for (long long z = c[2] - 1; z <= c[2] + 1; ++z) {
-          const auto it = grid.find(key({x, y, z}));
-          if (it == grid.end()) continue;
-          for (const int j : it->second) {
-            if (j <= i || j / 2 == i / 2) continue;
-            const Loop& B = loops[static_cast<size_t>(j)];
-            if (B.p.size() != m) continue;
-            const double tol = tolerance * std::min(A.edge, B.edge);
-            if ((A.centre - B.centre).norm() > tol) continue;
-            // A's vertex k is B's vertex (offset - k) mod m, nearest and within tol.
-            int offset = -1;
-            double gap = 0;
-            bool ok = true;
-            for (size_t k = 0; k < m && ok; ++k) {
-              size_t best = 0;
-              double bd = std::numeric_limits<double>::infinity();
-              for (size_t q = 0; q < m; ++q) {
-                const double d = (B.p[q] - A.p[k]).norm();
-                if (d < bd) {
-                  bd = d;
-                  best = q;
-                }
-              }
-              const int o = static_cast<int>((best + k) % m);
-              ok = bd <= tol && (offset < 0 || o == offset);
-              offset = o;
-              gap = std::max(gap, bd);
-            }
-            if (ok)
-              found[static_cast<size_t>(i)].push_back({i / 2, i % 2, j / 2, j % 2, offset, gap});
-          }
-        }
-  });
-  std::vector<ThreadWeld> all;
-  for (const std::vector<ThreadWeld>& f : found) all.insert(all.end(), f.begin(), f.end());
+  return loops;
+}
+
+// Whether loop B (as many vertices as A) meets A vertex for vertex within tol, in opposite
+// orders: A's vertex k nearest B's vertex (offset - k) mod m for one offset; the largest
+// distance in gap.
+bool loops_meet(const PlacedLoop& A, const PlacedLoop& B, double tol, int& offset, double& gap) {
+  const size_t m = A.p.size();
+  offset = -1;
+  gap = 0;
+  bool ok = true;
+  for (size_t k = 0; k < m && ok; ++k) {
+    size_t best = 0;
+    double bd = std::numeric_limits<double>::infinity();
+    for (size_t q = 0; q < m; ++q) {
+      const double d = (B.p[q] - A.p[k]).norm();
+      if (d < bd) {
+        bd = d;
+        best = q;
+      }
+    }
+    const int o = static_cast<int>((best + k) % m);
+    ok = bd <= tol && (offset < 0 || o == offset);
+    offset = o;
+    gap = std::max(gap, bd);
+  }
+  return ok;
+}
+
+// Each loop in at most one weld, the closest first (ties by loops), then in loop order.
+std::vector<ThreadWeld> closest_welds(std::vector<ThreadWeld> all, int loops) {
   std::sort(all.begin(), all.end(), [](const ThreadWeld& p, const ThreadWeld& q) {
     if (p.gap != q.gap) return p.gap < q.gap;
     return std::make_tuple(p.a, p.loop_a, p.b, p.loop_b) <
            std::make_tuple(q.a, q.loop_a, q.b, q.loop_b);
   });
-  std::vector<char> used(static_cast<size_t>(2 * n), 0);
+  std::vector<char> used(static_cast<size_t>(loops), 0);
   std::vector<ThreadWeld> out;
   for (const ThreadWeld& w : all) {
     const size_t la = static_cast<size_t>(2 * w.a + w.loop_a),
@@ -581,6 +565,44 @@ std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed
            std::make_tuple(q.a, q.loop_a, q.b, q.loop_b);
   });
   return out;
+}
+
+}  // namespace
+
+std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed,
+                                          const ThreadTiling& tiling,
+                                          const std::function<Vector3d(int, int)>& position,
+                                          double tolerance) {
+  const int n = static_cast<int>(placed.size());
+  const std::vector<PlacedLoop> loops = placed_loops(placed, tiling, position);
+  double cell = 0;
+  for (const PlacedLoop& l : loops)
+    if (std::isfinite(l.edge)) cell = std::max(cell, tolerance * l.edge);
+  if (!(cell > 0)) return {};
+  // Candidates: loops whose centres lie within the tolerance, tested vertex for vertex.
+  MatrixX3d centres(2 * n, 3);
+  for (int i = 0; i < 2 * n; ++i) centres.row(i) = loops[static_cast<size_t>(i)].centre.transpose();
+  const EndGrid grid(centres, cell);
+  std::vector<std::vector<ThreadWeld>> found(static_cast<size_t>(2 * n));
+  tbb::parallel_for(0, 2 * n, [&](int i) {
+    const PlacedLoop& A = loops[static_cast<size_t>(i)];
+    const size_t m = A.p.size();
+    if (m < 3 || !std::isfinite(A.edge)) return;
+    for (const int j : grid.near(A.centre)) {
+      if (j <= i || j / 2 == i / 2) continue;
+      const PlacedLoop& B = loops[static_cast<size_t>(j)];
+      if (B.p.size() != m) continue;
+      const double tol = tolerance * std::min(A.edge, B.edge);
+      if ((A.centre - B.centre).norm() > tol) continue;
+      int offset = -1;
+      double gap = 0;
+      if (loops_meet(A, B, tol, offset, gap))
+        found[static_cast<size_t>(i)].push_back({i / 2, i % 2, j / 2, j % 2, offset, gap});
+    }
+  });
+  std::vector<ThreadWeld> all;
+  for (const std::vector<ThreadWeld>& f : found) all.insert(all.end(), f.begin(), f.end());
+  return closest_welds(std::move(all), 2 * n);
 }
 
 namespace {
