@@ -82,9 +82,16 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
   }
   const double scale = (hi.colwise().maxCoeff() - lo.colwise().minCoeff()).norm();
   slack_ = 1e-9 * scale;
-
   std::vector<int> order(static_cast<std::size_t>(nf));
   for (int f = 0; f < nf; ++f) order[static_cast<std::size_t>(f)] = f;
+  build_nodes(lo, hi, centroid, FN, order, leaf_size);
+  copy_entries(V, F, FN, order, scale);
+  take_fingerprint();
+}
+
+void SwatchFaceTree::build_nodes(const MatrixX3d& lo, const MatrixX3d& hi,
+                                 const MatrixX3d& centroid, const MatrixX3d& FN,
+                                 std::vector<int>& order, int leaf_size) {
   // Depth-first build: node i's left child is i + 1, its right child is recorded on return.
   struct Builder {
     SwatchFaceTree& t;
@@ -134,14 +141,19 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
       return node;
     }
   };
-  Builder{*this, lo, hi, centroid, FN, order, leaf_size}.build(0, nf, 0);
+  Builder{*this, lo, hi, centroid, FN, order, leaf_size}.build(0, static_cast<int>(order.size()),
+                                                               0);
+}
 
-  // Per-entry copies of the face data, in leaf order.
+// Per-entry copies of the face data, in leaf order.
+void SwatchFaceTree::copy_entries(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& FN,
+                                  const std::vector<int>& order, double scale) {
+  const std::size_t nf = order.size();
   entry_faces_ = order;
-  entry_triangles_.resize(9 * static_cast<std::size_t>(nf));
-  entry_normals_.assign(4 * static_cast<std::size_t>(nf), 0.0);
-  entry_spheres_.resize(4 * static_cast<std::size_t>(nf));
-  for (std::size_t j = 0; j < order.size(); ++j) {
+  entry_triangles_.resize(9 * nf);
+  entry_normals_.assign(4 * nf, 0.0);
+  entry_spheres_.resize(4 * nf);
+  for (std::size_t j = 0; j < nf; ++j) {
     const int f = order[j];
     const Vector3d pa = V.row(F(f, 0)), pb = V.row(F(f, 1)), pc = V.row(F(f, 2));
     for (int a = 0; a < 3; ++a) {
@@ -156,16 +168,17 @@ SwatchFaceTree::SwatchFaceTree(const MatrixX3d& V, const MatrixX3i& F, int leaf_
     // Enlarged so that rounding never lets the sphere bound exceed a true distance.
     entry_spheres_[4 * j + 3] = r * (1 + 1e-12) + 1e-12 * scale;
   }
-
-  normal_x_.resize(static_cast<std::size_t>(nf));
-  normal_y_.resize(static_cast<std::size_t>(nf));
-  normal_z_.resize(static_cast<std::size_t>(nf));
-  for (std::size_t j = 0; j < static_cast<std::size_t>(nf); ++j) {
+  normal_x_.resize(nf);
+  normal_y_.resize(nf);
+  normal_z_.resize(nf);
+  for (std::size_t j = 0; j < nf; ++j) {
     normal_x_[j] = entry_normals_[4 * j];
     normal_y_[j] = entry_normals_[4 * j + 1];
     normal_z_[j] = entry_normals_[4 * j + 2];
   }
+}
 
+void SwatchFaceTree::take_fingerprint() {
   std::uint64_t fp = kFnv1aOffset;
   fnv1a(fp, &slack_, sizeof(double));
   fnv1a(fp, node_links_.data(), sizeof(int) * node_links_.size());
@@ -213,135 +226,177 @@ double SwatchFaceTree::entry_cost(int entry, const Vector3d& q, const Vector3d& 
   return entry_cost_with_factor(entry, q, entry_normal_factor(entry, n), lambda);
 }
 
+// One min_face_cost search: the best cost so far and the reach it leaves, the hint, the
+// nodes' bounds and the leaves' scan.
+class SwatchFaceTree::Query {
+ public:
+  Query(const SwatchFaceTree& t, const Vector3d& q, const Vector3d& n, double lambda, int* entry,
+        double max_distance)
+      : t_(t),
+        q_(q),
+        n_(n),
+        lambda_(lambda),
+        entry_(entry),
+        slack_(t.slack_),
+        // A node can hold a better face only if 1 + lambda * (distance - slack) < best, i.e.
+        // its box lies nearer than reach = (best - 1) / lambda + slack (no bound without a
+        // distance weight): compared squared, so inner nodes cost no square root.
+        // max_distance caps the reach the same way: faces farther away do not compete at all.
+        cap_(max_distance + slack_),
+        cap2_(cap_ * cap_ * (1.0 + 1e-12)),
+        max_dist2_(max_distance * max_distance),
+        reach2_(cap2_) {}
+
+  // The hint's face first: entry_cost's arithmetic, so that the leaf scan meeting the hint
+  // again cannot improve it.
+  void try_hint(int hint) {
+    const double dist2 =
+        triangle_dist2(q_, &t_.entry_triangles_[9 * static_cast<std::size_t>(hint)]);
+    if (dist2 <= max_dist2_) {
+      best_ = (1.0 + lambda_ * std::sqrt(dist2)) * t_.entry_normal_factor(hint, n_);
+      if (entry_) *entry_ = hint;
+      update_reach(best_);
+    }
+  }
+
+  // Depth first, the nearer child first, skipping nodes beyond the reach.
+  double search() {
+    int stack[kMaxDepth + 2];
+    double stack_d2[kMaxDepth + 2];
+    int sp = 0;
+    stack[sp] = 0;
+    stack_d2[sp++] = 0.0;
+    while (sp > 0) {
+      --sp;
+      const int i = stack[sp];
+      if (stack_d2[sp] >= reach2_) continue;
+      const int a = t_.node_links_[2 * static_cast<std::size_t>(i)];
+      if (a < 0) {
+        scan_leaf(i, a, stack_d2[sp]);
+        continue;
+      }
+      // Inner node: push the farther child first so the nearer one is searched first.
+      const int left = i + 1, right = a;
+      const double dl = box_distance2(left), dr = box_distance2(right);
+      const bool left_first = dl <= dr;
+      const int first = left_first ? left : right, second = left_first ? right : left;
+      const double d1 = left_first ? dl : dr, d2 = left_first ? dr : dl;
+      if (d2 < reach2_) {
+        stack[sp] = second;
+        stack_d2[sp++] = d2;
+      }
+      if (d1 < reach2_) {
+        stack[sp] = first;
+        stack_d2[sp++] = d1;
+      }
+    }
+    return best_;
+  }
+
+ private:
+  void update_reach(double best) {
+    if (lambda_ > 0) {
+      const double reach = (best - 1.0) / lambda_ + slack_;
+      reach2_ = std::min(cap2_, reach * reach * (1.0 + 1e-12));
+    }
+  }
+
+  // Squared distance from q to node i's box.
+  double box_distance2(int i) const {
+    const double* bx = &t_.node_boxes_[8 * static_cast<std::size_t>(i)];
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double e = std::max(0.0, std::max(bx[a] - q_(a), q_(a) - bx[4 + a]));
+      d2 += e * e;
+    }
+    return d2;
+  }
+
+  // Leaf i (link a < 0) at squared box distance d2: skipped whole when its normal cone and box
+  // bound the cost at best or more, else its entries scanned.
+  void scan_leaf(int i, int a, double d2) {
+    double best = best_;  // in a register for the scan
+    const double df = 1.0 + lambda_ * (std::sqrt(d2) - slack_);
+    const double* cone = &t_.node_cones_[4 * static_cast<std::size_t>(i)];
+    const double cx = n_(0) - cone[0], cy = n_(1) - cone[1], cz = n_(2) - cone[2];
+    const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
+    if (df * (1.0 + std::max(0.0, cone_lb)) >= best) return;
+    const int j0 = -1 - a, j1 = j0 + t_.node_links_[2 * static_cast<std::size_t>(i) + 1];
+    // Normal factor bound without a square root: skip an entry when
+    // |n - n_f| >= best / df - 1 (updated whenever best improves).
+    double r = best / df - 1.0;
+    double r2 = r * r * (1.0 + 1e-12);
+    // Blocks of kBlock entries (most fail the normal bound: on the apples ~316 entries are
+    // scanned per query and ~14 reach a distance): a branch-free pass computes the block's
+    // normal distances from per-coordinate arrays (vectorised) and lists the entries within
+    // the bound as it stands; only those are visited, and since the bound only tightens the
+    // visit re-tests it, so exactly the entries of a one-by-one scan are examined. On recorded
+    // queries of plane + apple / the ivy wall, 2.41 -> 2.15 / 1.47 -> 1.33 us.
+    constexpr int kBlock = 16;
+    for (int b0 = j0; b0 < j1; b0 += kBlock) {
+      const int bn = std::min(kBlock, j1 - b0);
+      const double* bx = &t_.normal_x_[static_cast<std::size_t>(b0)];
+      const double* by = &t_.normal_y_[static_cast<std::size_t>(b0)];
+      const double* bz = &t_.normal_z_[static_cast<std::size_t>(b0)];
+      const double n0 = n_(0), n1 = n_(1), n2 = n_(2);
+      double block_dn2[kBlock];
+      for (int k = 0; k < bn; ++k) {
+        const double nx = n0 - bx[k], ny = n1 - by[k], nz = n2 - bz[k];
+        block_dn2[k] = nx * nx + ny * ny + nz * nz;
+      }
+      int within[kBlock];
+      int count = 0;
+      for (int k = 0; k < bn; ++k) {
+        within[count] = k;
+        count += block_dn2[k] < r2 ? 1 : 0;
+      }
+      for (int m = 0; m < count; ++m) {
+        const int k = within[m];
+        const double dn2 = block_dn2[k];
+        if (dn2 >= r2) continue;
+        const int j = b0 + k;
+        const double nfac = 1.0 + std::sqrt(dn2);
+        // The entry can beat best only if its distance (at least |q - centre| - radius, less
+        // the slack) stays below reach = (best / nfac - 1) / lambda, and within the cap.
+        // Compared squared with a margin, so no square root: a skip is only ever taken when
+        // the cost bound really is >= best (the minimum and its entry are unchanged).
+        const double* sp4 = &t_.entry_spheres_[4 * static_cast<std::size_t>(j)];
+        const double sx = q_(0) - sp4[0], sy = q_(1) - sp4[1], sz = q_(2) - sp4[2];
+        const double reach = lambda_ > 0 ? std::min(cap_, (best / nfac - 1.0) / lambda_) : cap_;
+        const double bound = reach + slack_ + sp4[3];
+        if (!(bound > 0) || sx * sx + sy * sy + sz * sz >= bound * bound * (1.0 + 1e-12)) continue;
+        const double dist2 =
+            triangle_dist2(q_, &t_.entry_triangles_[9 * static_cast<std::size_t>(j)]);
+        const double cost = (1.0 + lambda_ * std::sqrt(dist2)) * nfac;  // face_cost
+        if (cost < best && dist2 <= max_dist2_) {
+          best = best_ = cost;
+          if (entry_) *entry_ = j;
+          update_reach(best);
+          r = best / df - 1.0;
+          r2 = r * r * (1.0 + 1e-12);
+        }
+      }
+    }
+  }
+
+  const SwatchFaceTree& t_;
+  const Vector3d q_, n_;
+  const double lambda_;
+  int* const entry_;
+  const double slack_, cap_, cap2_, max_dist2_;
+  double best_ = kInf, reach2_;
+};
+
 double SwatchFaceTree::min_face_cost(const Vector3d& q, const Vector3d& n, double lambda,
                                      int* entry, double max_distance, int hint) const {
   if (entry) *entry = -1;
   MQ_ASSERT(max_distance >= 0);
-  const double slack = slack_;
-  // Squared distance from q to node i's box.
-  auto box_distance2 = [&](int i) {
-    const double* bx = &node_boxes_[8 * static_cast<std::size_t>(i)];
-    double d2 = 0.0;
-    for (int a = 0; a < 3; ++a) {
-      const double e = std::max(0.0, std::max(bx[a] - q(a), q(a) - bx[4 + a]));
-      d2 += e * e;
-    }
-    return d2;
-  };
-  // A node can hold a better face only if 1 + lambda * (distance - slack) < best, i.e. its box
-  // lies nearer than reach = (best - 1) / lambda + slack (no bound without a distance weight):
-  // compared squared, so inner nodes cost no square root.
-  // max_distance caps the reach the same way: faces farther away do not compete at all.
-  const double cap = max_distance + slack, cap2 = cap * cap * (1.0 + 1e-12);
-  const double max_dist2 = max_distance * max_distance;
-  double best = kInf, reach2 = cap2;
-  auto update_reach = [&] {
-    if (lambda > 0) {
-      const double reach = (best - 1.0) / lambda + slack;
-      reach2 = std::min(cap2, reach * reach * (1.0 + 1e-12));
-    }
-  };
+  Query query(*this, q, n, lambda, entry, max_distance);
   if (hint >= 0) {
     MQ_ASSERT(hint < num_faces());
-    const double dist2 = triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(hint)]);
-    if (dist2 <= max_dist2) {
-      // entry_cost's arithmetic, so that the leaf scan meeting the hint again cannot improve it.
-      best = (1.0 + lambda * std::sqrt(dist2)) * entry_normal_factor(hint, n);
-      if (entry) *entry = hint;
-      update_reach();
-    }
+    query.try_hint(hint);
   }
-  int stack[kMaxDepth + 2];
-  double stack_d2[kMaxDepth + 2];
-  int sp = 0;
-  stack[sp] = 0;
-  stack_d2[sp++] = 0.0;
-  while (sp > 0) {
-    --sp;
-    const int i = stack[sp];
-    if (stack_d2[sp] >= reach2) continue;
-    const int a = node_links_[2 * static_cast<std::size_t>(i)];
-    if (a < 0) {
-      const double df = 1.0 + lambda * (std::sqrt(stack_d2[sp]) - slack);
-      const double* cone = &node_cones_[4 * static_cast<std::size_t>(i)];
-      const double cx = n(0) - cone[0], cy = n(1) - cone[1], cz = n(2) - cone[2];
-      const double cone_lb = std::sqrt(cx * cx + cy * cy + cz * cz) - cone[3];
-      if (df * (1.0 + std::max(0.0, cone_lb)) >= best) continue;
-      const int j0 = -1 - a, j1 = j0 + node_links_[2 * static_cast<std::size_t>(i) + 1];
-      // Normal factor bound without a square root: skip an entry when
-      // |n - n_f| >= best / df - 1 (updated whenever best improves).
-      double r = best / df - 1.0;
-      double r2 = r * r * (1.0 + 1e-12);
-      // Blocks of kBlock entries (most fail the normal bound: on the apples ~316 entries are
-      // scanned per query and ~14 reach a distance): a branch-free pass computes the block's
-      // normal distances from per-coordinate arrays (vectorised) and lists the entries within
-      // the bound as it stands; only those are visited, and since the bound only tightens the
-      // visit re-tests it, so exactly the entries of a one-by-one scan are examined. On
-      // recorded queries of plane + apple / the ivy wall, 2.41 -> 2.15 / 1.47 -> 1.33 us.
-      constexpr int kBlock = 16;
-      for (int b0 = j0; b0 < j1; b0 += kBlock) {
-        const int bn = std::min(kBlock, j1 - b0);
-        const double* bx = &normal_x_[static_cast<std::size_t>(b0)];
-        const double* by = &normal_y_[static_cast<std::size_t>(b0)];
-        const double* bz = &normal_z_[static_cast<std::size_t>(b0)];
-        const double n0 = n(0), n1 = n(1), n2 = n(2);
-        double block_dn2[kBlock];
-        for (int k = 0; k < bn; ++k) {
-          const double nx = n0 - bx[k], ny = n1 - by[k], nz = n2 - bz[k];
-          block_dn2[k] = nx * nx + ny * ny + nz * nz;
-        }
-        int within[kBlock];
-        int count = 0;
-        for (int k = 0; k < bn; ++k) {
-          within[count] = k;
-          count += block_dn2[k] < r2 ? 1 : 0;
-        }
-        for (int m = 0; m < count; ++m) {
-          const int k = within[m];
-          const double dn2 = block_dn2[k];
-          if (dn2 >= r2) continue;
-          const int j = b0 + k;
-          const double nfac = 1.0 + std::sqrt(dn2);
-          // The entry can beat best only if its distance (at least |q - centre| - radius, less
-          // the slack) stays below reach = (best / nfac - 1) / lambda, and within the cap.
-          // Compared squared with a margin, so no square root: a skip is only ever taken when
-          // the cost bound really is >= best (the minimum and its entry are unchanged).
-          const double* sp4 = &entry_spheres_[4 * static_cast<std::size_t>(j)];
-          const double sx = q(0) - sp4[0], sy = q(1) - sp4[1], sz = q(2) - sp4[2];
-          const double reach = lambda > 0 ? std::min(cap, (best / nfac - 1.0) / lambda) : cap;
-          const double bound = reach + slack + sp4[3];
-          if (!(bound > 0) || sx * sx + sy * sy + sz * sz >= bound * bound * (1.0 + 1e-12))
-            continue;
-          const double dist2 =
-              triangle_dist2(q, &entry_triangles_[9 * static_cast<std::size_t>(j)]);
-          const double cost = (1.0 + lambda * std::sqrt(dist2)) * nfac;  // face_cost
-          if (cost < best && dist2 <= max_dist2) {
-            best = cost;
-            if (entry) *entry = j;
-            update_reach();
-            r = best / df - 1.0;
-            r2 = r * r * (1.0 + 1e-12);
-          }
-        }
-      }
-      continue;
-    }
-    // Inner node: push the farther child first so the nearer one is searched first.
-    const int left = i + 1, right = a;
-    const double dl = box_distance2(left), dr = box_distance2(right);
-    const bool left_first = dl <= dr;
-    const int first = left_first ? left : right, second = left_first ? right : left;
-    const double d1 = left_first ? dl : dr, d2 = left_first ? dr : dl;
-    if (d2 < reach2) {
-      stack[sp] = second;
-      stack_d2[sp++] = d2;
-    }
-    if (d1 < reach2) {
-      stack[sp] = first;
-      stack_d2[sp++] = d1;
-    }
-  }
-  return best;
+  return query.search();
 }
 
 Eigen::VectorXd TranslationCostCpu::evaluate(const SwatchFaceTree& tree,

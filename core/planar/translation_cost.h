@@ -119,6 +119,15 @@ class SwatchFaceTree {
   std::uint64_t fingerprint() const { return fingerprint_; }
 
  private:
+  class Query;  // one min_face_cost search
+  // The constructor's steps: the nodes over the faces (reordering `order` into leaf order), the
+  // entries' copies of the faces in that order, the fingerprint.
+  void build_nodes(const MatrixX3d& lo, const MatrixX3d& hi, const MatrixX3d& centroid,
+                   const MatrixX3d& FN, std::vector<int>& order, int leaf_size);
+  void copy_entries(const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& FN,
+                    const std::vector<int>& order, double scale);
+  void take_fingerprint();
+
   int depth_ = 0;
   double slack_ = 0;
   std::vector<int> node_links_;
