@@ -987,7 +987,8 @@ def _draw_estimate(layout, context, s):
     if current and s.estimate_error:
         row.label(text="Estimate failed", icon="ERROR")
     elif current:
-        row.label(text=estimate_text(s), icon="INFO" if s.estimate_fits else "ERROR")
+        # No icon when it fits: the sidebar's default width then shows the whole line.
+        row.label(text=estimate_text(s), icon="NONE" if s.estimate_fits else "ERROR")
     else:
         row.label(text="Size: not estimated")
     row.operator("meshquilt.estimate", text="", icon="FILE_REFRESH")
@@ -1028,7 +1029,18 @@ def _draw_element_size(layout, context, s):
         text = bpy.utils.units.to_string(
             unit.system, "LENGTH", s.scale * diagonal * unit.scale_length, precision=3) \
             if unit.system != "NONE" else "%.4g" % (s.scale * diagonal)
-        layout.label(text="Element size at this Scale: %s" % text)
+        layout.label(text="At this Scale: %s" % text)  # short: the sidebar cuts long labels
+
+
+_LABEL_SHARE = 0.32  # of the sidebar's width for a setting's name: "Guidance" in full
+
+
+def _labelled(layout, data, prop, text):
+    """A setting with its name in a column of its own, so that the sidebar's default width shows
+    the whole name ("Sam...", "Guid..." were cut off by Blender's own split)."""
+    row = layout.split(factor=_LABEL_SHARE)
+    row.label(text=text)
+    row.prop(data, prop, text="")
 
 
 class MESHQUILT_PT_panel(bpy.types.Panel):
@@ -1041,9 +1053,12 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
     def draw(self, context):
         s = context.scene.meshquilt
         layout = self.layout
-        layout.prop(s, "base")
+        _labelled(layout, s, "base", "Base")
         layout.prop(s, "swatch_source", expand=True)
-        layout.prop(s, "swatch" if s.swatch_source == "OBJECT" else "sample")
+        if s.swatch_source == "OBJECT":
+            _labelled(layout, s, "swatch", "Swatch")
+        else:
+            _labelled(layout, s, "sample", "Sample")
         layout.prop(s, "scale")
         layout.prop(s, "element_size")
         _draw_element_size(layout, context, s)
@@ -1051,7 +1066,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         text = detail_text(context, s)
         if text:
             layout.label(text=text)
-        layout.prop(s, "guidance")
+        _labelled(layout, s, "guidance", "Guidance")
         if s.guidance == "AXIS":
             row = layout.row()
             row.prop(s, "guide_object")
@@ -1059,7 +1074,9 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         elif s.guidance == "ATTRIBUTE":
             layout.prop(s, "guide_attribute")
         if s.base is not None and s.base.type == "MESH":
-            layout.prop_search(s, "mask_group", s.base, "vertex_groups")
+            row = layout.split(factor=_LABEL_SHARE)
+            row.label(text="Mask")
+            row.prop_search(s, "mask_group", s.base, "vertex_groups", text="")
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
         layout.prop(s, "keep_results")
@@ -1091,7 +1108,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
                                                       context.scene.frame_end))
             if b.baked:
                 row.operator("meshquilt.clear_bake", icon="X", text="")
-            box.operator("meshquilt.remove_selected", icon="TRASH")
+            box.operator("meshquilt.remove_selected", icon="TRASH", text="Remove selected")
             if b.status:
                 box.label(text=b.status, icon="ERROR")
 

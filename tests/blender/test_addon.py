@@ -106,7 +106,7 @@ class FakeLayout:
     def row(self, **kw):
         return self
 
-    column = box = row
+    column = box = split = row
     prop_search = prop
 
 
@@ -906,7 +906,7 @@ def test_element_size_in_scene_units_is_passed_to_the_engine():
     bpy.context.view_layer.update()
     texts = drawn_panel()
     diagonal = 2.0 * 2.0 * math.sqrt(3.0)  # the 16 x 8 sphere's box is [-1, 1]^3, scaled 2x
-    shown = [t for t in texts if t.startswith("Element size at this Scale")]
+    shown = [t for t in texts if t.startswith("At this Scale")]
     import re
     value = re.search(r"([0-9.]+) ?m?$", shown[0]) if shown else None
     check(value and abs(float(value.group(1)) - 0.25 * diagonal) < 0.01,
