@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -74,6 +75,86 @@ bool visit(RTCPointQueryFunctionArguments* args) {
   return true;
 }
 
+// The output's triangles in an Embree scene (float copies; released with the object).
+class OutputScene {
+ public:
+  OutputScene(const EmbreeDevice& device, const TriMesh& output) {
+    scene_ = rtcNewScene(device.get());
+    device.check("coverage: rtcNewScene");
+    MQ_CHECK(scene_, Error, "coverage: Embree returned no scene");
+    try {
+      // A scene built once for few queries per output face: the fast build.
+      rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);
+      RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), output.V.rows()));
+      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), output.F.rows()));
+      if (!vb || !ib) {
+        rtcReleaseGeometry(geom);
+        device.check("coverage: rtcSetNewGeometryBuffer");
+        MQ_THROW(Error, "coverage: Embree returned no geometry buffer");
+      }
+      for (Eigen::Index i = 0; i < output.V.rows(); ++i)
+        for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(output.V(i, k));
+      for (Eigen::Index f = 0; f < output.F.rows(); ++f)
+        for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(output.F(f, k));
+      rtcCommitGeometry(geom);
+      rtcAttachGeometry(scene_, geom);
+      rtcReleaseGeometry(geom);
+      rtcCommitScene(scene_);
+      device.check("coverage: building the Embree BVH");
+    } catch (...) {
+      rtcReleaseScene(scene_);
+      throw;
+    }
+  }
+  ~OutputScene() { rtcReleaseScene(scene_); }
+  OutputScene(const OutputScene&) = delete;
+  OutputScene& operator=(const OutputScene&) = delete;
+  RTCScene get() const { return scene_; }
+
+ private:
+  RTCScene scene_ = nullptr;
+};
+
+// Per base face (those counted): whether output geometry lies within the radius of its
+// centroid on its outer side (visit: the first triangle found ends the query).
+std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& output, RTCScene scene,
+                                         double radius, double below,
+                                         const std::function<bool(Eigen::Index)>& counted) {
+  std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
+  const BoundingBox box = bounding_box(output.V);
+  // Float bounds and a float query point: the radius handed to Embree is enlarged far above
+  // their rounding; every triangle is then measured exactly in double.
+  const double slack = 1e-6 * (box.extent().norm() + std::max(box.min.cwiseAbs().maxCoeff(),
+                                                              box.max.cwiseAbs().maxCoeff())) +
+                       1e-30;
+  const MatrixX3d N = face_normals(base.V, base.F);
+  tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
+    if (!counted(f)) return;
+    Query q;
+    q.output = &output;
+    q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
+              .transpose() /
+          3.0;
+    q.n = N.row(f).transpose();
+    q.below = below;
+    q.radius = radius;
+    RTCPointQuery pq;
+    pq.x = static_cast<float>(q.c.x());
+    pq.y = static_cast<float>(q.c.y());
+    pq.z = static_cast<float>(q.c.z());
+    pq.time = 0.0f;
+    pq.radius = static_cast<float>(radius + slack + 1e-6 * q.c.cwiseAbs().maxCoeff());
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(scene, &pq, &context, visit, &q);
+    covered[static_cast<size_t>(f)] = q.found;
+  });
+  return covered;
+}
+
 }  // namespace
 
 double surface_coverage(const TriMesh& base, const TriMesh& output, double radius, double below,
@@ -94,65 +175,9 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
   MQ_CHECK(output.F.minCoeff() >= 0 && output.F.maxCoeff() < output.V.rows(), InvalidInput,
            "coverage: an output face index is out of range");
   const EmbreeDevice device;
-  RTCScene scene = rtcNewScene(device.get());
-  device.check("coverage: rtcNewScene");
-  MQ_CHECK(scene, Error, "coverage: Embree returned no scene");
-  std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
-  try {
-    // A scene built once for few queries per output face: the fast build.
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
-    RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), output.V.rows()));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), output.F.rows()));
-    if (!vb || !ib) {
-      rtcReleaseGeometry(geom);
-      device.check("coverage: rtcSetNewGeometryBuffer");
-      MQ_THROW(Error, "coverage: Embree returned no geometry buffer");
-    }
-    for (Eigen::Index i = 0; i < output.V.rows(); ++i)
-      for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(output.V(i, k));
-    for (Eigen::Index f = 0; f < output.F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(output.F(f, k));
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene);
-    device.check("coverage: building the Embree BVH");
-    const BoundingBox box = bounding_box(output.V);
-    // Float bounds and a float query point: the radius handed to Embree is enlarged far above
-    // their rounding; every triangle is then measured exactly in double.
-    const double slack = 1e-6 * (box.extent().norm() + std::max(box.min.cwiseAbs().maxCoeff(),
-                                                                box.max.cwiseAbs().maxCoeff())) +
-                         1e-30;
-    const MatrixX3d N = face_normals(base.V, base.F);
-    tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
-      if (!counted(f)) return;
-      Query q;
-      q.output = &output;
-      q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
-                .transpose() /
-            3.0;
-      q.n = N.row(f).transpose();
-      q.below = below;
-      q.radius = radius;
-      RTCPointQuery pq;
-      pq.x = static_cast<float>(q.c.x());
-      pq.y = static_cast<float>(q.c.y());
-      pq.z = static_cast<float>(q.c.z());
-      pq.time = 0.0f;
-      pq.radius = static_cast<float>(radius + slack + 1e-6 * q.c.cwiseAbs().maxCoeff());
-      RTCPointQueryContext context;
-      rtcInitPointQueryContext(&context);
-      rtcPointQuery(scene, &pq, &context, visit, &q);
-      covered[static_cast<size_t>(f)] = q.found;
-    });
-  } catch (...) {
-    rtcReleaseScene(scene);
-    throw;
-  }
-  rtcReleaseScene(scene);
+  const OutputScene scene(device, output);
+  const std::vector<unsigned char> covered =
+      covered_faces(base, output, scene.get(), radius, below, counted);
   const Eigen::VectorXd A = face_areas(base.V, base.F);
   // Summed in face order so the result does not depend on the thread count.
   double sum = 0, total = 0;
