@@ -99,10 +99,8 @@ double tri_area2(const Vector2d& a, const Vector2d& b, const Vector2d& c) {
   return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
 }
 
-}  // namespace
-
-TextureAtlas texture_atlas(const MatrixX3d& V, const MatrixX3i& F,
-                           const TextureAtlasOptions& options) {
+void validate_atlas_input(const MatrixX3d& V, const MatrixX3i& F,
+                          const TextureAtlasOptions& options) {
   MQ_CHECK(options.cone_cosine > -1.0 && options.cone_cosine < 1.0, InvalidInput,
            "texture atlas: cone_cosine must lie in (-1, 1), got ", options.cone_cosine);
   MQ_CHECK(options.max_area_distortion >= 1.0, InvalidInput,
@@ -113,20 +111,20 @@ TextureAtlas texture_atlas(const MatrixX3d& V, const MatrixX3i& F,
            "texture atlas: gutter must be finite and >= 0");
   MQ_CHECK(F.rows() > 0, InvalidInput, "texture atlas: the mesh has no faces");
   MQ_CHECK(V.allFinite(), InvalidInput, "texture atlas: vertices contain NaN or infinite values");
+}
+
+// Charts grown from each face not yet in one, by a work list of (seed, budget): a chart that
+// fails to flatten is released and its faces re-seeded smaller. chart: each face's chart.
+std::vector<Chart> grow_charts(const MatrixX3d& V, const MatrixX3i& F, const EdgeTopology& topo,
+                               const TextureAtlasOptions& options, std::vector<int>& chart) {
   const int n = static_cast<int>(V.rows());
   const int nf = static_cast<int>(F.rows());
-  const EdgeTopology topo = edge_topology(F, n);  // validates indices
-  const Eigen::VectorXd areas = face_areas(V, F);
-  for (int f = 0; f < nf; ++f)
-    MQ_CHECK(areas(f) > 0.0 && F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 0) != F(f, 2),
-             InvalidInput, "texture atlas: face ", f, " has zero area or a repeated vertex");
   const MatrixX3d FN = face_normals(V, F);
   const MatrixX3i TT = face_adjacency(topo);
-
-  std::vector<int> chart(nf, -1), vertex_mark(n, 0);
+  chart.assign(static_cast<size_t>(nf), -1);
+  std::vector<int> vertex_mark(n, 0);
   int stamp = 0;
   std::vector<Chart> charts;
-  // Work list of (seed, budget): a failed chart is released and its faces re-seeded smaller.
   for (int seed = 0; seed < nf; ++seed) {
     if (chart[seed] != -1) continue;
     int budget = options.max_chart_faces;
@@ -144,10 +142,12 @@ TextureAtlas texture_atlas(const MatrixX3d& V, const MatrixX3i& F,
       budget = std::max(1, std::min(budget, static_cast<int>(c.faces.size())) / 2);
     }
   }
+  return charts;
+}
 
-  // Shelf packing of the chart bounding boxes, tallest first (ties by chart id).
-  const double total_area = areas.sum();
-  const double gutter = options.gutter * std::sqrt(total_area);
+// Shelf packing of the chart bounding boxes, tallest first (ties by chart id), gutter apart:
+// each chart's offset.
+std::vector<Vector2d> pack_charts(const std::vector<Chart>& charts, double gutter) {
   const int nc = static_cast<int>(charts.size());
   std::vector<Vector2d> lo(nc), size(nc);
   double box_area = 0.0;
@@ -174,8 +174,27 @@ TextureAtlas texture_atlas(const MatrixX3d& V, const MatrixX3i& F,
     x += size[c].x() + gutter;
     shelf_height = std::max(shelf_height, size[c].y());
   }
+  return offset;
+}
+
+}  // namespace
+
+TextureAtlas texture_atlas(const MatrixX3d& V, const MatrixX3i& F,
+                           const TextureAtlasOptions& options) {
+  validate_atlas_input(V, F, options);
+  const int n = static_cast<int>(V.rows());
+  const int nf = static_cast<int>(F.rows());
+  const EdgeTopology topo = edge_topology(F, n);  // validates indices
+  const Eigen::VectorXd areas = face_areas(V, F);
+  for (int f = 0; f < nf; ++f)
+    MQ_CHECK(areas(f) > 0.0 && F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 0) != F(f, 2),
+             InvalidInput, "texture atlas: face ", f, " has zero area or a repeated vertex");
+  std::vector<int> chart;
+  const std::vector<Chart> charts = grow_charts(V, F, topo, options, chart);
+  const std::vector<Vector2d> offset = pack_charts(charts, options.gutter * std::sqrt(areas.sum()));
 
   TextureAtlas atlas;
+  const int nc = static_cast<int>(charts.size());
   atlas.num_charts = nc;
   atlas.face_chart = chart;
   atlas.FUV.resize(nf, 3);
