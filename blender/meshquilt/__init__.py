@@ -432,6 +432,11 @@ class Run:
         np.savetxt(path, np.clip(weights, 0.0, 1.0), fmt="%.6g",
                    header="meshquilt mask: vertex group '%s' of %s" % (name, obj.name))
 
+    def artist_message(self, error):
+        """The engine's error in the panel's terms for this run's objects and settings."""
+        return engine.artist_message(error, self.scale, self.max_memory, self.base.name,
+                                     self.swatch_name, self.element_size)
+
     def step(self):
         """Advances the run; returns its state ("running", "done", "failed", "cancelled")."""
         if self.state != "running":
@@ -442,10 +447,7 @@ class Run:
         if state == "failed" and len(self.jobs) < self.optional_jobs:
             state = "done"  # an optional job: the run goes on without what it adds
         if state == "failed":
-            self.state = "failed"
-            self.error = engine.artist_message(self.job.error, self.scale, self.max_memory,
-                                               self.base.name, self.swatch_name,
-                                               self.element_size)
+            self.state, self.error = "failed", self.artist_message(self.job.error)
         elif state == "cancelled":
             self.state = "cancelled"
         elif state == "done":
@@ -729,9 +731,7 @@ class MESHQUILT_OT_estimate(bpy.types.Operator):
         except (engine.EngineError, OSError, ValueError) as e:
             message = str(e)
             if run is not None and isinstance(e, engine.EngineError):
-                message = engine.artist_message(message, run.scale, run.max_memory,
-                                                run.base.name, run.swatch_name,
-                                                run.element_size)
+                message = run.artist_message(message)
             s.estimate_key, s.estimate_error = key, message
             self.report({"ERROR"}, message)
             return {"CANCELLED"}
@@ -1035,12 +1035,16 @@ def _draw_element_size(layout, context, s):
 _LABEL_SHARE = 0.32  # of the sidebar's width for a setting's name: "Guidance" in full
 
 
-def _labelled(layout, data, prop, text):
+def _labelled(layout, data, prop, text, search=None):
     """A setting with its name in a column of its own, so that the sidebar's default width shows
-    the whole name ("Sam...", "Guid..." were cut off by Blender's own split)."""
+    the whole name ("Sam...", "Guid..." were cut off by Blender's own split); search: (data,
+    collection) to pick a name from, as prop_search."""
     row = layout.split(factor=_LABEL_SHARE)
     row.label(text=text)
-    row.prop(data, prop, text="")
+    if search:
+        row.prop_search(data, prop, *search, text="")
+    else:
+        row.prop(data, prop, text="")
 
 
 class MESHQUILT_PT_panel(bpy.types.Panel):
@@ -1074,9 +1078,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         elif s.guidance == "ATTRIBUTE":
             layout.prop(s, "guide_attribute")
         if s.base is not None and s.base.type == "MESH":
-            row = layout.split(factor=_LABEL_SHARE)
-            row.label(text="Mask")
-            row.prop_search(s, "mask_group", s.base, "vertex_groups", text="")
+            _labelled(layout, s, "mask_group", "Mask", search=(s.base, "vertex_groups"))
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
         layout.prop(s, "keep_results")

@@ -8,6 +8,7 @@ base) is one more function that builds an argument list and returns a Job.
 
 import os
 import queue
+import re
 import shutil
 import signal
 import subprocess
@@ -353,6 +354,13 @@ def machine_memory_gib():
     return 0.0
 
 
+def _size_setting(scale, element_size):
+    """The panel's setting that sizes the elements and its value: ("Element size", "at Element
+    size 0.05") when one is given, else ("Scale", "at Scale 0.1")."""
+    knob = "Element size" if element_size > 0 else "Scale"
+    return knob, "at %s %g" % (knob, element_size if element_size > 0 else scale)
+
+
 def refusal_message(error, scale, limit_gib, element_size=0.0):
     """The artist's words for the engine refusing a job over --max-memory or --max-faces (None
     for any other error): what the job would need and what to change in Blender (the size by
@@ -360,7 +368,6 @@ def refusal_message(error, scale, limit_gib, element_size=0.0):
     if ("--max-memory" not in error and "--max-faces" not in error) or \
             "limit of" not in error:
         return None  # not a refusal (e.g. a value out of range)
-    import re
     faces = re.search(r"about ([0-9.e+]+) faces", error)
     limit = re.search(r"limit of ([0-9.e+]+)", error)
     n = float(faces.group(1)) if faces else None
@@ -369,8 +376,7 @@ def refusal_message(error, scale, limit_gib, element_size=0.0):
     need_gib = n * 400 / 2.0 ** 30 if n is not None else None
     need = (" would make about %s faces (about %.2g GiB)" % (format(int(n), ","), need_gib)
             if n is not None else " is too large")
-    knob = "Element size" if element_size > 0 else "Scale"
-    at = "at %s %g" % (knob, element_size if element_size > 0 else scale)
+    knob, at = _size_setting(scale, element_size)
     if need_gib is not None and limit and need_gib <= limit_gib:
         return ("meshquilt: %s the texture%s, more than the engine's limit of %s faces: raise "
                 "%s in the panel (fewer, larger elements) or lower Detail (fewer faces each)"
@@ -389,10 +395,8 @@ def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch"
     refused = refusal_message(error, scale, limit_gib, element_size)
     if refused:
         return refused
-    import re
     text = error.split(": error: ", 1)[-1]
-    knob = "Element size" if element_size > 0 else "Scale"
-    at = "at %s %g" % (knob, element_size if element_size > 0 else scale)
+    knob, at = _size_setting(scale, element_size)
     smaller = "lower %s in the panel (smaller elements)" % knob
     if "has zero size" in text:
         return ("meshquilt: the base %s has zero size (all its vertices at one point): pick "

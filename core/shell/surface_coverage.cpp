@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <vector>
 
@@ -118,11 +117,16 @@ class OutputScene {
   RTCScene scene_ = nullptr;
 };
 
+// Whether base face f is measured: all are without a mask (`faces` empty).
+bool counted(const std::vector<char>& faces, Eigen::Index f) {
+  return faces.empty() || faces[static_cast<size_t>(f)] != 0;
+}
+
 // Per base face (those counted): whether output geometry lies within the radius of its
 // centroid on its outer side (visit: the first triangle found ends the query).
 std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& output, RTCScene scene,
                                          double radius, double below,
-                                         const std::function<bool(Eigen::Index)>& counted) {
+                                         const std::vector<char>& faces) {
   std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
   const BoundingBox box = bounding_box(output.V);
   // Float bounds and a float query point: the radius handed to Embree is enlarged far above
@@ -132,7 +136,7 @@ std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& out
                        1e-30;
   const MatrixX3d N = face_normals(base.V, base.F);
   tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
-    if (!counted(f)) return;
+    if (!counted(faces, f)) return;
     Query q;
     q.output = &output;
     q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
@@ -168,21 +172,18 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
   MQ_CHECK(faces.empty() || static_cast<Eigen::Index>(faces.size()) == base.F.rows(), InvalidInput,
            "coverage: ", faces.size(), " mask flags for ", base.F.rows(), " faces");
   if (output.F.rows() == 0) return 0.0;
-  const auto counted = [&](Eigen::Index f) {
-    return faces.empty() || faces[static_cast<size_t>(f)] != 0;
-  };
   MQ_CHECK(output.V.allFinite(), InvalidInput, "coverage: the output has non-finite vertices");
   MQ_CHECK(output.F.minCoeff() >= 0 && output.F.maxCoeff() < output.V.rows(), InvalidInput,
            "coverage: an output face index is out of range");
   const EmbreeDevice device;
   const OutputScene scene(device, output);
   const std::vector<unsigned char> covered =
-      covered_faces(base, output, scene.get(), radius, below, counted);
+      covered_faces(base, output, scene.get(), radius, below, faces);
   const Eigen::VectorXd A = face_areas(base.V, base.F);
   // Summed in face order so the result does not depend on the thread count.
   double sum = 0, total = 0;
   for (Eigen::Index f = 0; f < base.F.rows(); ++f) {
-    if (!counted(f)) continue;
+    if (!counted(faces, f)) continue;
     total += A(f);
     if (covered[static_cast<size_t>(f)]) sum += A(f);
   }

@@ -607,13 +607,18 @@ std::vector<ThreadWeld> find_thread_welds(const std::vector<PlacedPiece>& placed
 
 namespace {
 
+// Whether placed piece k is dropped (none is when `dropped` is empty).
+bool is_dropped(const std::vector<char>& dropped, int k) {
+  return !dropped.empty() && dropped[static_cast<size_t>(k)] != 0;
+}
+
 // partner[2k + l]: the weld at piece k's loop l, between pieces both kept (-1: none).
 std::vector<int> weld_partners(int n, const std::vector<ThreadWeld>& welds,
-                               const std::function<bool(int)>& is_dropped) {
+                               const std::vector<char>& dropped) {
   std::vector<int> partner(static_cast<size_t>(2 * n), -1);
   for (size_t w = 0; w < welds.size(); ++w) {
     const ThreadWeld& x = welds[w];
-    if (is_dropped(x.a) || is_dropped(x.b)) continue;
+    if (is_dropped(dropped, x.a) || is_dropped(dropped, x.b)) continue;
     partner[static_cast<size_t>(2 * x.a + x.loop_a)] = static_cast<int>(w);
     partner[static_cast<size_t>(2 * x.b + x.loop_b)] = static_cast<int>(w);
   }
@@ -800,10 +805,7 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
                                          std::vector<std::vector<int>>* face_piece,
                                          int min_pieces) {
   const int n = static_cast<int>(placed.size());
-  const auto is_dropped = [&](int k) {
-    return !dropped.empty() && dropped[static_cast<size_t>(k)] != 0;
-  };
-  const std::vector<int> partner = weld_partners(n, welds, is_dropped);
+  const std::vector<int> partner = weld_partners(n, welds, dropped);
   ThreadWeldStats st;
   std::vector<SurfaceElement> out;
   if (face_piece) face_piece->clear();
@@ -812,7 +814,7 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
   // The vertex of the thread being built that each vertex of each of its pieces became.
   std::vector<std::vector<int>> map(static_cast<size_t>(n));
   for (int first = 0; first < n; ++first) {
-    if (is_dropped(first) || thread_of[first] >= 0) continue;
+    if (is_dropped(dropped, first) || thread_of[first] >= 0) continue;
     const int id = static_cast<int>(out.size());
     const std::vector<int> chain = thread_chain(first, id, partner, welds, thread_of);
     if (static_cast<int>(chain.size()) < min_pieces) {
@@ -832,7 +834,9 @@ std::vector<SurfaceElement> weld_threads(const std::vector<PlacedPiece>& placed,
     for (const int k : chain) std::vector<int>().swap(map[static_cast<size_t>(k)]);
   }
   for (const ThreadWeld& x : welds)
-    st.welds += is_dropped(x.a) || is_dropped(x.b) || !kept[static_cast<size_t>(x.a)] ? 0 : 1;
+    st.welds +=
+        is_dropped(dropped, x.a) || is_dropped(dropped, x.b) || !kept[static_cast<size_t>(x.a)] ? 0
+                                                                                                : 1;
   if (stats) *stats = st;
   return out;
 }

@@ -1098,7 +1098,14 @@ bool on_one_face(const Refinement& refinement, const SurfaceElement& e) {
 // tube radii).
 constexpr std::array<std::pair<double, double>, 8> kLeafMoves = {
     {{0, 0}, {0.15, 0}, {-0.15, 0}, {0.3, 0}, {-0.3, 0}, {0, 1}, {0.15, 1}, {-0.15, 1}}};
-constexpr double kLargestLeafShift = 0.3;
+// The farthest a leaf is moved along its stem, in leaf pitches.
+constexpr double largest_leaf_shift() {
+  double largest = 0;
+  for (const auto& [shift, push] : kLeafMoves)
+    largest = std::max(largest, shift < 0 ? -shift : shift);
+  return largest;
+}
+constexpr double kLargestLeafShift = largest_leaf_shift();
 
 void check_options(const VineGrowthOptions& o) {
   MQ_CHECK(o.up.allFinite() && o.up.norm() > 0, InvalidInput,
