@@ -181,6 +181,50 @@ bool elements_coincide(const Element& a, const Element& b, double tolerance,
   return all_within(a, b) && all_within(b, a);
 }
 
+namespace {
+
+// Why the stitched mesh is not one element as closed as its parents and manifold along the
+// seam (None when it is). One edge topology answers both seam checks; the parents' open edges
+// are counted only when the stitched element has any (closed elements, the common case, never
+// need them).
+StitchFailure seam_failure(const TriMesh& stitched, const Element& out, const Element& in) {
+  std::vector<int> fc;
+  if (connected_components(stitched.F, stitched.num_vertices(), fc) != 1)
+    return StitchFailure::NotOneComponent;
+  const EdgeTopology topo = edge_topology(stitched.F, stitched.num_vertices());
+  int boundary = 0, non_manifold = 0;
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    boundary += topo.is_boundary(e);
+    non_manifold += topo.is_non_manifold(e);
+  }
+  if (boundary > 0 && boundary > count_boundary_edges(out.F, static_cast<int>(out.V.rows())) +
+                                     count_boundary_edges(in.F, static_cast<int>(in.V.rows())))
+    return StitchFailure::OpenSeam;
+  if (non_manifold > 0) return StitchFailure::BadSeam;
+  return StitchFailure::None;
+}
+
+// Why the deformed merged element is refused (None when it is kept): it must stay within the
+// space of its two parents (a wrongly paired seam drags vertices far away) and must not pass
+// through itself.
+StitchFailure merged_failure(const Element& result, const Element& out, const Element& in,
+                             double mean_edge_length) {
+  const double slack = 2.0 * mean_edge_length;
+  const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
+  const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
+  if ((result.lo.array() < lo.array()).any() || (result.hi.array() > hi.array()).any() ||
+      result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
+      result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
+    return StitchFailure::Distorted;
+  IntersectionOptions all_pairs;
+  all_pairs.between_components_only = false;
+  if (!intersecting_face_pairs(result.V, result.F, all_pairs).empty())
+    return StitchFailure::SelfIntersecting;
+  return StitchFailure::None;
+}
+
+}  // namespace
+
 std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
                                       const OverlapRegion& region, double mean_edge_length,
                                       const MergeOptions& options, StitchFailure* failure,
@@ -223,21 +267,8 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
     return fail(StitchFailure::BadSeam);
   }
   if (!stitched) return fail(StitchFailure::LoopsUnpaired);
-  std::vector<int> fc;
-  if (connected_components(stitched->mesh.F, stitched->mesh.num_vertices(), fc) != 1)
-    return fail(StitchFailure::NotOneComponent);
-  // One edge topology answers both seam checks; the parents' open edges are counted only when
-  // the stitched element has any (closed elements, the common case, never need them).
-  const EdgeTopology topo = edge_topology(stitched->mesh.F, stitched->mesh.num_vertices());
-  int boundary = 0, non_manifold = 0;
-  for (int e = 0; e < topo.num_edges(); ++e) {
-    boundary += topo.is_boundary(e);
-    non_manifold += topo.is_non_manifold(e);
-  }
-  if (boundary > 0 && boundary > count_boundary_edges(out.F, static_cast<int>(out.V.rows())) +
-                                     count_boundary_edges(in.F, static_cast<int>(in.V.rows())))
-    return fail(StitchFailure::OpenSeam);
-  if (non_manifold > 0) return fail(StitchFailure::BadSeam);
+  if (const StitchFailure why = seam_failure(stitched->mesh, out, in); why != StitchFailure::None)
+    return fail(why);
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;
@@ -249,19 +280,9 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   result.F = stitched->mesh.F;
   result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
   result.update();
-  // The stitched element must stay within the space of its two parents (a wrongly paired seam
-  // drags vertices far away) and must not pass through itself.
-  const double slack = 2.0 * mean_edge_length;
-  const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
-  const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
-  if ((result.lo.array() < lo.array()).any() || (result.hi.array() > hi.array()).any() ||
-      result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
-      result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
-    return fail(StitchFailure::Distorted);
-  IntersectionOptions all_pairs;
-  all_pairs.between_components_only = false;
-  if (!intersecting_face_pairs(result.V, result.F, all_pairs).empty())
-    return fail(StitchFailure::SelfIntersecting);
+  if (const StitchFailure why = merged_failure(result, out, in, mean_edge_length);
+      why != StitchFailure::None)
+    return fail(why);
   return result;
 }
 

@@ -505,8 +505,75 @@ void add_parameter_area(const GlobalParameterization& gp, int num_faces, double&
   }
 }
 
-// The lattice of a tileable swatch carried onto the base (section 2's quilt of such a swatch is
-// its lattice tiling, core/planar/swatch_symmetry): every copy whose centre lies on the
+// The copies of the lattice over the parameterised surface: the orbit representatives (indices
+// into the swatch's elements), their centres in the plane and every copy, counted in faces
+// before anything is built (section 2's quilt of such a swatch is its lattice tiling).
+struct LatticeTiling {
+  std::vector<int> reps;
+  std::vector<Vector2d> centres;
+  std::vector<LatticeCopy> copies;
+};
+
+// The tiling, its size in gstats; refused over options.max_faces. Empty when the job only counts.
+LatticeTiling tile_lattice(const GlobalParameterization& gp, const SurfaceJob& job,
+                           const PreparedSwatch& swatch, const PreparedSwatch& full,
+                           const SwatchSymmetry& sym, const Vector2d& lo,
+                           const SurfaceQuiltingOptions& options, GlobalQuiltingStats& gstats) {
+  const double max_faces = options.max_faces;
+  LatticeTiling t;
+  // The orbits and their centres at full detail: a Preview places the same copies.
+  t.reps = orbit_representatives(full, sym);
+  gstats.orbits = static_cast<int>(t.reps.size());
+  for (const int r : t.reps) t.centres.push_back(element_centre(full.elements[r]) + lo);
+  t.copies = lattice_copies(gp, job.base.num_faces(), sym, t.centres);
+  double faces = 0;
+  for (const LatticeCopy& c : t.copies)
+    faces += static_cast<double>(swatch.elements[t.reps[c.rep]].F.rows());
+  gstats.layout_faces = faces;
+  if (options.global.count_only) return {};
+  MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", t.copies.size(),
+           " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
+           " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
+  add_parameter_area(gp, job.base.num_faces(), gstats.parameter_area);
+  return t;
+}
+
+// One copy P (the swatch element moved to its lattice place, centre `centre`, in face f's
+// chart) placed on the base as options.placement says: through the layout where the layout
+// keeps the element's shape (adaptive), else as a copy bent only by the surface (place_linear),
+// which sets `copied`. False when it cannot be placed on the surface.
+bool place_lattice_copy(const GlobalParameterization& gp, const SurfaceJob& job, const MatrixX3d& P,
+                        const Vector2d& centre, int f, const Eigen::MatrixXd& differential,
+                        double shell_height, const SurfaceQuiltingOptions::Global& options,
+                        SurfaceElement& s, bool& copied) {
+  using Placement = SurfaceQuiltingOptions::Global::Placement;
+  const Placement mode = options.placement;
+  // The layout's differential at the centre's face, or averaged over the element.
+  Eigen::Matrix<double, 2, 3> M;
+  M.row(0) = differential.row(f).head<3>();
+  M.row(1) = differential.row(f).tail<3>();
+  bool placed_ok = false, through_layout = false;
+  if (mode != Placement::kRigid) {
+    std::vector<signed char> turn;
+    placed_ok = through_layout = place_from(gp, job, P, f, shell_height, s, &turn);
+    if (placed_ok && mode == Placement::kAdaptive &&
+        !within_shape_limits(differential, P, s, turn, options, M))
+      placed_ok = false;
+  }
+  copied = false;
+  if (!placed_ok && mode != Placement::kLayout) {
+    SurfaceElement::Alternative layout_version;
+    if (through_layout)
+      layout_version = {std::move(s.face), std::move(s.barycentric), std::move(s.height)};
+    placed_ok =
+        place_linear(gp, job, M, P, centre, f, shell_height, mode == Placement::kRigid, options, s);
+    if (placed_ok) s.through_layout = std::move(layout_version);
+    copied = placed_ok;
+  }
+  return placed_ok;
+}
+
+// The lattice of a tileable swatch carried onto the base: every copy whose centre lies on the
 // parameterised surface, placed from the face holding its centre. The output is counted before
 // anything is built, and refused over max_faces.
 std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, const SurfaceJob& job,
@@ -515,27 +582,13 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
                                           const SurfaceQuiltingOptions& options,
                                           GlobalQuiltingStats& gstats, StageTimes& times,
                                           ProgressSink* progress) {
-  const double max_faces = options.max_faces;
-  std::vector<int> reps;
-  std::vector<Vector2d> centres;
-  std::vector<LatticeCopy> copies;
+  LatticeTiling tiling;
   {
     ScopedStage stage(times, progress, Stage::Tiling);
-    // The orbits and their centres at full detail: a Preview places the same copies.
-    reps = orbit_representatives(full, sym);
-    gstats.orbits = static_cast<int>(reps.size());
-    for (const int r : reps) centres.push_back(element_centre(full.elements[r]) + lo);
-    copies = lattice_copies(gp, job.base.num_faces(), sym, centres);
-    double faces = 0;
-    for (const LatticeCopy& c : copies)
-      faces += static_cast<double>(swatch.elements[reps[c.rep]].F.rows());
-    gstats.layout_faces = faces;
+    tiling = tile_lattice(gp, job, swatch, full, sym, lo, options, gstats);
     if (options.global.count_only) return {};
-    MQ_CHECK(faces <= max_faces, InvalidInput, "the global layout would place ", copies.size(),
-             " elements of about ", faces, " faces in all, more than the limit of ", max_faces,
-             " (--max-faces, or --max-memory at 400 bytes a face); use a larger --scale");
-    add_parameter_area(gp, job.base.num_faces(), gstats.parameter_area);
   }
+  const std::vector<LatticeCopy>& copies = tiling.copies;
   ScopedStage stage(times, progress, Stage::Placement);
   Eigen::Matrix2d basis;
   basis.col(0) = sym.a;
@@ -551,7 +604,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
     report_progress(progress, Stage::Placement, first, n);
     tbb::parallel_for(first, std::min(n, first + block), [&](int i) {
       const LatticeCopy& c = copies[static_cast<size_t>(i)];
-      const Element& e = swatch.elements[static_cast<size_t>(reps[c.rep])];
+      const Element& e = swatch.elements[static_cast<size_t>(tiling.reps[c.rep])];
       const Vector2d t = lo + basis * c.k.cast<double>();
       MatrixX3d P = e.V;
       P.col(0).array() += t.x();
@@ -559,31 +612,12 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
       SurfaceElement& s = out[static_cast<size_t>(i)];
       s.F = e.F;
       s.kind = e.kind;
-      const Vector2d centre = centres[static_cast<size_t>(c.rep)] + basis * c.k.cast<double>();
-      using Placement = SurfaceQuiltingOptions::Global::Placement;
-      const Placement mode = options.global.placement;
-      // The layout's differential at the centre's face, or averaged over the element.
-      Eigen::Matrix<double, 2, 3> M;
-      M.row(0) = differential.row(c.face).head<3>();
-      M.row(1) = differential.row(c.face).tail<3>();
-      bool placed_ok = false, through_layout = false;
-      if (mode != Placement::kRigid) {
-        std::vector<signed char> turn;
-        placed_ok = through_layout = place_from(gp, job, P, c.face, swatch.size.z(), s, &turn);
-        if (placed_ok && mode == Placement::kAdaptive &&
-            !within_shape_limits(differential, P, s, turn, options.global, M))
-          placed_ok = false;
-      }
-      if (!placed_ok && mode != Placement::kLayout) {
-        SurfaceElement::Alternative layout_version;
-        if (through_layout)
-          layout_version = {std::move(s.face), std::move(s.barycentric), std::move(s.height)};
-        placed_ok = place_linear(gp, job, M, P, centre, c.face, swatch.size.z(),
-                                 mode == Placement::kRigid, options.global, s);
-        if (placed_ok) s.through_layout = std::move(layout_version);
-        copied[static_cast<size_t>(i)] = placed_ok;
-      }
-      ok[static_cast<size_t>(i)] = placed_ok;
+      const Vector2d centre =
+          tiling.centres[static_cast<size_t>(c.rep)] + basis * c.k.cast<double>();
+      bool by_copy = false;
+      ok[static_cast<size_t>(i)] = place_lattice_copy(gp, job, P, centre, c.face, differential,
+                                                      swatch.size.z(), options.global, s, by_copy);
+      copied[static_cast<size_t>(i)] = by_copy;
     });
   }
   std::vector<SurfaceElement> placed;

@@ -7,6 +7,27 @@ namespace mq {
 
 namespace {
 
+// Moves `bary` along the unit direction t in the face of corners x (unit normal n, twice the
+// area two_a) for `distance`, or to where it leaves the face first (then `distance` is cut to
+// the way gone). Returns the corner opposite the edge it leaves by, -1 when it stays inside.
+int advance_in_face(const Vector3d (&x)[3], const Vector3d& n, double two_a, const Vector3d& t,
+                    Vector3d& bary, double& distance) {
+  // Barycentric coordinate k changes along t at the rate grad(b_k) . t.
+  double rate[3];
+  for (int k = 0; k < 3; ++k) rate[k] = n.cross(x[(k + 2) % 3] - x[(k + 1) % 3]).dot(t) / two_a;
+  int exit = -1;
+  for (int k = 0; k < 3; ++k)
+    if (rate[k] < 0) {
+      const double s = std::max(0.0, bary(k)) / -rate[k];
+      if (s < distance) {
+        distance = s;
+        exit = k;
+      }
+    }
+  for (int k = 0; k < 3; ++k) bary(k) += distance * rate[k];
+  return exit;
+}
+
 template <typename Position>
 bool walk(const Position& position, const MatrixX3i& F, const MatrixX3i& TT, int& face,
           Vector3d& bary, const Vector3d& t_in, int max_faces) {
@@ -27,20 +48,8 @@ bool walk(const Position& position, const MatrixX3i& F, const MatrixX3i& TT, int
   if (!(remaining > 0)) return true;
   t /= remaining;
   for (int step = 0; step < max_faces; ++step) {
-    // Barycentric coordinate k changes along t at the rate grad(b_k) . t.
-    double rate[3];
-    for (int k = 0; k < 3; ++k) rate[k] = n.cross(x[(k + 2) % 3] - x[(k + 1) % 3]).dot(t) / two_a;
-    int exit = -1;
     double s_exit = remaining;
-    for (int k = 0; k < 3; ++k)
-      if (rate[k] < 0) {
-        const double s = std::max(0.0, bary(k)) / -rate[k];
-        if (s < s_exit) {
-          s_exit = s;
-          exit = k;
-        }
-      }
-    for (int k = 0; k < 3; ++k) bary(k) += s_exit * rate[k];
+    const int exit = advance_in_face(x, n, two_a, t, bary, s_exit);
     if (exit < 0) {
       bary = bary.cwiseMax(0.0);
       bary /= bary.sum();
