@@ -11,4 +11,12 @@ namespace mq {
 // one point the scale is 1. Preconditions: equal row counts, finite values. Throws nothing.
 MatrixX3d similarity_fit(const MatrixX3d& from, const MatrixX3d& to);
 
+// The rotation R nearest to the cross-covariance C = sum_i b_i a_i^T of centred corresponding
+// points a_i (from) and b_i (to): R maximises trace(R^T C), so R a_i best fits b_i (Kabsch; a
+// reflection is replaced by the nearest rotation). `singular` (optional) receives the
+// singular values of C with the reflection's sign applied, whose sum is the fit's covariance for
+// the scale. Throws nothing.
+Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& cross_covariance,
+                                 Vector3d* singular = nullptr);
+
 }  // namespace mq

@@ -10,6 +10,7 @@
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
+#include "core/mesh/similarity_fit.h"
 #include "core/shell/element_editing.h"
 
 namespace mq {
@@ -20,16 +21,6 @@ void FollowBaseOptions::validate() const {
 }
 
 namespace {
-
-// The rotation R minimising sum |R (p_i - cp) - (q_i - cq)|^2 (Kabsch; a reflection is
-// replaced by the nearest rotation).
-Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& covariance) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
-                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  return svd.matrixV() * D * svd.matrixU().transpose();
-}
 
 // Intersection tests among the elements of `out` near a few active ones: the faces of the
 // active elements and of those whose boxes overlap theirs, not the whole output.
@@ -240,8 +231,8 @@ void place_element(const SavedQuilt& saved, const MatrixX3d& V, const MatrixX3d&
   }
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   for (size_t i = 0; i < vs.size(); ++i)
-    covariance += (P.row(vs[i]).transpose() - cp) * (q[i] - cq).transpose();
-  const Eigen::Matrix3d R = best_rotation(covariance);
+    covariance += (q[i] - cq) * (P.row(vs[i]).transpose() - cp).transpose();
+  const Eigen::Matrix3d R = nearest_rotation(covariance);
   double largest = 0;
   for (size_t i = 0; i < vs.size(); ++i) {
     const Vector3d x = R * (P.row(vs[i]).transpose() - cp) + cq;
