@@ -216,6 +216,10 @@ void declare_surface_options(CommandLine& cl) {
             ">= 0.5), or a first line 'faces' and then one 0-based face index per line; '#' "
             "lines are comments. Whole elements are kept or dropped (by where most of their "
             "vertices lie); coverage is judged over the mask");
+  cl.option("size-map", "FILE",
+            "vary the element size: one factor per base vertex (1: the size --scale or "
+            "--element-size sets; the largest at most 8 times the smallest), followed smoothly "
+            "by the global layout (lattices and threads: --method auto or global)");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");
@@ -377,6 +381,7 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
     throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
                      std::to_string(diagonal));
   if (cl.has("mask")) in.mask = read_surface_mask(cl.get("mask"), base);
+  if (cl.has("size-map")) options.size_map = read_size_map(cl.get("size-map"), base);
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),
                      cl.get_double("field", 2));

@@ -100,6 +100,15 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Mask", default="",
         description="A vertex group of the base: texture only where its weight is 0.5 or more, "
         "whole elements kept at the border (empty: the whole base)")
+    size_group: bpy.props.StringProperty(
+        name="Size", default="",
+        description="A vertex group of the base: elements at the full size where its weight is "
+        "1, at Smallest where it is 0 (or the vertex is not in it); chain mail and weave only "
+        "(empty: one size)")
+    smallest_size: bpy.props.FloatProperty(
+        name="Smallest", default=0.5, min=0.125, max=1.0, subtype="FACTOR",
+        description="The element size where the Size group's weight is 0, as a share of the "
+        "full size")
     keep_results: bpy.props.BoolProperty(
         name="Keep earlier results", default=False,
         description="Run adds its result beside the base's earlier one instead of replacing "
@@ -119,8 +128,8 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
 
 def estimate_key(context, settings):
     """The settings an estimate depends on, as a string cheap enough for draw(): the base (its
-    mesh's size, modifiers and placement), the swatch, scale, seed, guidance, detail, mask and
-    the limit."""
+    mesh's size, modifiers and placement), the swatch, scale, seed, guidance, detail, mask, size
+    group and the limit."""
     base = settings.base
     if base is None or base.type != "MESH":
         return ""
@@ -133,7 +142,8 @@ def estimate_key(context, settings):
     else:
         parts += ["sample", settings.sample]
     parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed,
-              settings.stretch, settings.guidance, settings.detail, settings.mask_group]
+              settings.stretch, settings.guidance, settings.detail, settings.mask_group,
+              settings.size_group, round(settings.smallest_size, 4)]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -328,6 +338,11 @@ class Run:
         if settings.mask_group:
             mask_file = os.path.join(self.dir, "mask.txt")
             self._export_mask(depsgraph, base, settings.mask_group, mask_file, len(V))
+        size_file = None
+        if settings.size_group:
+            size_file = os.path.join(self.dir, "sizes.txt")
+            self._export_sizes(depsgraph, base, settings.size_group, settings.smallest_size,
+                               size_file, len(V))
         self.jobs = []
         self.material_names = {}  # the engine's kind name -> the swatch's material name
         self.swatch_name = settings.swatch.name if settings.swatch_source == "OBJECT" else \
@@ -346,7 +361,8 @@ class Run:
         self.elements_path = os.path.join(self.dir, "elements.csv")
         self.options = dict(seed=settings.seed, stretch=settings.stretch, field=field,
                             field_file=field_file, max_memory=self.max_memory,
-                            element_size=self.element_size, detail=self.detail, mask=mask_file)
+                            element_size=self.element_size, detail=self.detail, mask=mask_file,
+                            size_map=size_file)
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.result_path, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
@@ -404,13 +420,13 @@ class Run:
         np.savetxt(path, vectors, fmt="%.9g")
 
     @staticmethod
-    def _export_mask(depsgraph, obj, name, path, count):
+    def _group_weights(depsgraph, obj, name, count, setting):
         """The weights of the vertex group `name` of the evaluated base, one per exported
-        vertex (0 where a vertex is not in the group), as the engine's --mask file."""
+        vertex (0 where a vertex is not in the group); `setting` names the panel's row."""
         group = obj.vertex_groups.get(name)
         if group is None:
-            raise engine.EngineError("%s has no vertex group named '%s' (the Mask)"
-                                     % (obj.name, name))
+            raise engine.EngineError("%s has no vertex group named '%s' (the %s)"
+                                     % (obj.name, name, setting))
         evaluated = obj.evaluated_get(depsgraph)
         me = evaluated.to_mesh()
         try:
@@ -423,14 +439,28 @@ class Run:
         finally:
             evaluated.to_mesh_clear()
         if len(weights) != count:
-            raise engine.EngineError("the Mask has %d weights for %d vertices"
-                                     % (len(weights), count))
+            raise engine.EngineError("the %s has %d weights for %d vertices"
+                                     % (setting, len(weights), count))
+        return np.clip(weights, 0.0, 1.0)
+
+    @staticmethod
+    def _export_mask(depsgraph, obj, name, path, count):
+        """The Mask group's weights as the engine's --mask file."""
+        weights = Run._group_weights(depsgraph, obj, name, count, "Mask")
         if not (weights >= 0.5).any():
             raise engine.EngineError(
                 "the Mask '%s' sets no vertex of %s (no weight of 0.5 or more): assign vertices "
                 "to it with a weight of 0.5 or more, or clear Mask" % (name, obj.name))
-        np.savetxt(path, np.clip(weights, 0.0, 1.0), fmt="%.6g",
+        np.savetxt(path, weights, fmt="%.6g",
                    header="meshquilt mask: vertex group '%s' of %s" % (name, obj.name))
+
+    @staticmethod
+    def _export_sizes(depsgraph, obj, name, smallest, path, count):
+        """The Size group's weights w as the engine's --size-map file: smallest + (1 -
+        smallest) w per vertex (the full size at weight 1)."""
+        weights = Run._group_weights(depsgraph, obj, name, count, "Size group")
+        np.savetxt(path, smallest + (1.0 - smallest) * weights, fmt="%.6g",
+                   header="meshquilt size map: vertex group '%s' of %s" % (name, obj.name))
 
     def artist_message(self, error):
         """The engine's error in the panel's terms for this run's objects and settings."""
@@ -1079,6 +1109,9 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             layout.prop(s, "guide_attribute")
         if s.base is not None and s.base.type == "MESH":
             _labelled(layout, s, "mask_group", "Mask", search=(s.base, "vertex_groups"))
+            _labelled(layout, s, "size_group", "Size", search=(s.base, "vertex_groups"))
+            if s.size_group:
+                _labelled(layout, s, "smallest_size", "Smallest")
         layout.prop(s, "stretch")
         layout.prop(s, "seed")
         layout.prop(s, "keep_results")

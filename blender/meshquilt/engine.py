@@ -280,7 +280,7 @@ def swatch_job(engine, kind, output, seed=1):
 
 def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
                  field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None,
-                 element_size=0.0, detail=1.0, mask=None):
+                 element_size=0.0, detail=1.0, mask=None, size_map=None):
     """The arguments of a surface job (surface_job; estimate with the same settings); an
     element_size > 0 (the swatch's longer side in the base's units) replaces the scale; a
     detail below 1 keeps that share of each swatch element's faces (the same layout)."""
@@ -304,6 +304,8 @@ def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
         args += ["--field-file", field_file]
     if mask:
         args += ["--mask", mask]
+    if size_map:
+        args += ["--size-map", size_map]
     return args
 
 
@@ -313,7 +315,8 @@ def surface_job(engine, base, swatch, output, scale, **options):
     also saves the result over the base (.mqq) for embed_job; `max_memory` (GiB) refuses a
     larger job before any work; `stats` writes the run's figures as JSON; `detail` in (0, 1]
     keeps that share of each swatch element's faces; `mask` a file of one weight per base
-    vertex (the texture only where it is 0.5 or more)."""
+    vertex (the texture only where it is 0.5 or more); `size_map` a file of one element size
+    factor per base vertex."""
     return Job(engine, surface_args(base, swatch, output, scale, **options),
                detail=options.get("detail", 1.0))
 
@@ -418,6 +421,11 @@ def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch"
             cause = "the elements are too large for its parts"
         return ("meshquilt: %s only %.0f%% of %s would be covered (%.0f%% needed): %s; %s; "
                 "nothing was added" % (at, got, base, needed, cause, smaller))
+    if text.startswith("a size map is followed by the global layout only"):
+        return ("meshquilt: the Size group varies chain mail and weave (lattices of elements "
+                "and threads), not %s: clear Size in the panel" % swatch)
+    if text.startswith("the size map's largest value"):
+        return "meshquilt: the Size group's sizes are too far apart: raise Smallest in the panel"
     if text.startswith("no element of the swatch could be placed"):
         return "meshquilt: %s no element of the swatch fits on %s: %s" % (at, base, smaller)
     if re.match(r"all [0-9]+ elements placed were removed", text):

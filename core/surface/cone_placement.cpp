@@ -1,5 +1,6 @@
 #include "core/surface/cone_placement.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <queue>
 
@@ -42,7 +43,8 @@ void move_cones(const TrivialConnection& solver, const Adjacency& adj,
   for (int round = 0; round < options.max_rounds && reach >= 1; ++round) {
     // dE/dk_v = 2 (P (A u))_v, P the inverse of the factorised -Delta, k_v the curvature at v:
     // moving a cone of curvature c from v to w changes E by about 2 c (s_w - s_v).
-    const Eigen::VectorXd s = solver.solve_poisson(solver.vertex_area().cwiseProduct(u));
+    const Eigen::VectorXd s = solver.solve_poisson(solver.vertex_area().cwiseProduct(
+        options.target.size() ? misfit(solver, u, options.target) : u));
     std::vector<int> next = index;
     int moved = 0, cancelled = 0;
     for (int v = 0; v < nv; ++v) {
@@ -67,7 +69,7 @@ void move_cones(const TrivialConnection& solver, const Adjacency& adj,
     }
     if (moved == 0) break;
     const Eigen::VectorXd u_next = solver.log_scale(next);
-    const double e_next = scale_energy(solver, u_next);
+    const double e_next = scale_energy(solver, u_next, options.target);
     ++rep.rounds;
     if (e_next < energy) {
       index = std::move(next);
@@ -83,10 +85,32 @@ void move_cones(const TrivialConnection& solver, const Adjacency& adj,
 
 }  // namespace
 
-double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u) {
+Eigen::VectorXd misfit(const TrivialConnection& solver, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& target) {
+  // Per component, less its area-weighted mean: the overall size is the normalisation's
+  // (core/surface/global_quilting), and a cone cannot move u's mean on a closed component.
+  Eigen::VectorXd d = u - target;
+  const std::vector<int>& component = solver.vertex_component();
+  const Eigen::VectorXd& a = solver.vertex_area();
+  const int nc = d.size() ? *std::max_element(component.begin(), component.end()) + 1 : 0;
+  std::vector<double> sum(static_cast<size_t>(nc), 0), area(static_cast<size_t>(nc), 0);
+  for (Eigen::Index v = 0; v < d.size(); ++v) {
+    sum[component[v]] += a(v) * d(v);
+    area[component[v]] += a(v);
+  }
+  for (Eigen::Index v = 0; v < d.size(); ++v)
+    if (area[component[v]] > 0) d(v) -= sum[component[v]] / area[component[v]];
+  return d;
+}
+
+double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u,
+                    const Eigen::VectorXd& target) {
   const Eigen::VectorXd& a = solver.vertex_area();
   const double total = a.sum();
-  return total > 0 ? a.dot(u.cwiseProduct(u)) / total : 0.0;
+  if (!(total > 0)) return 0.0;
+  if (target.size() == 0) return a.dot(u.cwiseProduct(u)) / total;
+  const Eigen::VectorXd d = misfit(solver, u, target);
+  return a.dot(d.cwiseProduct(d)) / total;
 }
 
 std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> index,
@@ -97,6 +121,8 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
            "cone placement: ", nv, " indices for ", solver.interior().size(), " vertices");
   MQ_CHECK(options.max_rounds >= 0 && options.reach >= 1, InvalidInput,
            "cone placement: max_rounds must be >= 0 and reach >= 1");
+  MQ_CHECK(options.target.size() == 0 || options.target.size() == nv, InvalidInput,
+           "cone placement: ", options.target.size(), " target scales for ", nv, " vertices");
   ConePlacementReport rep;
   const std::vector<char>& interior = solver.interior();
   std::vector<int> stamp(static_cast<size_t>(nv), -1);
@@ -120,7 +146,7 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
     }
   }
   Eigen::VectorXd u = solver.log_scale(index);
-  double energy = scale_energy(solver, u);
+  double energy = scale_energy(solver, u, options.target);
   rep.energy_before = energy;
   move_cones(solver, adj, options, index, u, energy, stamp, mark, rep);
   rep.energy_after = energy;

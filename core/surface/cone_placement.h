@@ -22,6 +22,10 @@ namespace mq {
 struct ConePlacementOptions {
   int max_rounds = 40;  // rounds of moves (each: two Poisson solves)
   int reach = 3;        // a cone moves at most this many edges per round
+  // #V log scale the metric should have (a size map's, issue 25: the layout's scale is the
+  // inverse of the element size); empty: 0, the surface's own size everywhere. E then measures
+  // u - target.
+  Eigen::VectorXd target;
 };
 
 struct ConePlacementReport {
@@ -35,7 +39,8 @@ struct ConePlacementReport {
 // Splits every cone of |index| > 1 into unit cones (on the vertex and its nearest interior
 // neighbours), then moves cones one interior vertex ring at a time towards lower
 // E = sum_v A_v u_v^2 (first order in the sensitivity G (A u), checked by a solve after each
-// round: a round that does not lower E is undone and the reach halved). A + and a - cone that
+// round: a round that does not lower E is undone and the reach halved), u taken against
+// options.target when one is given. A + and a - cone that
 // meet cancel. The indices keep their sums per component. Deterministic.
 //   solver  the factorised trivial connection of the mesh
 //   index   #V indices (units of 1/N turn), admissible for solver
@@ -45,7 +50,14 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
                              const ConePlacementOptions& options = {},
                              ConePlacementReport* report = nullptr);
 
-// E = sum_v A_v u_v^2 / sum_v A_v: the mean squared log scale of a cone metric.
-double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u);
+// u - target (#V each), less its area-weighted mean on each component: the part of a size map's
+// scale a cone metric misses.
+Eigen::VectorXd misfit(const TrivialConnection& solver, const Eigen::VectorXd& u,
+                       const Eigen::VectorXd& target);
+
+// E = sum_v A_v u_v^2 / sum_v A_v: the mean squared log scale of a cone metric (u minus the
+// target's log scale, when one is given and non-empty, #V).
+double scale_energy(const TrivialConnection& solver, const Eigen::VectorXd& u,
+                    const Eigen::VectorXd& target = {});
 
 }  // namespace mq

@@ -91,9 +91,11 @@ bool share_wedge(const GlobalParameterization& gp, int f, int g) {
 // the base from face f0, vertex by vertex, each walk starting where the previous one ended.
 // False when a vertex lies beyond a boundary or around a singular vertex. turn (optional)
 // receives per vertex the sign of the chart transition from f0's chart to its face's (+1, or -1
-// across a half turn).
+// across a half turn). Heights are scaled by height_scale (a size map's nominal size: the
+// element's width follows the layout, its thickness this).
 bool place_from(const GlobalParameterization& gp, const SurfaceJob& job, const MatrixX3d& P, int f0,
-                double shell_height, SurfaceElement& s, std::vector<signed char>* turn = nullptr) {
+                double shell_height, SurfaceElement& s, std::vector<signed char>* turn = nullptr,
+                double height_scale = 1) {
   s.face.resize(P.rows());
   s.barycentric.resize(P.rows(), 3);
   s.height.resize(P.rows());
@@ -106,7 +108,7 @@ bool place_from(const GlobalParameterization& gp, const SurfaceJob& job, const M
       return false;
     s.face[v] = face;
     s.barycentric.row(v) = b.transpose();
-    s.height(v) = std::clamp(P(v, 2), 0.0, shell_height);
+    s.height(v) = std::clamp(height_scale * P(v, 2), 0.0, shell_height);
     if (turn) turn->push_back(static_cast<signed char>(to_current.sigma));
   }
   s.flat = P;
@@ -149,7 +151,7 @@ Eigen::MatrixXd layout_differential(const GlobalParameterization& gp, const TriM
 bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P,
                          const SurfaceElement& s, const std::vector<signed char>& turn,
                          const SurfaceQuiltingOptions::Global& options,
-                         Eigen::Matrix<double, 2, 3>& mean) {
+                         Eigen::Matrix<double, 2, 3>& mean, double nominal = 1) {
   if (s.face.empty()) return true;
   // The halves: either side of the centre along the footprint's x or y, whichever is longer.
   const Eigen::RowVector2d lo = P.leftCols<2>().colwise().minCoeff(),
@@ -184,7 +186,8 @@ bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P
     const double a = scale_of(sum[0] / count[0], nullptr), b = scale_of(sum[1] / count[1], nullptr);
     even = std::max(a, b) <= options.max_element_variation * std::min(a, b);
   }
-  return element_scale <= options.max_element_scale && aspect <= options.max_element_aspect && even;
+  return element_scale / nominal <= options.max_element_scale &&
+         aspect <= options.max_element_aspect && even;
 }
 
 // The element as the layout's first-order image at its centre, bent only by the surface: its
@@ -192,13 +195,15 @@ bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P
 // through the inverse of the layout's differential M (2 by 3, plane per surface unit), is walked
 // along the surface as a straightest geodesic. Where M is far from a similarity (aspect over
 // max_element_aspect) only its rotation and mean scale are kept; the scale makes the element
-// 1 / sqrt(s1 s2) times the swatch's, clamped to [1 / max_element_scale, max_element_scale]. So
+// 1 / sqrt(s1 s2) times the swatch's, clamped to [1 / max_element_scale, max_element_scale]
+// times the nominal size (a size map's, else 1; within_shape_limits' scale is against it too). So
 // an element keeps its place among neighbours laid out through the layout to first order (its
 // links), and loses only the layout's variation across it (a teardrop's) and extreme sizes.
 bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
                   const Eigen::Matrix<double, 2, 3>& M, const MatrixX3d& P, const Vector2d& centre,
                   int f, double shell_height, bool similarity,
-                  const SurfaceQuiltingOptions::Global& options, SurfaceElement& s) {
+                  const SurfaceQuiltingOptions::Global& options, SurfaceElement& s,
+                  double nominal = 1) {
   const MatrixX3i& F = job.base.F;
   // Thin V needs a dynamic column count (Eigen asserts it; a fixed 2 x 3 is refused).
   const Eigen::JacobiSVD<Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, 3>> svd(
@@ -207,8 +212,8 @@ bool place_linear(const GlobalParameterization& gp, const SurfaceJob& job,
   if (!(sv(1) > 0)) return false;
   const double sigma = std::sqrt(sv(0) * sv(1));
   if (similarity || sv(0) > options.max_element_aspect * sv(1)) sv.setConstant(sigma);
-  const double k =
-      std::clamp(1.0 / sigma, 1.0 / options.max_element_scale, options.max_element_scale);
+  const double k = std::clamp(1.0 / sigma, nominal / options.max_element_scale,
+                              nominal * options.max_element_scale);
   // Plane offset -> surface offset: V diag(1 / sv) U^T, rescaled to the clamped size.
   const Eigen::Matrix<double, 3, 2> inverse =
       (k * sigma) * svd.matrixV() * sv.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
@@ -396,6 +401,14 @@ double log_mean_scale(const GlobalParameterization& gp, const TriMesh& base) {
   return total > 0 ? std::exp(sum / total) : 1.0;
 }
 
+// The area-weighted mean over job.base of log nominal_size.
+double mean_log_size(const SurfaceJob& job) {
+  const Eigen::VectorXd area = face_areas(job.base.V, job.base.F);
+  double sum = 0;
+  for (int f = 0; f < job.base.num_faces(); ++f) sum += area(f) * std::log(nominal_size(job, f));
+  return area.sum() > 0 ? sum / area.sum() : 0.0;
+}
+
 // Nearest point of offset + lattice(a, b) to x.
 Vector2d nearest_symmetry(const SwatchSymmetry& sym, const Vector2d& x, const Vector2d& offset) {
   Eigen::Matrix2d basis;
@@ -420,7 +433,9 @@ GlobalParameterization seamless_parameterization(const MatrixX3d& V, const TriMe
   GlobalParameterizationOptions go;
   go.face_scale = face_scale;
   GlobalParameterization gp = global_parameterization(V, base.F, job.topo, job.TT, df, go);
-  const double sigma = face_scale.size() ? log_mean_scale(gp, base) : median_scale(gp, base);
+  double sigma = face_scale.size() ? log_mean_scale(gp, base) : median_scale(gp, base);
+  // A size map's mean (relative to the swatch, at the largest size) is kept, not normalised.
+  if (job.log_size.size()) sigma *= std::exp(mean_log_size(job));
   gp.wedge_uv /= sigma;
   go.target_scale = 1.0 / sigma;
   stats.scale_correction = 1.0 / sigma;
@@ -553,11 +568,13 @@ bool place_lattice_copy(const GlobalParameterization& gp, const SurfaceJob& job,
   M.row(0) = differential.row(f).head<3>();
   M.row(1) = differential.row(f).tail<3>();
   bool placed_ok = false, through_layout = false;
+  // The size the size map asks for here (1 without one): the limits are taken against it.
+  const double nominal = nominal_size(job, f);
   if (mode != Placement::kRigid) {
     std::vector<signed char> turn;
-    placed_ok = through_layout = place_from(gp, job, P, f, shell_height, s, &turn);
+    placed_ok = through_layout = place_from(gp, job, P, f, shell_height, s, &turn, nominal);
     if (placed_ok && mode == Placement::kAdaptive &&
-        !within_shape_limits(differential, P, s, turn, options, M))
+        !within_shape_limits(differential, P, s, turn, options, M, nominal))
       placed_ok = false;
   }
   copied = false;
@@ -565,8 +582,8 @@ bool place_lattice_copy(const GlobalParameterization& gp, const SurfaceJob& job,
     SurfaceElement::Alternative layout_version;
     if (through_layout)
       layout_version = {std::move(s.face), std::move(s.barycentric), std::move(s.height)};
-    placed_ok =
-        place_linear(gp, job, M, P, centre, f, shell_height, mode == Placement::kRigid, options, s);
+    placed_ok = place_linear(gp, job, M, P, centre, f, shell_height, mode == Placement::kRigid,
+                             options, s, nominal);
     if (placed_ok) s.through_layout = std::move(layout_version);
     copied = placed_ok;
   }
@@ -663,7 +680,7 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
         SurfaceElement s;
         s.F = part.F;
         s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
-        if (place_from(gp, job, part.V, f0, shell_height, s))
+        if (place_from(gp, job, part.V, f0, shell_height, s, nullptr, nominal_size(job, f0)))
           per[c].push_back(std::move(s));
         else
           ++off[c];
@@ -772,10 +789,12 @@ class ThreadPiecePlacer {
     s.F = piece.F;
     s.kind = piece.kind;
     std::vector<signed char> turn;
-    if (!place_from(gp_, job_, P, c.face, shell_height_, s, &turn)) return kPieceOff;
+    const double nominal = nominal_size(job_, c.face);
+    if (!place_from(gp_, job_, P, c.face, shell_height_, s, &turn, nominal)) return kPieceOff;
     s.flat.resize(0, 3);  // a thread has no rigid shape to fall back to
     Eigen::Matrix<double, 2, 3> M;
-    if (!within_shape_limits(differential_, P, s, turn, limits_, M)) return kPieceDistorted;
+    if (!within_shape_limits(differential_, P, s, turn, limits_, M, nominal))
+      return kPieceDistorted;
     X.resize(P.rows(), 3);
     for (Eigen::Index v = 0; v < P.rows(); ++v)
       X.row(v) = displace_along_normal(job_.base, N_, s.face[static_cast<size_t>(v)],
@@ -982,8 +1001,11 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
   const TrivialConnection connection(base.V, base.F, job.topo, job.TT, df.N);
   if (connection.unbalanced_component(df.index) >= 0) return false;
   ConePlacementReport report;
-  const std::vector<int> cones =
-      place_cones(connection, df.index, vertex_adjacency(base.F, base.num_vertices()), {}, &report);
+  ConePlacementOptions placement;
+  // A size map: the layout's scale is the inverse of the element size.
+  if (job.log_size.size()) placement.target = -job.log_size;
+  const std::vector<int> cones = place_cones(
+      connection, df.index, vertex_adjacency(base.F, base.num_vertices()), placement, &report);
   gstats.split_poles = report.split_poles;
   gstats.cone_moves = report.moves;
   gstats.scale_energy_before = report.energy_before;
@@ -1000,11 +1022,17 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
   const double E = report.energy_after;
   gstats.scale_exponent =
       E > 0 ? std::min(1.0, std::sqrt(std::log(options.max_overfill) / (2 * E))) : 1.0;
+  // With a size map the part of u that misses it (r) is what is followed only partly: the
+  // scale is e^(u - (1 - a) r), e^u where a = 1.
+  const double a = gstats.scale_exponent;
+  Eigen::VectorXd log_scale = metric.u;
+  if (placement.target.size())
+    log_scale -= (1 - a) * misfit(connection, metric.u, placement.target);
+  const double factor = placement.target.size() ? 1.0 : a;
   face_scale.resize(base.num_faces());
   for (int f = 0; f < base.num_faces(); ++f)
-    face_scale(f) =
-        std::exp(gstats.scale_exponent *
-                 (metric.u(base.F(f, 0)) + metric.u(base.F(f, 1)) + metric.u(base.F(f, 2))) / 3);
+    face_scale(f) = std::exp(
+        factor * (log_scale(base.F(f, 0)) + log_scale(base.F(f, 1)) + log_scale(base.F(f, 2))) / 3);
   return true;
 }
 
@@ -1028,8 +1056,13 @@ GlobalParameterization global_layout(const SurfaceJob& job, const SwatchSymmetry
   DirectionField df = layout_line_field(smoothed, job, options, gstats);
   Eigen::VectorXd face_scale;
   const MatrixX3d* layout_V = &smoothed;
-  if (options.conformal && conformal_layout_field(job, options, df, face_scale, gstats))
+  if (options.conformal && conformal_layout_field(job, options, df, face_scale, gstats)) {
     layout_V = &base.V;
+  } else if (job.log_size.size()) {
+    // Without the cone metric the field is not made parallel for it: followed by least squares.
+    face_scale.resize(base.num_faces());
+    for (int f = 0; f < base.num_faces(); ++f) face_scale(f) = 1 / nominal_size(job, f);
+  }
   return seamless_parameterization(*layout_V, base, job, df, face_scale, symmetry, options.seamless,
                                    anchor, gstats);
 }

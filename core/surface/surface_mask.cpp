@@ -85,6 +85,34 @@ SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base) {
   return parse_surface_mask(read_input_file(path, "mask file", std::size_t{1} << 30), path, base);
 }
 
+Eigen::VectorXd parse_size_map(const std::string& text, const std::string& name,
+                               const TriMesh& base) {
+  std::vector<double> sizes;
+  int line = 0;
+  for (std::size_t at = 0; at <= text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string s = trimmed(text.substr(at, end - at));
+    at = end + 1;
+    ++line;
+    if (s.empty() || s[0] == '#') continue;
+    char* stop = nullptr;
+    const double size = std::strtod(s.c_str(), &stop);
+    MQ_CHECK(stop == s.c_str() + s.size() && std::isfinite(size) && size > 0, InvalidInput, name,
+             ":", line, ": expected a positive element size factor, got '", s, "'");
+    MQ_CHECK(static_cast<int>(sizes.size()) < base.num_vertices(), InvalidInput, name, ":", line,
+             ": more sizes than the base's ", base.num_vertices(), " vertices");
+    sizes.push_back(size);
+  }
+  MQ_CHECK(static_cast<int>(sizes.size()) == base.num_vertices(), InvalidInput, name, ": ",
+           sizes.size(), " sizes for the base's ", base.num_vertices(), " vertices");
+  return Eigen::Map<const Eigen::VectorXd>(sizes.data(), static_cast<Eigen::Index>(sizes.size()));
+}
+
+Eigen::VectorXd read_size_map(const std::string& path, const TriMesh& base) {
+  return parse_size_map(read_input_file(path, "size map", std::size_t{1} << 30), path, base);
+}
+
 double masked_area_share(const SurfaceMask& mask, const TriMesh& base) {
   const Eigen::VectorXd area = face_areas(base.V, base.F);
   const Vector3d samples[4] = {Vector3d::Constant(1.0 / 3), Vector3d(2.0 / 3, 1.0 / 6, 1.0 / 6),

@@ -207,6 +207,16 @@ void validate_surface_options(const SurfaceQuiltingOptions& options, const TriMe
   MQ_CHECK(options.field.rows() == 0 || options.field.rows() == base_in.num_faces(), InvalidInput,
            "the guidance field has ", options.field.rows(), " vectors for ", base_in.num_faces(),
            " base faces");
+  const Eigen::VectorXd& size = options.size_map;
+  if (size.size() == 0) return;
+  MQ_CHECK(size.size() == base_in.num_vertices(), InvalidInput, "the size map has ", size.size(),
+           " values for ", base_in.num_vertices(), " base vertices");
+  MQ_CHECK(size.allFinite() && size.minCoeff() > 0, InvalidInput,
+           "the size map's values must be positive and finite");
+  MQ_CHECK(size.maxCoeff() <= SurfaceQuiltingOptions::kMaxSizeMapRange * size.minCoeff(),
+           InvalidInput, "the size map's largest value is ", size.maxCoeff() / size.minCoeff(),
+           " times its smallest, more than ", SurfaceQuiltingOptions::kMaxSizeMapRange,
+           " (neighbouring elements of sizes so far apart cannot keep their links)");
 }
 
 // job.cleaned and job.input_vertex from the base as given; returns, per face of job.cleaned,
@@ -225,6 +235,20 @@ std::vector<int> clean_base(const TriMesh& base_in, const SurfaceQuiltingOptions
   return input_face;
 }
 
+// The base's area, each face's weighted by the mean over its corners of 1 / size^2 when a size
+// map is given (elements of half the size are four times as many).
+double size_weighted_area(const TriMesh& base_in, const Eigen::VectorXd& size_map) {
+  const Eigen::VectorXd area = face_areas(base_in.V, base_in.F);
+  if (size_map.size() == 0) return area.sum();
+  double sum = 0;
+  for (int f = 0; f < base_in.num_faces(); ++f) {
+    double w = 0;
+    for (int k = 0; k < 3; ++k) w += 1 / (size_map(base_in.F(f, k)) * size_map(base_in.F(f, k)));
+    sum += area(f) * w / 3;
+  }
+  return sum;
+}
+
 // The swatch's scale on the surface (section 3.1's relative size s), and the output estimated
 // before any work: the swatch's faces per unit of footprint area at that scale, over the base's
 // area (issue 14: --scale 1e-6 ran out of memory). Throws InvalidInput over options.max_faces.
@@ -240,8 +264,11 @@ void scale_within_estimate(const TriMesh& base_in, const TriMesh& swatch_mesh,
   const double k = job.swatch_scale;
   const double footprint = std::max(swatch_sides(1) * swatch_sides(2), 1e-300) * k * k;
   const double faces = static_cast<double>(swatch_mesh.num_faces()) *
-                       face_areas(base_in.V, base_in.F).sum() / footprint;
+                       size_weighted_area(base_in, options.size_map) / footprint;
   stats.estimated_faces = faces;
+  // The swatch (and so the shell) at the largest size the map asks for; smaller elements are
+  // made smaller copies (SurfaceJob::log_size is relative to it).
+  if (options.size_map.size()) job.swatch_scale *= options.size_map.maxCoeff();
   MQ_CHECK(faces <= options.max_faces, InvalidInput, "at ", size_option(options),
            " the texture would have about ", faces, " faces, more than the limit of ",
            options.max_faces,
@@ -270,11 +297,38 @@ void simplify_to_proxy(const SurfaceQuiltingOptions& options, double thickness, 
   stats.proxy_error = proxy.max_error;
 }
 
+// The log of the size map over its largest value at each vertex of job.base
+// (SurfaceJob::log_size: relative to the swatch, which is at the largest size): through each
+// refined face's corners in its parent face, whose corners are those of the input face it came from
+// (welding and removing faces keep the corners' order); under a proxy, whose faces are not
+// input faces, the mean over a vertex's faces of their origin faces' mean log size.
+Eigen::VectorXd refined_log_size(const TriMesh& base_in, const Eigen::VectorXd& size_map,
+                                 const std::vector<int>& input_face, const SurfaceJob& job) {
+  const Eigen::VectorXd log_in = (size_map / size_map.maxCoeff()).array().log();
+  const int nv = job.base.num_vertices();
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(nv);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(nv);
+  const bool proxy = job.input_vertex.empty();
+  for (int f = 0; f < job.base.num_faces(); ++f) {
+    const int parent = job.refinement.parent[static_cast<size_t>(f)];
+    const int in = input_face[static_cast<size_t>(parent)];
+    const Vector3d corner_log(log_in(base_in.F(in, 0)), log_in(base_in.F(in, 1)),
+                              log_in(base_in.F(in, 2)));
+    for (int k = 0; k < 3; ++k) {
+      const int v = job.base.F(f, k);
+      const Vector3d b = job.refinement.corners.row(f).segment<3>(3 * k).transpose();
+      out(v) += proxy ? corner_log.mean() : b.dot(corner_log);
+      count(v) += 1;
+    }
+  }
+  return out.cwiseQuotient(count.cwiseMax(1.0));
+}
+
 // Patches are grown from, and coverage is marked on, whole triangles, so triangles must be
 // small next to the swatch: the base is refined by longest-edge bisection (the surface itself
 // is unchanged) until no edge is longer than max_edge; the guidance field (given per input
 // face, or the smooth default) and the adjacency over the refined faces.
-void refine_base(const SurfaceQuiltingOptions& options, double max_edge,
+void refine_base(const TriMesh& base_in, const SurfaceQuiltingOptions& options, double max_edge,
                  const std::vector<int>& input_face, SurfaceJob& job, SurfaceQuiltingStats& stats) {
   job.base = bisect_longest_edges(job.cleaned, max_edge, 2'000'000, &job.refinement);
   stats.base_faces = job.base.num_faces();
@@ -286,6 +340,8 @@ void refine_base(const SurfaceQuiltingOptions& options, double max_edge,
   } else {
     job.field = smooth_tangent_field(job.base.V, job.base.F);
   }
+  if (options.size_map.size())
+    job.log_size = refined_log_size(base_in, options.size_map, input_face, job);
   job.topo = edge_topology(job.base.F, job.base.num_vertices());
   job.TT = face_adjacency(job.topo);
 }
@@ -303,11 +359,12 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   std::sort(swatch_sides.data(), swatch_sides.data() + 3);
   scale_within_estimate(base_in, swatch_mesh, swatch_sides, options, job, stats);
   const double diagonal = bounding_box(base_in.V, base_in.F).extent().norm();
-  const double max_edge =
-      (options.element_size > 0 ? options.element_size : options.scale * diagonal) *
-      options.base_edge_fraction;
+  double max_edge = (options.element_size > 0 ? options.element_size : options.scale * diagonal) *
+                    options.base_edge_fraction;
+  // Refined for the smallest elements the size map asks for.
+  if (options.size_map.size()) max_edge *= std::min(1.0, options.size_map.minCoeff());
   simplify_to_proxy(options, swatch_sides(0), max_edge, job, input_face, stats);
-  refine_base(options, max_edge, input_face, job, stats);
+  refine_base(base_in, options, max_edge, input_face, job, stats);
   // The swatch at its size on the surface (section 3.1's relative size s).
   job.swatch = swatch_mesh;
   job.swatch.V *= job.swatch_scale;
@@ -317,6 +374,13 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   }
   stats.swatch_scale = job.swatch_scale;
   return job;
+}
+
+double nominal_size(const SurfaceJob& job, int f) {
+  if (job.log_size.size() == 0) return 1.0;
+  return std::exp((job.log_size(job.base.F(f, 0)) + job.log_size(job.base.F(f, 1)) +
+                   job.log_size(job.base.F(f, 2))) /
+                  3);
 }
 
 const PreparedSwatch& swatch_at_full_detail(const SurfaceJob& job, const PreparedSwatch& swatch,
@@ -646,6 +710,9 @@ SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
                                     const SurfaceQuiltingOptions& options,
                                     TranslationCostEvaluator& evaluator,
                                     SurfaceQuiltingStats* stats_out, ProgressSink* progress) {
+  MQ_CHECK(job.log_size.size() == 0, InvalidInput,
+           "a size map is followed by the global layout only (lattices of elements and "
+           "threads); this swatch takes the local patches");
   LocalPatchSynthesis synthesis(job, options, evaluator, stats);
   while (!synthesis.finished()) synthesis.run_patch(progress);
   SurfaceQuilt quilt = synthesis.take_quilt(job);

@@ -68,6 +68,12 @@ struct SurfaceQuiltingOptions {
   double element_size = 0;
   // Unit tangent vector per base face orienting the swatch's x axis; empty: a smooth field.
   MatrixX3d field;
+  // Element size per vertex of the base as given, as a factor of the size set by scale or
+  // element_size (issue 25, `--size-map`): each > 0, the largest at most kMaxSizeMapRange times
+  // the smallest; interpolated over the faces. Followed by the global layout (lattices and
+  // threads) only, as the log scale its cones are placed for; empty: one size.
+  Eigen::VectorXd size_map;
+  static constexpr double kMaxSizeMapRange = 8;
   // When the swatch given is one at lower detail (core/mesh/element_detail.h), the swatch it was
   // made from: its symmetry decides the method and the global layout's lattice, which the
   // simplified copies keep only approximately (no exact half turn), so that a Preview and the
@@ -191,7 +197,14 @@ struct SurfaceJob {
   double swatch_scale = 0;  // factor applied to the swatch
   TriMesh swatch;           // the swatch scaled by it
   TriMesh full_swatch;      // options.full_detail_swatch scaled by it (empty: none given)
+  // #V(base): log of options.size_map at each vertex (interpolated where the base was refined,
+  // the mean over a proxy vertex's faces' input faces); empty without a size map.
+  Eigen::VectorXd log_size;
 };
+
+// The element size the size map asks for on face f of job.base, as a factor of job.swatch's
+// (the geometric mean of its corners' SurfaceJob::log_size): in (0, 1]; 1 without a size map.
+double nominal_size(const SurfaceJob& job, int f);
 
 // The swatch at full detail, which decides the method and the layout (a Preview is then the full
 // run's layout, SurfaceQuiltingOptions::full_detail_swatch): job.full_swatch prepared into

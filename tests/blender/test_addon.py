@@ -1145,6 +1145,49 @@ def test_a_vertex_group_masks_the_texture():
 
 
 @test
+def test_a_vertex_group_sets_the_element_size():
+    scene = new_scene()
+    s = scene.meshquilt
+    base = small_sphere("Sized")
+    # Full size over the top cap (weight 1), Smallest (a half) elsewhere.
+    group = base.vertex_groups.new(name="Big")
+    group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
+    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
+
+    def elements():
+        obj = base.meshquilt.result
+        me = obj.data
+        centres = np.empty(3 * len(me.polygons))
+        me.polygons.foreach_get("center", centres)
+        ids = face_ids(obj)
+        centres = centres.reshape(-1, 3)
+        n = int(ids.max()) + 1
+        count = np.bincount(ids, minlength=n)
+        z = np.bincount(ids, centres[:, 2], n) / np.maximum(count, 1)
+        return z[count > 0]
+
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "one-size run did not finish")
+    plain = elements()
+    s.size_group = "Big"
+    check("op:meshquilt.run" in drawn_panel(), "panel: %s" % drawn_panel())
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "sized run did not finish")
+    sized = elements()
+    # Below the cap the elements are half as large: about four times as many there, while
+    # the cap keeps about its count.
+    low, low_plain = np.sum(sized < -0.2), np.sum(plain < -0.2)
+    high, high_plain = np.sum(sized > 0.5), np.sum(plain > 0.5)
+    print("[blender]   size group: %d elements below, %d one-size; %d on the cap, %d one-size"
+          % (low, low_plain, high, high_plain), flush=True)
+    check(low > 2.5 * low_plain, "%d elements below the cap, %d at one size" % (low, low_plain))
+    check(high < 2.0 * max(high_plain, 1), "%d on the cap, %d at one size" % (high, high_plain))
+    # A swatch the size map does not apply to: said in the panel's terms.
+    s.sample = "apples"
+    message = reported(bpy.ops.meshquilt.run)
+    check("clear Size" in message, message)
+    s.size_group = ""
+
+
+@test
 def test_results_are_built_with_the_mesh_apis_of_blender_4():
     # What 4.x changed in what build_mesh uses (checked against the 4.0-4.3 API references):
     # MeshPolygon.loop_total read-only from 4.0 (sizes follow from loop_start), and

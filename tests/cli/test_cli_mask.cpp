@@ -1,8 +1,10 @@
 // surface --element-size and --mask (issue 25 item 3): the size in the base's units gives the
 // bytes --scale gives for the same size; a masked run writes whole elements over the mask, and
-// a bad mask file fails in one line before any work, writing nothing.
+// a bad mask file fails in one line before any work, writing nothing; --size-map makes the
+// rings smaller where it asks, the estimate counts them, and bad size maps fail alike.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "core/mesh/geometry_measures.h"
@@ -91,6 +93,50 @@ TEST(CliMask, MaskedRunAndBadMaskFiles) {
   }
   EXPECT_FALSE(fs::exists(dir + "/x.obj"));
   EXPECT_FALSE(fs::exists(dir + "/x.json"));
+}
+
+TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
+  const std::string dir = test::temp_dir();
+  write_inputs(dir);
+  const TriMesh grid = read_mesh(dir + "/grid.obj");
+  // Full size over x < 4, half size over x > 6, a ramp between.
+  std::string sizes = "# element size per vertex\n";
+  for (int v = 0; v < grid.num_vertices(); ++v)
+    sizes += std::to_string(1.0 - 0.5 * std::clamp((grid.V(v, 0) - 4) / 2, 0.0, 1.0)) + "\n";
+  spit(dir + "/sizes.txt", sizes);
+  const std::string job =
+      "surface --base grid.obj --swatch sw.obj --field 1 0 0 --scale 0.07 --quiet";
+  const CliRun plain = meshquilt(dir, job + " -o p.obj");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const CliRun m = meshquilt(dir, job + " --size-map sizes.txt -o m.obj --stats m.json");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const TriMesh a = read_mesh(dir + "/p.obj"), b = read_mesh(dir + "/m.obj");
+  // The right half holds four times the rings: about 2.5 times the faces in all.
+  const double ratio = static_cast<double>(b.num_faces()) / a.num_faces();
+  EXPECT_GT(ratio, 2.0);
+  EXPECT_LT(ratio, 3.0);
+  EXPECT_GE(std::stod(json_value(slurp(dir + "/m.json"), "coverage")), 0.9);
+  const CliRun e = meshquilt(dir, job + " --size-map sizes.txt -o e.obj --estimate");
+  ASSERT_EQ(e.status, 0) << e.err;
+  const double estimated = std::stod(e.out.substr(e.out.find("faces ") + 6));
+  EXPECT_NEAR(estimated / b.num_faces(), 1.0, 0.2) << e.out << b.num_faces();
+  // Bad maps: one line naming the file or the problem, exit 1, nothing written.
+  std::string ones;
+  for (int v = 0; v + 1 < grid.num_vertices(); ++v) ones += "1\n";
+  spit(dir + "/short.txt", ones);
+  spit(dir + "/zero.txt", ones + "0\n");
+  spit(dir + "/wide.txt", ones + "0.1\n");
+  for (const char* bad : {"short.txt", "zero.txt", "wide.txt", "missing.txt"}) {
+    const CliRun r = meshquilt(dir, job + " --size-map " + bad + " -o x.obj --stats x.json");
+    EXPECT_EQ(r.status, 1) << bad;
+    EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/x.obj"));
+  // The local patches do not follow a size map: refused in one line.
+  const CliRun patches = meshquilt(dir, job + " --size-map sizes.txt --method patches -o x.obj");
+  EXPECT_EQ(patches.status, 1);
+  EXPECT_EQ(patches.err_lines().size(), 1u) << patches.err;
+  EXPECT_FALSE(fs::exists(dir + "/x.obj"));
 }
 
 }  // namespace
