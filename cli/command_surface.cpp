@@ -25,6 +25,7 @@
 #include "core/surface/surface_mask.h"
 #include "core/surface/surface_quilting.h"
 #include "core/surface/tangent_field.h"
+#include "core/surface/vertex_map_io.h"
 #include "core/surface/vine_growth.h"
 #include "host/tet_stretch_evaluator.h"
 #include "host/translation_cost_evaluator.h"

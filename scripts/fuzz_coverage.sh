@@ -20,8 +20,10 @@ declare -A parsers=(
   [ply]='::read_ply\(|::Ply|::parse_ply|::ply_'
   [off]='::read_off\('
   [keys]='read_key_vectors'
-  [field]='read_vertex_vector_field')
-for target in ${FUZZ_TARGETS:-obj ply off keys field}; do
+  [field]='read_vertex_vector_field'
+  [mask]='parse_surface_mask'
+  [size]='parse_size_map')
+for target in ${FUZZ_TARGETS:-obj ply off keys field mask size}; do
   corpus=build-fuzz/corpus-$target
   [ -d "$corpus" ] || corpus=fuzz/corpus/$target
   out=build-fuzz-coverage/$target

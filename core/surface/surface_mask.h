@@ -1,7 +1,7 @@
 // Where a surface texture is wanted (issue 25, `meshquilt surface --mask`): the base is quilted
 // as usual, then whole elements over the rest are dropped, so that none is cut at the mask's
-// border; coverage is then judged over the mask alone. And how large it is wanted, per vertex
-// (`--size-map`), read here beside the mask: both are maps over the base's vertices.
+// border; coverage is then judged over the mask alone. Its file is read by
+// core/surface/vertex_map_io.
 #pragma once
 
 #include <string>
@@ -20,28 +20,6 @@ struct SurfaceMask {
   // Whether the point with barycentric coordinates b on face f of the base lies in the mask.
   bool contains(const TriMesh& base, int f, const Vector3d& b) const;
 };
-
-// Parses a mask for `base` (the base as given) from `text`, named `name` in messages. Lines
-// empty or starting with '#' are skipped. Either one number per base vertex, in [0, 1]; or a
-// first line `faces` and then one 0-based face index per line. Throws InvalidInput (one line:
-// name, line number) for a wrong count, a value that is not a number in [0, 1], an index out of
-// range, or a mask that sets nothing.
-SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
-                               const TriMesh& base);
-
-// parse_surface_mask on a file's contents (a regular file, core/mesh/input_file).
-SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base);
-
-// A size map (SurfaceQuiltingOptions::size_map, `surface --size-map`) for `base` from `text`:
-// one element size factor per base vertex (> 0, finite; 1 is the size --scale or
-// --element-size sets), lines empty or starting with '#' skipped. Throws InvalidInput (one
-// line: name, line number) for a value that is not such a number or a wrong count. The range
-// is checked where the options are validated.
-Eigen::VectorXd parse_size_map(const std::string& text, const std::string& name,
-                               const TriMesh& base);
-
-// parse_size_map on a file's contents (a regular file, core/mesh/input_file).
-Eigen::VectorXd read_size_map(const std::string& path, const TriMesh& base);
 
 // Per face of quilt.base: whether its centroid lies in the mask, located on `base` (the base
 // as given, which the mask describes) by its closest point: exact where quilt.base is a

@@ -14,6 +14,7 @@
 #include "core/shell/surface_coverage.h"
 #include "core/surface/global_quilting.h"
 #include "core/surface/surface_mask.h"
+#include "core/surface/vertex_map_io.h"
 #include "tests/core/planar_checks.h"
 #include "tests/test_support.h"
 
