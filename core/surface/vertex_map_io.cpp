@@ -18,13 +18,10 @@ std::string trimmed(const std::string& s) {
   return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
 }
 
-}  // namespace
-
-SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
-                               const TriMesh& base) {
-  SurfaceMask mask;
-  std::vector<double> weights;
-  bool faces = false, first = true, any = false;
+// Calls visit(line number, trimmed text) for each line of `text` that is neither empty nor a
+// '#' comment, in order.
+template <typename Visit>
+void for_each_value_line(const std::string& text, Visit visit) {
   int line = 0;
   for (std::size_t at = 0; at <= text.size();) {
     std::size_t end = text.find('\n', at);
@@ -33,11 +30,23 @@ SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
     at = end + 1;
     ++line;
     if (s.empty() || s[0] == '#') continue;
+    visit(line, s);
+  }
+}
+
+}  // namespace
+
+SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
+                               const TriMesh& base) {
+  SurfaceMask mask;
+  std::vector<double> weights;
+  bool faces = false, first = true, any = false;
+  for_each_value_line(text, [&](int line, const std::string& s) {
     if (first && s == "faces") {
       faces = true;
       first = false;
       mask.face.assign(static_cast<size_t>(base.num_faces()), 0);
-      continue;
+      return;
     }
     first = false;
     errno = 0;
@@ -59,7 +68,7 @@ SurfaceMask parse_surface_mask(const std::string& text, const std::string& name,
       weights.push_back(w);
       any = any || w >= 0.5;
     }
-  }
+  });
   if (!faces) {
     MQ_CHECK(static_cast<int>(weights.size()) == base.num_vertices(), InvalidInput, name, ": ",
              weights.size(), " weights for the base's ", base.num_vertices(),
@@ -79,14 +88,7 @@ SurfaceMask read_surface_mask(const std::string& path, const TriMesh& base) {
 Eigen::VectorXd parse_size_map(const std::string& text, const std::string& name,
                                const TriMesh& base) {
   std::vector<double> sizes;
-  int line = 0;
-  for (std::size_t at = 0; at <= text.size();) {
-    std::size_t end = text.find('\n', at);
-    if (end == std::string::npos) end = text.size();
-    const std::string s = trimmed(text.substr(at, end - at));
-    at = end + 1;
-    ++line;
-    if (s.empty() || s[0] == '#') continue;
+  for_each_value_line(text, [&](int line, const std::string& s) {
     char* stop = nullptr;
     const double size = std::strtod(s.c_str(), &stop);
     MQ_CHECK(stop == s.c_str() + s.size() && std::isfinite(size) && size > 0, InvalidInput, name,
@@ -94,7 +96,7 @@ Eigen::VectorXd parse_size_map(const std::string& text, const std::string& name,
     MQ_CHECK(static_cast<int>(sizes.size()) < base.num_vertices(), InvalidInput, name, ":", line,
              ": more sizes than the base's ", base.num_vertices(), " vertices");
     sizes.push_back(size);
-  }
+  });
   MQ_CHECK(static_cast<int>(sizes.size()) == base.num_vertices(), InvalidInput, name, ": ",
            sizes.size(), " sizes for the base's ", base.num_vertices(), " vertices");
   return Eigen::Map<const Eigen::VectorXd>(sizes.data(), static_cast<Eigen::Index>(sizes.size()));

@@ -1093,6 +1093,21 @@ def test_run_after_run_replaces_the_result_unless_earlier_ones_are_kept():
 
 
 
+def element_heights(base):
+    """The z of each element's centre (the mean of its faces' centres) in the base's latest
+    result."""
+    obj = base.meshquilt.result
+    me = obj.data
+    centres = np.empty(3 * len(me.polygons))
+    me.polygons.foreach_get("center", centres)
+    ids = face_ids(obj)
+    centres = centres.reshape(-1, 3)
+    n = int(ids.max()) + 1
+    count = np.bincount(ids, minlength=n)
+    z = np.bincount(ids, centres[:, 2], n) / np.maximum(count, 1)
+    return z[count > 0]
+
+
 @test
 def test_a_vertex_group_masks_the_texture():
     scene = new_scene()
@@ -1105,23 +1120,12 @@ def test_a_vertex_group_masks_the_texture():
     s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
     import meshquilt
 
-    def elements():
-        obj = base.meshquilt.result
-        me = obj.data
-        centres = np.empty(3 * len(me.polygons))
-        me.polygons.foreach_get("center", centres)
-        ids = face_ids(obj)
-        centres = centres.reshape(-1, 3)
-        n = int(ids.max()) + 1
-        z = np.bincount(ids, centres[:, 2], n) / np.maximum(np.bincount(ids, minlength=n), 1)
-        return z[np.bincount(ids, minlength=n) > 0]
-
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "unmasked run did not finish")
-    everywhere = elements()
+    everywhere = element_heights(base)
     s.mask_group = "Top"
     check("op:meshquilt.run" in drawn_panel(), "panel: %s" % drawn_panel())
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "masked run did not finish")
-    masked = elements()
+    masked = element_heights(base)
     ring = 0.25 * 2 * math.sqrt(3) / 3  # the 3 x 3 sample's side at Scale 0.25, over 3
     # Whole elements kept by where most of their vertices lie: none beyond about one ring
     # below the group's border (z 0.2, pulled in a little by the subdivision).
@@ -1153,25 +1157,12 @@ def test_a_vertex_group_sets_the_element_size():
     group = base.vertex_groups.new(name="Big")
     group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
     s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
-
-    def elements():
-        obj = base.meshquilt.result
-        me = obj.data
-        centres = np.empty(3 * len(me.polygons))
-        me.polygons.foreach_get("center", centres)
-        ids = face_ids(obj)
-        centres = centres.reshape(-1, 3)
-        n = int(ids.max()) + 1
-        count = np.bincount(ids, minlength=n)
-        z = np.bincount(ids, centres[:, 2], n) / np.maximum(count, 1)
-        return z[count > 0]
-
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "one-size run did not finish")
-    plain = elements()
+    plain = element_heights(base)
     s.size_group = "Big"
     check("op:meshquilt.run" in drawn_panel(), "panel: %s" % drawn_panel())
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "sized run did not finish")
-    sized = elements()
+    sized = element_heights(base)
     # Below the cap the elements are half as large: about four times as many there, while
     # the cap keeps about its count.
     low, low_plain = np.sum(sized < -0.2), np.sum(plain < -0.2)
