@@ -370,11 +370,6 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
              ": the swatch is flat (no thickness along its smallest side), and surface grows it "
              "in a shell as thick as the swatch; give it thickness, or use plane");
   }
-  // A proxy's vertices are none of the base's, so a quilt over one could not follow the base.
-  if (cl.has("save-quilt") && options.proxy_min_faces > 0 &&
-      base.num_faces() > options.proxy_min_faces)
-    throw UsageError("--save-quilt on a base of over " + std::to_string(options.proxy_min_faces) +
-                     " faces needs --no-proxy (a simplified proxy cannot follow the base)");
   // --scale's range, relative to the base's diagonal.
   const double diagonal = base.num_vertices() ? bounding_box(base.V).extent().norm() : 0.0;
   if (options.element_size > 0 && diagonal > 0 &&

@@ -325,9 +325,8 @@ class Run:
                                          % base.name)
             self.scale = self.element_size / diagonal
         self.base_matrix = np.array(base.matrix_world)
-        # The quilt saved for following the base (not over a base the engine would simplify).
-        self.quilt_path = os.path.join(self.dir, "quilt.mqq") \
-            if len(T) <= follow.PROXY_MIN_FACES else None
+        # The quilt saved for following the base.
+        self.quilt_path = os.path.join(self.dir, "quilt.mqq")
         if settings.guidance == "AXIS":
             axis = {"X": 0, "Y": 1, "Z": 2}[settings.guide_axis]
             field = tuple(settings.guide_object.matrix_world.to_3x3().col[axis])

@@ -21,8 +21,6 @@ import numpy as np
 
 from . import engine, exchange
 
-# The engine quilts a base of more faces over a simplified proxy, which cannot follow the base.
-PROXY_MIN_FACES = 200000
 FACES_FILE = "base_faces.npz"
 JOB_TIMEOUT = 600.0
 

@@ -150,17 +150,20 @@ class ElementPairs {
 
 SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
                             SavedQuiltHeader header, int* inexact) {
-  MQ_CHECK(static_cast<Eigen::Index>(quilt.input_vertex.size()) == quilt.input_base.V.rows() &&
-               !quilt.input_vertex.empty(),
-           InvalidInput,
-           "the quilt cannot be saved: its base was simplified to a proxy (a base of over "
-           "200,000 faces), whose vertices do not follow the base's; use --no-proxy");
+  // Under a proxy the output is located over the base as given (welded): the proxy lies within
+  // a twentieth of the shell height of it, so the prisms over it hold the output too.
+  const bool proxy = quilt.input_vertex.empty();
+  const TriMesh& base = proxy ? quilt.welded_base : quilt.input_base;
+  const std::vector<int>& input_vertex = proxy ? quilt.welded_input_vertex : quilt.input_vertex;
+  MQ_CHECK(static_cast<Eigen::Index>(input_vertex.size()) == base.V.rows() &&
+               !input_vertex.empty(),
+           InvalidInput, "the quilt cannot be saved: its base as given was not kept");
   SavedQuilt saved;
   header.shell_height = quilt.shell_height;
   saved.header = std::move(header);
-  saved.input_vertex = quilt.input_vertex;
-  saved.base.V = quilt.input_base.V;
-  saved.base.F = quilt.input_base.F;
+  saved.input_vertex = input_vertex;
+  saved.base.V = base.V;
+  saved.base.F = base.F;
   saved.output.V = output.V;
   saved.output.F = output.F;
   saved.output.kinds = output.kinds;

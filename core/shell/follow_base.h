@@ -14,8 +14,9 @@
 namespace mq {
 
 // The saved quilt of a synthesis: `output` is embed_quilt's result for `quilt`, located in the
-// prisms of quilt.input_base (locate_in_prisms; `inexact` counts the vertices it could not
-// place exactly). Throws InvalidInput for a proxy base (no input_vertex).
+// prisms of quilt.input_base, or of quilt.welded_base when that is a proxy (locate_in_prisms;
+// `inexact` counts the vertices it could not place exactly). Throws InvalidInput when neither
+// has its input_vertex.
 SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
                             SavedQuiltHeader header, int* inexact = nullptr);
 

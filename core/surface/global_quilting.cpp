@@ -1124,9 +1124,7 @@ SurfaceQuilt global_surface_quilt(SurfaceJob& job, const PreparedSwatch& swatch,
   quilt.kinds = swatch.kinds;
   quilt.shell_height = swatch.size.z();
   quilt.base = job.base;
-  quilt.input_base = std::move(job.cleaned);
-  quilt.refinement = std::move(job.refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
+  take_input_bases(job, quilt);
   quilt.elements = std::move(placed);
   stats.elements = static_cast<int>(quilt.elements.size());
   for (const SurfaceElement& e : quilt.elements) {

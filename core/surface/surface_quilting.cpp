@@ -126,6 +126,14 @@ TriMesh without_fins(const TriMesh& mesh, std::vector<int>& input_face,
 
 }  // namespace
 
+void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt) {
+  quilt.input_base = std::move(job.cleaned);
+  quilt.refinement = std::move(job.refinement);
+  quilt.input_vertex = std::move(job.input_vertex);
+  quilt.welded_base = std::move(job.welded);
+  quilt.welded_input_vertex = std::move(job.welded_input_vertex);
+}
+
 void to_input_base(const SurfaceQuilt& quilt, int& face, Vector3d& b) {
   if (!quilt.refinement.parent.empty()) to_parent(quilt.refinement, face, b);
 }
@@ -291,6 +299,8 @@ void simplify_to_proxy(const SurfaceQuiltingOptions& options, double thickness, 
   if (proxy.mesh.num_faces() >= job.cleaned.num_faces()) return;
   for (int& f : proxy.origin_face) f = input_face[static_cast<size_t>(f)];
   input_face = std::move(proxy.origin_face);
+  job.welded = std::move(job.cleaned);
+  job.welded_input_vertex = std::move(job.input_vertex);
   job.cleaned = std::move(proxy.mesh);
   job.input_vertex.clear();
   stats.proxy_faces = job.cleaned.num_faces();
@@ -694,9 +704,7 @@ SurfaceQuilt LocalPatchSynthesis::take_quilt(SurfaceJob& job) {
   quilt.kinds = swatch_.kinds;
   quilt.shell_height = H_;
   quilt.base = job.base;
-  quilt.input_base = std::move(job.cleaned);
-  quilt.refinement = std::move(job.refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
+  take_input_bases(job, quilt);
   ScopedStageTimer timer(times_, Stage::PostProcessing);
   for (size_t id = 0; id < store_.elements.size(); ++id)
     if (store_.alive[id] && !store_.elements[id].face.empty())

@@ -52,6 +52,10 @@ struct SurfaceQuilt {
   // #V(input_base): the vertex of the base as given each input_base vertex is (empty for a
   // proxy, whose vertices are none of them): how a saved quilt follows the base moved.
   std::vector<int> input_vertex;
+  // When input_base is a proxy: the base as given, welded, and its input_vertex, which a saved
+  // quilt is located over instead (empty otherwise).
+  TriMesh welded_base;
+  std::vector<int> welded_input_vertex;
 };
 
 // Local coordinates on the refined base expressed on the input base: refined faces are affine
@@ -197,10 +201,18 @@ struct SurfaceJob {
   double swatch_scale = 0;  // factor applied to the swatch
   TriMesh swatch;           // the swatch scaled by it
   TriMesh full_swatch;      // options.full_detail_swatch scaled by it (empty: none given)
+  // Under a proxy: the base as given, welded, and its input_vertex (SurfaceQuilt::welded_base).
+  TriMesh welded;
+  std::vector<int> welded_input_vertex;
   // #V(base): log of options.size_map at each vertex (interpolated where the base was refined,
   // the mean over a proxy vertex's faces' input faces); empty without a size map.
   Eigen::VectorXd log_size;
 };
+
+// Moves the job's bases into the quilt: cleaned (input_base), refinement, input_vertex and,
+// under a proxy, the welded base as given.
+void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt);
+
 
 // The element size the size map asks for on face f of job.base, as a factor of job.swatch's
 // (the geometric mean of its corners' SurfaceJob::log_size): in (0, 1]; 1 without a size map.

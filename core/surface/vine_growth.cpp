@@ -1453,9 +1453,7 @@ SurfaceQuilt finish_vine_quilt(SurfaceJob& job, const VineSwatch& vine, VinePlac
   quilt.kinds = vine.swatch.kinds;
   quilt.shell_height = vine.swatch.size.z();
   quilt.base = std::move(job.base);
-  quilt.input_base = std::move(job.cleaned);
-  quilt.refinement = std::move(job.refinement);
-  quilt.input_vertex = std::move(job.input_vertex);
+  take_input_bases(job, quilt);
   stats.iterations = vs.stems;
   stats.counts.added = static_cast<int>(quilt.elements.size());
   stats.elements = static_cast<int>(quilt.elements.size());

@@ -8,6 +8,10 @@
 
 #include "core/mesh/geometry_measures.h"
 #include "core/shell/follow_base.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/surface/global_quilting.h"
+#include "tests/core/planar_checks.h"
+#include "tests/core/shell_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -139,6 +143,45 @@ TEST(FollowBase, ElementsPressedTogetherFollowOrGoInEveryFrame) {
     EXPECT_EQ(fewer.num_faces(), out.num_faces() - 12);
     EXPECT_EQ(stats.num_removed, 1);
   }
+}
+
+// A base quilted over a simplified proxy (issue 25: --save-quilt refused such bases): the quilt
+// is saved over the base as given, follows it, and on the unmoved base gives the output bit for
+// bit. A sphere of 20,480 faces, simplified when over 1,000.
+TEST(FollowBase, AQuiltMadeOverAProxyFollowsTheBaseGiven) {
+  TriMesh base = test::icosphere(5);
+  base.V *= 3.0;
+  SurfaceQuiltingOptions o;
+  o.proxy_min_faces = 1000;
+  o.scale = 0.08;
+  TranslationCostCpu cost;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt quilt = quilt_surface_global(base, test::tiny_chainmail(), o, cost, &stats);
+  ASSERT_GT(stats.proxy_faces, 0);
+  ASSERT_TRUE(quilt.input_vertex.empty());
+  EXPECT_EQ(quilt.welded_base.num_faces(), base.num_faces());
+  QuiltEmbeddingOptions e;
+  TetStretchCpu stretch;
+  const TriMesh output = embed_quilt(quilt, e, stretch);
+  ASSERT_GT(output.num_faces(), 0);
+  SavedQuiltHeader header;
+  header.base = fingerprint(base);
+  int inexact = -1;
+  const SavedQuilt saved = make_saved_quilt(quilt, output, header, &inexact);
+  std::printf("[ measure  ] proxy of %d faces for %d: %d of %d output vertices placed inexactly\n",
+              stats.proxy_faces, base.num_faces(), inexact, output.num_vertices());
+  EXPECT_LE(inexact, output.num_vertices() / 100);
+  EXPECT_EQ(saved.base.num_faces(), base.num_faces());
+  const MatrixX3d rest = welded_positions(saved, base);
+  const TriMesh same = follow_base(saved, rest, {}, nullptr);
+  EXPECT_EQ(same.V, output.V);
+  // Moved as a whole, the output moves with it.
+  TriMesh moved = base;
+  moved.V.rowwise() += Eigen::RowVector3d(0.5, -1.0, 2.0);
+  const TriMesh out = follow_base(saved, welded_positions(saved, moved), {}, nullptr);
+  ASSERT_EQ(out.V.rows(), output.V.rows());
+  EXPECT_LT((out.V.rowwise() - Eigen::RowVector3d(0.5, -1.0, 2.0) - output.V).cwiseAbs().maxCoeff(),
+            1e-9);
 }
 
 }  // namespace
