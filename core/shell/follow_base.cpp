@@ -155,8 +155,7 @@ SavedQuilt make_saved_quilt(const SurfaceQuilt& quilt, const TriMesh& output,
   const bool proxy = quilt.input_vertex.empty();
   const TriMesh& base = proxy ? quilt.welded_base : quilt.input_base;
   const std::vector<int>& input_vertex = proxy ? quilt.welded_input_vertex : quilt.input_vertex;
-  MQ_CHECK(static_cast<Eigen::Index>(input_vertex.size()) == base.V.rows() &&
-               !input_vertex.empty(),
+  MQ_CHECK(static_cast<Eigen::Index>(input_vertex.size()) == base.V.rows() && !input_vertex.empty(),
            InvalidInput, "the quilt cannot be saved: its base as given was not kept");
   SavedQuilt saved;
   header.shell_height = quilt.shell_height;

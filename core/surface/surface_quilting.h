@@ -213,7 +213,6 @@ struct SurfaceJob {
 // under a proxy, the welded base as given.
 void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt);
 
-
 // The element size the size map asks for on face f of job.base, as a factor of job.swatch's
 // (the geometric mean of its corners' SurfaceJob::log_size): in (0, 1]; 1 without a size map.
 double nominal_size(const SurfaceJob& job, int f);
