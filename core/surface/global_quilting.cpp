@@ -405,7 +405,7 @@ double log_mean_scale(const GlobalParameterization& gp, const TriMesh& base) {
 double mean_log_size(const SurfaceJob& job) {
   const Eigen::VectorXd area = face_areas(job.base.V, job.base.F);
   double sum = 0;
-  for (int f = 0; f < job.base.num_faces(); ++f) sum += area(f) * std::log(nominal_size(job, f));
+  for (int f = 0; f < job.base.num_faces(); ++f) sum += area(f) * face_log_size(job, f);
   return area.sum() > 0 ? sum / area.sum() : 0.0;
 }
 
@@ -1028,6 +1028,7 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
   Eigen::VectorXd log_scale = metric.u;
   if (placement.target.size())
     log_scale -= (1 - a) * misfit(connection, metric.u, placement.target);
+  // Without a map e^(a u), rounded as before (a times the corners' sum).
   const double factor = placement.target.size() ? 1.0 : a;
   face_scale.resize(base.num_faces());
   for (int f = 0; f < base.num_faces(); ++f)

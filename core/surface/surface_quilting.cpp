@@ -386,11 +386,15 @@ SurfaceJob prepare_surface_job(const TriMesh& base_in, const TriMesh& swatch_mes
   return job;
 }
 
+double face_log_size(const SurfaceJob& job, int f) {
+  if (job.log_size.size() == 0) return 0.0;
+  return (job.log_size(job.base.F(f, 0)) + job.log_size(job.base.F(f, 1)) +
+          job.log_size(job.base.F(f, 2))) /
+         3;
+}
+
 double nominal_size(const SurfaceJob& job, int f) {
-  if (job.log_size.size() == 0) return 1.0;
-  return std::exp((job.log_size(job.base.F(f, 0)) + job.log_size(job.base.F(f, 1)) +
-                   job.log_size(job.base.F(f, 2))) /
-                  3);
+  return job.log_size.size() ? std::exp(face_log_size(job, f)) : 1.0;
 }
 
 const PreparedSwatch& swatch_at_full_detail(const SurfaceJob& job, const PreparedSwatch& swatch,

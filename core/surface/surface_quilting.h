@@ -216,6 +216,8 @@ void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt);
 // The element size the size map asks for on face f of job.base, as a factor of job.swatch's
 // (the geometric mean of its corners' SurfaceJob::log_size): in (0, 1]; 1 without a size map.
 double nominal_size(const SurfaceJob& job, int f);
+// Its log: the mean of the corners' SurfaceJob::log_size (0 without a size map).
+double face_log_size(const SurfaceJob& job, int f);
 
 // The swatch at full detail, which decides the method and the layout (a Preview is then the full
 // run's layout, SurfaceQuiltingOptions::full_detail_swatch): job.full_swatch prepared into

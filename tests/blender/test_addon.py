@@ -1108,16 +1108,22 @@ def element_heights(base):
     return z[count > 0]
 
 
+def sphere_with_top_cap(name, group_name):
+    """A new scene's settings and a small sphere whose cap above z 0.2 is the vertex group
+    `group_name` (weight 1), set up for the sample chain mail at Scale 0.25, Detail 10%."""
+    s = new_scene().meshquilt
+    base = small_sphere(name)
+    group = base.vertex_groups.new(name=group_name)
+    group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
+    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
+    return s, base
+
+
 @test
 def test_a_vertex_group_masks_the_texture():
-    scene = new_scene()
-    s = scene.meshquilt
-    base = small_sphere("Masked")
-    # The top cap in a group, through a Subdivision modifier (the evaluated mesh's weights).
-    group = base.vertex_groups.new(name="Top")
-    group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
+    s, base = sphere_with_top_cap("Masked", "Top")
+    # Through a Subdivision modifier (the evaluated mesh's weights).
     base.modifiers.new("Subdivision", "SUBSURF").levels = 1
-    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
     import meshquilt
 
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "unmasked run did not finish")
@@ -1150,13 +1156,8 @@ def test_a_vertex_group_masks_the_texture():
 
 @test
 def test_a_vertex_group_sets_the_element_size():
-    scene = new_scene()
-    s = scene.meshquilt
-    base = small_sphere("Sized")
     # Full size over the top cap (weight 1), Smallest (a half) elsewhere.
-    group = base.vertex_groups.new(name="Big")
-    group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
-    s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
+    s, base = sphere_with_top_cap("Sized", "Big")
     check(bpy.ops.meshquilt.run() == {"FINISHED"}, "one-size run did not finish")
     plain = element_heights(base)
     s.size_group = "Big"
