@@ -20,56 +20,6 @@ namespace mq::cli {
 
 namespace {
 
-// A name with one printf-style frame number (%d or %0Nd; %% is a literal %).
-class FramePattern {
- public:
-  FramePattern(const std::string& pattern, const char* option) : pattern_(pattern) {
-    int found = 0;
-    for (size_t i = 0; i < pattern.size(); ++i) {
-      if (pattern[i] != '%') continue;
-      if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
-        ++i;
-        continue;
-      }
-      size_t j = i + 1;
-      int width = 0;
-      while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9' && width < 100)
-        width = 10 * width + (pattern[j++] - '0');
-      if (j >= pattern.size() || pattern[j] != 'd')
-        throw UsageError(std::string(option) + " '" + pattern +
-                         "': a frame number is written %d or %0Nd (e.g. walk_%04d.obj)");
-      at_ = i;
-      end_ = j + 1;
-      width_ = width;
-      ++found;
-      i = j;
-    }
-    if (found != 1)
-      throw UsageError(std::string(option) + " '" + pattern +
-                       "' needs exactly one frame number (%d or %0Nd) with --frames");
-  }
-
-  std::string operator()(int frame) const {
-    std::string number = std::to_string(frame);
-    if (static_cast<int>(number.size()) < width_)
-      number.insert(0, static_cast<size_t>(width_) - number.size(), '0');
-    return unescape(pattern_.substr(0, at_)) + number + unescape(pattern_.substr(end_));
-  }
-
- private:
-  static std::string unescape(const std::string& s) {
-    std::string out;
-    for (size_t i = 0; i < s.size(); ++i) {
-      out += s[i];
-      if (s[i] == '%' && i + 1 < s.size() && s[i + 1] == '%') ++i;
-    }
-    return out;
-  }
-  std::string pattern_;
-  size_t at_ = 0, end_ = 0;
-  int width_ = 0;
-};
-
 struct FrameResult {
   int frame = 0;
   std::string base, output;
@@ -165,11 +115,7 @@ FollowBaseOptions following_options(const CommandLine& cl) {
 std::vector<FrameResult> requested_frames(const CommandLine& cl) {
   std::vector<FrameResult> frames;
   if (cl.has("frames")) {
-    const std::string range = cl.get("frames");
-    int a = 0, b = 0;
-    if (!parse_range(range, a, b) || b - a >= 100000)
-      throw UsageError("--frames expects A-B with 0 <= A <= B (at most 100000 frames), got '" +
-                       range + "'");
+    const auto [a, b] = frame_range(cl.get("frames"));
     const FramePattern base_name(cl.get("base"), "--base"), out_name(cl.get("output"), "-o");
     for (int f = a; f <= b; ++f) frames.push_back({f, base_name(f), out_name(f), {}, 0});
   } else {

@@ -165,4 +165,59 @@ bool parse_range(const std::string& text, int& a, int& b) {
          used == static_cast<int>(text.size()) && 0 <= a && a <= b;
 }
 
+namespace {
+
+std::string unescape_percent(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    out += s[i];
+    if (s[i] == '%' && i + 1 < s.size() && s[i + 1] == '%') ++i;
+  }
+  return out;
+}
+
+}  // namespace
+
+FramePattern::FramePattern(const std::string& pattern, const char* option) : pattern_(pattern) {
+  int found = 0;
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') continue;
+    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    int width = 0;
+    while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9' && width < 100)
+      width = 10 * width + (pattern[j++] - '0');
+    if (j >= pattern.size() || pattern[j] != 'd')
+      throw UsageError(std::string(option) + " '" + pattern +
+                       "': a frame number is written %d or %0Nd (e.g. walk_%04d.obj)");
+    at_ = i;
+    end_ = j + 1;
+    width_ = width;
+    ++found;
+    i = j;
+  }
+  if (found != 1)
+    throw UsageError(std::string(option) + " '" + pattern +
+                     "' needs exactly one frame number (%d or %0Nd) with --frames");
+}
+
+std::string FramePattern::operator()(int frame) const {
+  std::string number = std::to_string(frame);
+  if (static_cast<int>(number.size()) < width_)
+    number.insert(0, static_cast<size_t>(width_) - number.size(), '0');
+  return unescape_percent(pattern_.substr(0, at_)) + number +
+         unescape_percent(pattern_.substr(end_));
+}
+
+std::pair<int, int> frame_range(const std::string& text) {
+  int a = 0, b = 0;
+  if (!parse_range(text, a, b) || b - a >= 100000)
+    throw UsageError("--frames expects A-B with 0 <= A <= B (at most 100000 frames), got '" + text +
+                     "'");
+  return {a, b};
+}
+
 }  // namespace mq::cli

@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mq::cli {
@@ -66,5 +67,22 @@ class CommandLine {
 // A range "A-B" with 0 <= A <= B as the whole text (embed --frames, edit --ids): true with a and
 // b set, false for anything else.
 bool parse_range(const std::string& text, int& a, int& b);
+
+// A name with one printf-style frame number (%d or %0Nd; %% is a literal %): the files of a
+// sequence (embed --frames, surface --swatch-frames). Throws UsageError naming `option` for a
+// pattern without exactly one frame number.
+class FramePattern {
+ public:
+  FramePattern(const std::string& pattern, const char* option);
+  std::string operator()(int frame) const;
+
+ private:
+  std::string pattern_;
+  size_t at_ = 0, end_ = 0;
+  int width_ = 0;
+};
+
+// The frames A-B of --frames (0 <= A <= B, at most 100000 frames). Throws UsageError otherwise.
+std::pair<int, int> frame_range(const std::string& text);
 
 }  // namespace mq::cli

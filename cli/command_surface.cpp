@@ -3,7 +3,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -20,6 +22,7 @@
 #include "core/shell/quilt_embedding.h"
 #include "core/shell/saved_quilt.h"
 #include "core/shell/surface_coverage.h"
+#include "core/shell/swatch_animation.h"
 #include "core/structure/texture_structure.h"
 #include "core/surface/global_quilting.h"
 #include "core/surface/surface_mask.h"
@@ -268,6 +271,13 @@ void declare_surface_options(CommandLine& cl) {
             "also save the result in local coordinates over the base (elements, their kinds, "
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
             "again on the base moved (posed, animated) without a new synthesis");
+  cl.option("swatch-frames", "PATTERN",
+            "animate the result with the swatch (vines: ivy): frames of the swatch, the same mesh "
+            "with its vertices moved, named by a pattern with one frame number (%d or %0Nd; "
+            "'meshquilt swatch ivy --frames N' makes some). Each output vertex moves as the point "
+            "of the swatch it came from, in its own frame on the base; with --frames A-B, -o is a "
+            "pattern too and one output is written per frame (same faces and element order)");
+  cl.option("frames", "A-B", "the frames of --swatch-frames to follow, one output each");
   add_detail_option(cl);
   add_output_options(cl);
   add_run_options(cl);
@@ -285,7 +295,28 @@ struct SurfaceRequest {
   double min_coverage = 0;
   double detail = 1;
   Device device = Device::Auto;
+  // With --swatch-frames: per frame, its number, the swatch frame's file and the output's.
+  struct Frame {
+    int number = 0;
+    std::string swatch, output;
+  };
+  std::vector<Frame> frames;
 };
+
+// --swatch-frames and --frames: the frames' files, or none.
+std::vector<SurfaceRequest::Frame> requested_swatch_frames(const CommandLine& cl) {
+  if (cl.has("swatch-frames") != cl.has("frames"))
+    throw UsageError("--swatch-frames and --frames A-B go together");
+  std::vector<SurfaceRequest::Frame> frames;
+  if (!cl.has("frames")) return frames;
+  if (cl.has("detail") && cl.get_double("detail", 0) != 1)
+    throw UsageError("--swatch-frames animates the swatch as given: not with --detail");
+  const auto [a, b] = frame_range(cl.get("frames"));
+  const FramePattern swatch(cl.get("swatch-frames"), "--swatch-frames"),
+      output(cl.get("output"), "-o");
+  for (int f = a; f <= b; ++f) frames.push_back({f, swatch(f), output(f)});
+  return frames;
+}
 
 SurfaceRequest parse_surface_request(const CommandLine& cl) {
   if (!cl.has("base")) throw UsageError("--base FILE is required");
@@ -294,14 +325,24 @@ SurfaceRequest parse_surface_request(const CommandLine& cl) {
   if (cl.has("field") + cl.has("field-file") + cl.has("keys") > 1)
     throw UsageError("give at most one of --field, --field-file and --keys");
   SurfaceRequest r;
-  r.out_path = cl.get("output");
-  mesh_format_from_path(r.out_path);
+  r.frames = requested_swatch_frames(cl);
+  r.out_path = r.frames.empty() ? cl.get("output") : r.frames.front().output;
   r.write_options = output_options(cl);
-  std::vector<std::string> outputs = output_files(r.out_path, r.write_options);
+  std::vector<std::string> outputs, inputs{cl.get("base"), cl.get("swatch"), cl.get("field-file"),
+                                           cl.get("keys"), cl.get("mask")};
+  for (const SurfaceRequest::Frame& f : r.frames) inputs.push_back(f.swatch);
+  for (const std::string& out :
+       r.frames.empty() ? std::vector<std::string>{r.out_path} : std::vector<std::string>{}) {
+    mesh_format_from_path(out);
+    for (const std::string& file : output_files(out, r.write_options)) outputs.push_back(file);
+  }
+  for (const SurfaceRequest::Frame& f : r.frames) {
+    mesh_format_from_path(f.output);
+    for (const std::string& file : output_files(f.output, r.write_options)) outputs.push_back(file);
+  }
   outputs.push_back(cl.get("stats"));
   outputs.push_back(cl.get("save-quilt"));
-  check_paths(outputs, {cl.get("base"), cl.get("swatch"), cl.get("field-file"), cl.get("keys"),
-                        cl.get("mask")});
+  check_paths(outputs, inputs);
   if (cl.has("scale") && cl.has("element-size"))
     throw UsageError("give --scale or --element-size, not both");
 
@@ -334,6 +375,7 @@ SurfaceRequest parse_surface_request(const CommandLine& cl) {
   else if (placement != "adaptive")
     throw UsageError("--element-placement expects adaptive, layout or rigid, got '" + placement +
                      "'");
+  options.keep_sources = !r.frames.empty();
   r.method = cl.get("method");
   if (r.method != "auto" && r.method != "global" && r.method != "patches" && r.method != "vines")
     throw UsageError("--method expects auto, global, patches or vines, got '" + r.method + "'");
@@ -344,9 +386,10 @@ SurfaceRequest parse_surface_request(const CommandLine& cl) {
 // field goes into r.options.
 struct SurfaceInputs {
   TriMesh base;
-  ElementDetail swatch;  // at --detail (its mesh is the swatch quilted)
-  TriMesh full_swatch;   // as read
-  SurfaceMask mask;      // empty without --mask
+  ElementDetail swatch;                // at --detail (its mesh is the swatch quilted)
+  TriMesh full_swatch;                 // as read
+  SurfaceMask mask;                    // empty without --mask
+  std::vector<TriMesh> swatch_frames;  // with --swatch-frames: each frame as read
 };
 
 void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs& in) {
@@ -376,6 +419,12 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
       !(options.element_size >= 1e-6 * diagonal && options.element_size <= 10 * diagonal))
     throw UsageError("--element-size must be in [1e-6, 10] times the base's diagonal " +
                      std::to_string(diagonal));
+  // Every swatch frame read and checked before any work: a missing frame, or one that is not the
+  // swatch moved, fails the run before anything is written.
+  for (const SurfaceRequest::Frame& f : r.frames) {
+    in.swatch_frames.push_back(read_mesh(f.swatch));
+    swatch_motion(swatch, in.swatch_frames.back(), 1.0, f.swatch);
+  }
   if (cl.has("mask")) in.mask = read_surface_mask(cl.get("mask"), base);
   if (cl.has("size-map")) options.size_map = read_size_map(cl.get("size-map"), base);
   if (cl.has("field")) {
@@ -434,6 +483,7 @@ struct SurfaceOutcome {
   QuiltEmbeddingStats embedding;
   bool global = false, vines = false;  // the method run (auto decides)
   StructureSummary structure;
+  SettledMotionStats settled;  // with --swatch-frames
   double wall = 0;
 };
 
@@ -467,6 +517,31 @@ SavedQuilt make_saved(const CommandLine& cl, const SurfaceRequest& r, const Surf
                   (r.detail < 1 ? " --detail " + cl.get("detail") : std::string()) + " --seed " +
                   cl.get("seed");
   return make_saved_quilt(quilt, result, header);
+}
+
+// The structure figures (issue 13), measured for --stats only: a second or so on a million
+// faces, not worth it on every run. Returns the seconds taken (not part of the run's wall time).
+double measure_for_stats(RunContext& run, const TriMesh& result, const SurfaceInputs& in,
+                         SurfaceOutcome& o) {
+  if (run.stats_path().empty()) return 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  ScopedStageTimer timer(o.stats.times, Stage::Structure);
+  o.structure = summarize_structure(result, in.swatch.mesh, &in.base, o.stats.swatch_scale);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --swatch-frames: the result's vertices located in the swatch and the frames' motions, settled
+// so that no element meets another in any frame.
+SwatchAnimation animate(const SurfaceRequest& r, const SurfaceInputs& in, const SurfaceQuilt& quilt,
+                        const TriMesh& result, SurfaceOutcome& o,
+                        std::vector<SwatchMotion>& motions) {
+  ScopedStageTimer timer(o.stats.times, Stage::Animation);
+  SwatchAnimation animation(quilt, o.embedding.kept, result, in.swatch.mesh, o.stats.swatch_scale);
+  for (size_t k = 0; k < r.frames.size(); ++k)
+    motions.push_back(swatch_motion(in.swatch.mesh, in.swatch_frames[k], o.stats.swatch_scale,
+                                    r.frames[k].swatch));
+  animation.settle(motions, &o.settled);
+  return animation;
 }
 
 // The summary a run prints unless --quiet (the structure follows with --stats).
@@ -528,6 +603,11 @@ void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
         "placed (%d off the surface)\n",
         gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
         gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
+  if (!r.frames.empty())
+    std::printf(
+        "swatch animation: %zu frames (to %s); %d elements move at half their motion and %d "
+        "stay still, where they would meet another element\n",
+        r.frames.size(), r.frames.back().output.c_str(), o.settled.damped, o.settled.stilled);
   if (vines)
     std::printf(
         "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "
@@ -571,6 +651,10 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
   SurfaceOutcome o;
   SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
+  MQ_CHECK(r.frames.empty() || o.vines, InvalidInput,
+           "--swatch-frames: a swatch animation is followed by the vine method (a swatch of one "
+           "vine with leaves, like 'meshquilt swatch ivy') only; this swatch took the ",
+           o.global ? "global" : "patches", " method");
   if (cl.has("mask")) {
     r.embedding.coverage_faces = mask_quilt_faces(in.mask, in.base, quilt);
     drop_unmasked_elements(quilt, r.embedding.coverage_faces);
@@ -592,19 +676,17 @@ int run_surface(int argc, char** argv, int first) {
     ScopedStageTimer timer(o.stats.times, Stage::SaveQuilt);
     saved = make_saved(cl, r, in, quilt, result);
   }
-  // The structure figures (issue 13) are measured for --stats: a second or so on a million
-  // faces, not worth it on every run; not part of the run's wall time.
-  double measuring = 0;
-  if (!run.stats_path().empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    ScopedStageTimer timer(o.stats.times, Stage::Structure);
-    o.structure = summarize_structure(result, swatch, &in.base, o.stats.swatch_scale);
-    measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  const double measuring = measure_for_stats(run, result, in, o);
   if (cl.has("save-quilt")) write_saved_quilt(cl.get("save-quilt"), saved);
-  // The mesh and the --stats file are one commit (issue 28).
+  // The mesh and the --stats file are one commit (issue 28); with --swatch-frames the mesh is
+  // the first frame's, and the others follow.
+  std::optional<SwatchAnimation> animation;
+  std::vector<SwatchMotion> motions;
+  if (!r.frames.empty()) animation = animate(r, in, quilt, result, o, motions);
+  const auto frame = [&](size_t k) { return animation->frame(motions[k]); };
   o.wall = write_output_and_stats(
-      run, r.out_path, result, r.write_options, o.stats.times, start, measuring, [&](double w) {
+      run, r.out_path, animation ? frame(0) : result, r.write_options, o.stats.times, start,
+      measuring, [&](double w) {
         return stats_json(o.stats, o.embedding, r.embedding_name, evaluator->name(), run.threads(),
                           w, cl.get("base"), cl.get("swatch"),
                           o.global  ? "global"
@@ -613,6 +695,10 @@ int run_surface(int argc, char** argv, int first) {
                           o.global ? &o.global_stats : nullptr, o.structure, memory_limit(cl),
                           r.min_coverage, own_coverage, in.swatch, r.detail);
       });
+  for (size_t k = 1; k < r.frames.size(); ++k) {
+    ScopedStageProgress shown(run.progress(), Stage::Writing);
+    write_output(r.frames[k].output, frame(k), r.write_options);
+  }
   run.progress()->finish();
   if (!run.quiet()) {
     print_surface_summary(r, in, o, evaluator->name(), run.threads());

@@ -27,6 +27,11 @@ void declare_swatch_options(CommandLine& cl) {
   cl.option("length", "L", "ivy: vine length in units of --scale", "10");
   cl.option("detail", "N", "segments around a ring/tube or apple resolution", "0");
   cl.option("seed", "N", "random seed (apples, ivy)", "1");
+  cl.option("frames", "N",
+            "ivy: also a looping wind animation of N frames (leaves lifting and rolling about "
+            "where they meet the vine, the vine swaying): -o is then a pattern with one frame "
+            "number (%d or %0Nd), frames 0 to N-1 are written, frame 0 the swatch itself; for "
+            "'surface --swatch-frames'");
   cl.flag("quiet", "print nothing but errors");
   cl.option("max-faces", "N",
             "refuse a swatch estimated to have more faces (also bounded by the machine's memory)",
@@ -142,9 +147,22 @@ int run_swatch(int argc, char** argv, int first) {
   SwatchRequest q;
   q.kind = cl.positional_value("KIND");
   const std::string out = cl.get("output");
-  mesh_format_from_path(out);
   const WriteOptions write_options = output_options(cl);
-  check_paths(output_files(out, write_options), {});
+  // With --frames: one output per frame, each name from the pattern.
+  std::vector<std::string> outputs{out};
+  if (cl.has("frames")) {
+    if (q.kind != "ivy") throw UsageError("--frames animates the ivy swatch only");
+    const int frames = static_cast<int>(cl.get_int("frames", 1, 100000));
+    const FramePattern name(out, "-o");
+    outputs.clear();
+    for (int k = 0; k < frames; ++k) outputs.push_back(name(k));
+  }
+  std::vector<std::string> files;
+  for (const std::string& o : outputs) {
+    mesh_format_from_path(o);
+    for (const std::string& f : output_files(o, write_options)) files.push_back(f);
+  }
+  check_paths(files, {});
   q.scale = cl.get_double("scale", 0, 1e-6, 1e6);
   q.detail = static_cast<int>(cl.get_int("detail", 0, 256));
   q.seed = static_cast<uint64_t>(cl.get_int("seed", 0, 1LL << 62));
@@ -163,12 +181,18 @@ int run_swatch(int argc, char** argv, int first) {
   else
     throw UsageError("unknown swatch kind '" + q.kind +
                      "' (chainmail, chainmail-square, weave, apples or ivy)");
-  write_output(out, mesh, write_options);
-  if (!cl.has("quiet")) {
-    std::vector<int> fc;
-    const int elements = connected_components(mesh.F, mesh.num_vertices(), fc);
-    std::printf("wrote %s: %s swatch, %d faces, %d vertices, %d elements\n", out.c_str(),
-                q.kind.c_str(), mesh.num_faces(), mesh.num_vertices(), elements);
+  IvyWindOptions wind;
+  wind.frames = static_cast<int>(outputs.size());
+  const std::vector<TriMesh> frames = cl.has("frames") ? ivy_wind(mesh, wind) : std::vector{mesh};
+  for (size_t k = 0; k < outputs.size(); ++k) {
+    const TriMesh& m = frames[k];
+    write_output(outputs[k], m, write_options);
+    if (!cl.has("quiet")) {
+      std::vector<int> fc;
+      const int elements = connected_components(m.F, m.num_vertices(), fc);
+      std::printf("wrote %s: %s swatch, %d faces, %d vertices, %d elements\n", outputs[k].c_str(),
+                  q.kind.c_str(), m.num_faces(), m.num_vertices(), elements);
+    }
   }
   return 0;
 }

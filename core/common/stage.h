@@ -33,6 +33,7 @@ enum class Stage : std::uint8_t {
   ElementRemoval,       // what still intersects removed
   Coverage,             // the share of the base covered
   Structure,            // the structure measure (links, shapes)
+  Animation,            // --swatch-frames: the output located in the swatch, frames settled
   SaveQuilt,            // --save-quilt
   Writing,              // the output files
 };
@@ -65,6 +66,7 @@ constexpr const char* kStageNames[] = {
     "element removal",       // ElementRemoval
     "coverage",              // Coverage
     "structure",             // Structure
+    "animation",             // Animation
     "save quilt",            // SaveQuilt
     "writing",               // Writing
 };

@@ -10,6 +10,7 @@
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
+#include "core/mesh/settled_motion.h"
 
 namespace mq {
 namespace {
@@ -449,6 +450,145 @@ TriMesh ivy_section(const IvyOptions& o) {
   }
   move_to_origin(ivy);
   return ivy;
+}
+
+namespace {
+
+// The parts of an ivy section the wind moves: its vine (the element longest along x: its
+// vertices, where it starts, its length and radius) and each leaf (its vertices, the point it
+// turns about, its axis from there in the plane, its element).
+struct IvyParts {
+  struct Leaf {
+    int element = 0;
+    std::vector<int> vertices;
+    Vector3d pivot = Vector3d::Zero(), axis = Vector3d::UnitX();
+  };
+  int vine = 0;
+  std::vector<int> vine_vertices;
+  double x0 = 0, length = 1, radius = 0;
+  std::vector<Leaf> leaves;
+};
+
+// The leaf's pivot: the line across its back (its point least far along its axis, at the
+// height of its vertex nearest the vine), so that turning it lifts every point, none sinking
+// towards the vine. false for a leaf with no extent in the plane.
+bool set_leaf_pivot(const TriMesh& ivy, const std::vector<int>& vine, IvyParts::Leaf& leaf) {
+  int pivot = leaf.vertices.front();
+  double nearest = kInf;
+  Vector3d centroid = Vector3d::Zero();
+  for (const int v : leaf.vertices) {
+    centroid += ivy.V.row(v).transpose();
+    for (const int w : vine) {
+      const double d = (ivy.V.row(v) - ivy.V.row(w)).squaredNorm();
+      if (d < nearest) nearest = d, pivot = v;
+    }
+  }
+  centroid /= static_cast<double>(leaf.vertices.size());
+  const Vector3d p = ivy.V.row(pivot).transpose();
+  Vector3d axis = centroid - p;
+  axis.z() = 0;
+  if (!(axis.norm() > 0)) return false;
+  leaf.axis = axis.normalized();
+  double back = 0;
+  for (const int v : leaf.vertices)
+    back = std::min(back, (ivy.V.row(v).transpose() - p).dot(leaf.axis));
+  leaf.pivot = p + back * leaf.axis;
+  return true;
+}
+
+IvyParts ivy_parts(const TriMesh& ivy) {
+  const int nv = ivy.num_vertices();
+  std::vector<int> face_component;
+  const int n = connected_components(ivy.F, nv, face_component);
+  MQ_CHECK(n >= 2, InvalidInput, "ivy wind: the ivy needs a vine and at least one leaf");
+  std::vector<std::vector<int>> vertices(static_cast<size_t>(n));
+  std::vector<int> component(static_cast<size_t>(nv), -1);
+  for (int f = 0; f < ivy.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      component[static_cast<size_t>(ivy.F(f, k))] = face_component[static_cast<size_t>(f)];
+  for (int v = 0; v < nv; ++v)
+    if (component[static_cast<size_t>(v)] >= 0)
+      vertices[static_cast<size_t>(component[static_cast<size_t>(v)])].push_back(v);
+  const auto extent = [&](int c, int axis) {
+    double lo = kInf, hi = -kInf;
+    for (const int v : vertices[static_cast<size_t>(c)]) {
+      lo = std::min(lo, ivy.V(v, axis));
+      hi = std::max(hi, ivy.V(v, axis));
+    }
+    return std::pair{lo, hi};
+  };
+  IvyParts parts;
+  for (int c = 1; c < n; ++c) {
+    const auto [lo, hi] = extent(c, 0);
+    const auto [vlo, vhi] = extent(parts.vine, 0);
+    if (hi - lo > vhi - vlo) parts.vine = c;
+  }
+  parts.vine_vertices = vertices[static_cast<size_t>(parts.vine)];
+  const auto [x0, x1] = extent(parts.vine, 0);
+  const auto [z0, z1] = extent(parts.vine, 2);
+  parts.x0 = x0;
+  parts.length = std::max(x1 - x0, 1e-300);
+  parts.radius = 0.5 * (z1 - z0);
+  for (int c = 0; c < n; ++c) {
+    if (c == parts.vine) continue;
+    IvyParts::Leaf leaf;
+    leaf.element = c;
+    leaf.vertices = vertices[static_cast<size_t>(c)];
+    if (set_leaf_pivot(ivy, parts.vine_vertices, leaf)) parts.leaves.push_back(std::move(leaf));
+  }
+  return parts;
+}
+
+// Frame `frame` of the wind on `ivy` (ivy_wind), each element's motion scaled by its amplitude.
+MatrixX3d ivy_wind_positions(const TriMesh& ivy, const IvyParts& parts, int frame,
+                             const IvyWindOptions& o, const std::vector<double>& amplitude) {
+  // The gust: zero at the loop's ends with zero slope, a wave one section long along x.
+  const double t = static_cast<double>(frame) / o.frames;
+  const double gust = std::pow(std::sin(M_PI * t), 2);
+  const auto wave = [&](double x, double shift) {
+    return std::sin(2 * M_PI * (2 * t - (x - parts.x0) / parts.length) + shift);
+  };
+  const double a_vine = amplitude[static_cast<size_t>(parts.vine)];
+  const auto sway = [&](double x) {
+    return Vector3d(0, a_vine * o.vine_sway * parts.radius * gust * wave(x, 0), 0);
+  };
+  MatrixX3d out = ivy.V;
+  if (gust == 0) return out;
+  if (a_vine > 0 && o.vine_sway > 0)
+    for (const int v : parts.vine_vertices) out.row(v) += sway(ivy.V(v, 0)).transpose();
+  for (const IvyParts::Leaf& leaf : parts.leaves) {
+    const double a = amplitude[static_cast<size_t>(leaf.element)];
+    if (a == 0) continue;
+    const Vector3d& p = leaf.pivot;
+    // Lifting about axis x z raises the tip; rolling about the axis tilts it sideways.
+    const double lift = a * o.lift_angle * gust * (0.5 + 0.5 * wave(p.x(), 0));
+    const double roll = o.roll_share * lift * wave(p.x(), 1);
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(lift, leaf.axis.cross(Vector3d::UnitZ()).normalized()) *
+         Eigen::AngleAxisd(roll, leaf.axis))
+            .toRotationMatrix();
+    const Vector3d carried = sway(p.x());
+    for (const int v : leaf.vertices)
+      out.row(v) = (p + carried + R * (ivy.V.row(v).transpose() - p)).transpose();
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<TriMesh> ivy_wind(const TriMesh& ivy, const IvyWindOptions& o) {
+  MQ_CHECK(o.frames >= 1, InvalidInput, "ivy wind: frames must be >= 1");
+  MQ_CHECK(o.lift_angle >= 0 && o.roll_share >= 0 && o.vine_sway >= 0, InvalidInput,
+           "ivy wind: amplitudes must be >= 0");
+  const IvyParts parts = ivy_parts(ivy);
+  // Leaves that would meet a neighbour or the vine in some frame move less (settled_amplitudes).
+  const std::vector<double> amplitude = settled_amplitudes(
+      ivy.V, ivy.F, o.frames,
+      [&](int k, const std::vector<double>& a) { return ivy_wind_positions(ivy, parts, k, o, a); });
+  std::vector<TriMesh> frames(static_cast<size_t>(o.frames), ivy);
+  for (int k = 1; k < o.frames; ++k)
+    frames[static_cast<size_t>(k)].V = ivy_wind_positions(ivy, parts, k, o, amplitude);
+  return frames;
 }
 
 }  // namespace mq

@@ -107,4 +107,25 @@ struct IvyOptions {
 // Throws InvalidInput for length <= 0, leaves < 0 or leaf_size <= 0.
 TriMesh ivy_section(const IvyOptions& options = {});
 
+// A looping wind animation of an ivy section (issue 25, a swatch animation to try): `frames`
+// frames, each the section with its vertices moved (faces unchanged), frame 0 the section itself
+// and the loop closing after the last. Each leaf turns rigidly about the line across its back
+// (through its attachment, its vertex nearest the vine): its tip lifts by up to lift_angle and it
+// rolls about its own axis by up to roll_share of that; the vine can sway sideways by up to
+// vine_sway of its radius, carrying its leaves (0 by default: ivy holds to its wall by rootlets,
+// and stems laid as closely as the vine method lays them would sway into their neighbours' leaves).
+// A gust (sin^2 over the loop) runs along the vine as a wave of the section's length, so that
+// sections laid end to end move as one. A leaf that would meet the vine or another leaf in some
+// frame moves half as much, else not at all (settled_amplitudes).
+struct IvyWindOptions {
+  int frames = 24;
+  double lift_angle = 0.35;  // radians
+  double roll_share = 0.15;
+  double vine_sway = 0;
+};
+
+// The ivy's longest element (along x) is its vine, every other element a leaf. Throws
+// InvalidInput for frames < 1, a mesh of fewer than two elements, or negative amplitudes.
+std::vector<TriMesh> ivy_wind(const TriMesh& ivy, const IvyWindOptions& options = {});
+
 }  // namespace mq

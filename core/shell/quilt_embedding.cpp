@@ -605,6 +605,7 @@ TriMesh QuiltEmbedder::output() {
                       : stats_.removed_intersecting);
       continue;
     }
+    stats_.kept.push_back(static_cast<int>(k));
     out.V.middleRows(kv, ev) = all_.V.middleRows(v0, ev);
     out.F.middleRows(kf, ef) = e.F.array() + static_cast<int>(kv);
     out.face_kind.insert(out.face_kind.end(), static_cast<size_t>(ef), e.kind);

@@ -71,6 +71,9 @@ struct QuiltEmbeddingStats {
   long long checked_vertices = 0;
   double below_base = 0, above_shell = 0, lowest_height = 0;
   int faces = 0, vertices = 0, elements = 0;
+  // The output's elements (its connected components, in order) as indices into quilt.elements:
+  // those not removed, each with its vertices and faces in the element's order.
+  std::vector<int> kept;
   // Spread of element surface areas (how even the texture is over the surface).
   double element_area_mean = 0, element_area_cv = 0, element_area_min = 0, element_area_max = 0;
   // Fraction of the base's area with output geometry within 1.5 shell heights on its outer

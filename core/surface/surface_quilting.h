@@ -40,6 +40,22 @@ struct SurfaceElement {
     MatrixX3d barycentric;   // #V by 3
     Eigen::VectorXd height;  // #V
   } through_layout;
+  // Optional (#V by 3, or empty): where each vertex comes from in the swatch (issue 25, swatch
+  // animation; core/shell/swatch_animation): a point on the prepared swatch's element
+  // `source_element` (the swatch scaled to the output, in its synthesis frame), or beyond it
+  // along SurfaceQuilt::repeat for the element repeated so. Kept with
+  // SurfaceQuiltingOptions::keep_sources, by the vine method.
+  int source_element = -1;
+  MatrixX3d source;
+};
+
+// A swatch element repeated end to end along an axis in the quilt (the vine method's stems):
+// sources beyond it are wrapped into it. element -1: none.
+struct SwatchRepeat {
+  int element = -1;
+  Vector3d start = Vector3d::Zero();  // where one repeat starts, in the prepared swatch's frame
+  Vector3d axis = Vector3d::UnitX();  // unit
+  double period = 0;                  // one repeat's length along the axis
 };
 
 struct SurfaceQuilt {
@@ -49,6 +65,7 @@ struct SurfaceQuilt {
   TriMesh input_base;              // the base as given, coincident vertices welded (or its proxy)
   Refinement refinement;           // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
+  SwatchRepeat repeat;             // how SurfaceElement::source wraps (vines)
   // #V(input_base): the vertex of the base as given each input_base vertex is (empty for a
   // proxy, whose vertices are none of them): how a saved quilt follows the base moved.
   std::vector<int> input_vertex;
@@ -78,6 +95,9 @@ struct SurfaceQuiltingOptions {
   // threads) only, as the log scale its cones are placed for; empty: one size.
   Eigen::VectorXd size_map;
   static constexpr double kMaxSizeMapRange = 8;
+  // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch
+  // animation (issue 25); followed by the vine method only.
+  bool keep_sources = false;
   // When the swatch given is one at lower detail (core/mesh/element_detail.h), the swatch it was
   // made from: its symmetry decides the method and the global layout's lattice, which the
   // simplified copies keep only approximately (no exact half turn), so that a Preview and the

@@ -89,6 +89,7 @@ struct SwatchLeaf {
   MatrixX3i F;
   int kind = 0;
   double attach = 0;  // where it sits along one swatch vine length, in [0, period]
+  int element = 0;    // in the prepared swatch
 };
 
 struct VineModel {
@@ -105,6 +106,12 @@ struct VineModel {
   double extent = 0;               // max |wave| + radius: the tube's lateral reach from the axis
   double reach = 0;                // the farthest any element's vertex lies from the axis
   std::vector<SwatchLeaf> leaves;  // ascending attach
+  // Where the stems come from in the swatch (SurfaceElement::source, for swatch animation): the
+  // vine's element, its axis frame in the prepared swatch (footprint origin and unit axis), and
+  // where it starts along the axis.
+  int element = 0;
+  Vector2d origin = Vector2d::Zero(), axis = Vector2d::UnitX();
+  double u0 = 0;
 
   // A leaf's vertices in the stem's straight frame (arc length, lateral, height) when attached
   // at arc length x: moved with the stem's centreline there (its point and tangent), so that it
@@ -364,6 +371,7 @@ void add_swatch_leaves(const PreparedSwatch& swatch, int vine_index, const VineA
     const Element& el = swatch.elements[e];
     SwatchLeaf leaf;
     leaf.kind = el.kind;
+    leaf.element = static_cast<int>(e);
     leaf.attach = leaf_attachment(el, frame, c);
     pose_swatch_leaf(el, frame, c, hz, leaf);
     m.reach = std::max(m.reach, m.pose(leaf, leaf.attach).col(1).cwiseAbs().maxCoeff());
@@ -389,6 +397,10 @@ VineModel analyse_vine(const PreparedSwatch& swatch, int vine_index,
   for (Eigen::Index i = 0; i < nv; ++i) U.row(i) = frame(vine.V.row(i).transpose()).transpose();
   const double u0 = U.col(0).minCoeff(), u1 = U.col(0).maxCoeff();
   m.period = u1 - u0;
+  m.element = vine_index;
+  m.origin = frame.origin;
+  m.axis = frame.axis;
+  m.u0 = u0;
   MQ_CHECK(m.period > 0, InvalidInput, "the swatch's vine has no length");
   set_vine_resolution(vine, m);
   const SwatchCentreline centre = measure_centreline(U, u0, u1, m);
@@ -1028,10 +1040,22 @@ double parallel_spacing(const VineModel& m) {
   return hi;
 }
 
+// Where the vertex q of a stem (in its straight frame: arc length, lateral, height) with pattern
+// phase `phase` comes from in the swatch (SurfaceElement::source): the straight frame laid along
+// the swatch vine's axis, unwrapped (SurfaceQuilt::repeat says where along one swatch vine length
+// it is). The swatch's own centreline differs from the stem's by the periodic blend: a shear of
+// the stem, not a part of the swatch, so the stem's shape is kept as it is here.
+Vector3d stem_source(const VineModel& m, const Vector3d& q, double phase) {
+  const Vector2d left(-m.axis.y(), m.axis.x());
+  const Vector2d p = m.origin + (m.u0 + q.x() + phase) * m.axis + q.y() * left;
+  return {p.x(), p.y(), q.z()};
+}
+
 // A stem laid along its line: each vertex reached from its cross-section's centre on the line
-// by its offset in the frame, along the surface.
+// by its offset in the frame, along the surface. With `sources`, each vertex's place in the
+// swatch too (stem_source).
 Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
-                 const Displacement& shell, std::vector<double>* rings) {
+                 const Displacement& shell, std::vector<double>* rings, bool sources) {
   std::vector<double> ring;
   const TriMesh t = stem_in_frame(m, frame.length(), phase, &ring);
   Placed out;
@@ -1051,15 +1075,22 @@ Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
     if (s != at) c = frame.at(s, direction), at = s;
     set_vertex(out, v, frame.offset(c, direction, t.V(v, 0) - s, t.V(v, 1)), t.V(v, 2), shell);
   }
+  if (sources) {
+    e.source_element = m.element;
+    e.source.resize(nv, 3);
+    for (int v = 0; v < nv; ++v)
+      e.source.row(v) = stem_source(m, t.V.row(v).transpose(), phase).transpose();
+  }
   if (rings) *rings = std::move(ring);
   return out;
 }
 
 // A swatch leaf laid rigidly from its attachment at arc length x: each vertex reached by its
 // offset from there, along the surface. *whole is cleared when part of it would lie beyond the
-// base's boundary.
+// base's boundary. `sources`: the swatch's leaf, vertex by vertex (SurfaceElement::source).
 Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& frame, double x,
-                 double phase, double push, const Displacement& shell, bool* whole) {
+                 double phase, double push, const Displacement& shell, bool* whole,
+                 const MatrixX3d* sources) {
   Placed out;
   SurfaceElement& e = out.element;
   e.kind = leaf.kind;
@@ -1078,6 +1109,10 @@ Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& fr
   for (int v = 0; v < nv; ++v)
     set_vertex(out, v, frame.offset(a, direction, e.flat(v, 0), e.flat(v, 1), whole), e.flat(v, 2),
                shell);
+  if (sources) {
+    e.source_element = leaf.element;
+    e.source = *sources;
+  }
   return out;
 }
 
@@ -1262,9 +1297,12 @@ struct CheckedStem {
 // quilt they make.
 class VinePlacement {
  public:
+  // sources (optional): the prepared swatch, whose points each element's vertices come from are
+  // kept (SurfaceElement::source).
   VinePlacement(const SurfaceJob& job, const SurfaceWalker& walker, const VineModel& model,
-                const StreamlineOptions& so, double shell_height)
+                const StreamlineOptions& so, double shell_height, const PreparedSwatch* sources)
       : job_(job),
+        sources_(sources),
         walker_(walker),
         model_(model),
         so_(so),
@@ -1335,7 +1373,7 @@ class VinePlacement {
   CheckedStem make_checked_stem(const StemLine& st) const {
     CheckedStem out;
     const StemFrame frame(walker_, st.line);
-    out.placed = make_stem(model_, frame, st.phase, shell_, &out.rings);
+    out.placed = make_stem(model_, frame, st.phase, shell_, &out.rings, sources_ != nullptr);
     const Placed& p = out.placed;
     std::vector<char>& b = out.bad;
     b.assign(static_cast<size_t>(p.element.F.rows()), 0);
@@ -1396,7 +1434,9 @@ class VinePlacement {
       const double xs = x + shift * pitch;
       if (xs < 0 || xs > S) continue;
       bool whole = true;
-      Placed p = make_leaf(model_, leaf, frame, xs, phase, push * model_.radius, shell_, &whole);
+      Placed p =
+          make_leaf(model_, leaf, frame, xs, phase, push * model_.radius, shell_, &whole,
+                    sources_ ? &sources_->elements[static_cast<size_t>(leaf.element)].V : nullptr);
       // Whole on the base, clear of everything placed, and not folded through itself
       // (bent over a box's edge, the displacement can fold a leaf).
       if (!whole || placed_.intersects(p.position, p.element.F) >= 0 ||
@@ -1424,6 +1464,7 @@ class VinePlacement {
   }
 
   const SurfaceJob& job_;
+  const PreparedSwatch* sources_;
   const SurfaceWalker& walker_;
   const VineModel& model_;
   const StreamlineOptions& so_;
@@ -1451,6 +1492,11 @@ SurfaceQuilt finish_vine_quilt(SurfaceJob& job, const VineSwatch& vine, VinePlac
   }
   SurfaceQuilt quilt = std::move(placement.quilt());
   quilt.kinds = vine.swatch.kinds;
+  const VineModel& m = vine.model;
+  quilt.repeat.element = m.element;
+  quilt.repeat.axis = Vector3d(m.axis.x(), m.axis.y(), 0);
+  quilt.repeat.start = Vector3d(m.origin.x(), m.origin.y(), 0) + m.u0 * quilt.repeat.axis;
+  quilt.repeat.period = m.period;
   quilt.shell_height = vine.swatch.size.z();
   quilt.base = std::move(job.base);
   take_input_bases(job, quilt);
@@ -1531,7 +1577,8 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
     ScopedStageTimer timer(times, Stage::Streamlines);
     stems = trace_stems(job, walker, guide, so, &vs.streamlines_short, progress);
   }
-  VinePlacement placement(job, walker, vine.model, so, H);
+  VinePlacement placement(job, walker, vine.model, so, H,
+                          options.keep_sources ? &vine.swatch : nullptr);
   {
     ScopedStageTimer timer(times, Stage::Stems);
     placement.grow_stems(std::move(stems), vs);

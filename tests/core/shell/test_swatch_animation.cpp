@@ -1,0 +1,207 @@
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "core/common/errors.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
+#include "core/planar/swatch_generators.h"
+#include "core/planar/translation_cost.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/shell/swatch_animation.h"
+#include "core/surface/global_quilting.h"
+#include "core/surface/vine_growth.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+// The bench jobs' ivy (`swatch ivy --count 2 --length 2`).
+TriMesh ivy_swatch() {
+  IvyOptions o;
+  o.leaves = 2;
+  o.length = 2;
+  return ivy_section(o);
+}
+
+// The vertices of each connected component of m.
+std::vector<std::vector<int>> component_vertices(const TriMesh& m) {
+  std::vector<int> fc;
+  const int n = connected_components(m.F, m.num_vertices(), fc);
+  std::vector<std::vector<int>> out(static_cast<size_t>(n));
+  std::vector<int> of(static_cast<size_t>(m.num_vertices()), -1);
+  for (int f = 0; f < m.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) of[static_cast<size_t>(m.F(f, k))] = fc[static_cast<size_t>(f)];
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (of[static_cast<size_t>(v)] >= 0)
+      out[static_cast<size_t>(of[static_cast<size_t>(v)])].push_back(v);
+  return out;
+}
+
+// The largest relative change of an edge's length from a to b (same faces).
+double edge_strain(const MatrixX3d& a, const MatrixX3d& b, const MatrixX3i& F,
+                   const std::vector<char>* faces = nullptr) {
+  double worst = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (faces && !(*faces)[static_cast<size_t>(f)]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int i = F(f, k), j = F(f, (k + 1) % 3);
+      const double la = (a.row(i) - a.row(j)).norm(), lb = (b.row(i) - b.row(j)).norm();
+      worst = std::max(worst, std::abs(lb - la) / la);
+    }
+  }
+  return worst;
+}
+
+TEST(IvyWind, LoopsLiftsTheLeavesAndKeepsEverythingApart) {
+  const TriMesh ivy = ivy_swatch();
+  IvyWindOptions o;
+  o.frames = 12;
+  const std::vector<TriMesh> frames = ivy_wind(ivy, o);
+  ASSERT_EQ(frames.size(), 12u);
+  EXPECT_TRUE(frames[0].V == ivy.V);  // frame 0 is the section, bit for bit
+  const double height = ivy.V.col(2).maxCoeff();
+  double lifted = 0;
+  IntersectionOptions all;
+  all.between_components_only = false;
+  for (const TriMesh& f : frames) {
+    EXPECT_TRUE(f.F == ivy.F);
+    EXPECT_TRUE(f.face_kind == ivy.face_kind);
+    EXPECT_GE(f.V.col(2).minCoeff(), -1e-12);  // nothing under the plane it rests on
+    EXPECT_TRUE(intersecting_face_pairs(f.V, f.F, all).empty());
+    // Leaves turn rigidly and the vine holds still: no edge changes length beyond rounding.
+    EXPECT_LT(edge_strain(ivy.V, f.V, ivy.F), 1e-9);
+    lifted = std::max(lifted, f.V.col(2).maxCoeff() - height);
+  }
+  // Mid-loop the gust lifts leaf tips well above the section's own height.
+  EXPECT_GT(lifted, 0.5 * height);
+  // Frames near the loop's ends are near the section (it closes smoothly).
+  EXPECT_LT((frames[1].V - ivy.V).rowwise().norm().maxCoeff(),
+            (frames[6].V - ivy.V).rowwise().norm().maxCoeff());
+  EXPECT_THROW(ivy_wind(ivy, IvyWindOptions{0}), InvalidInput);
+}
+
+struct Animated {
+  SurfaceQuilt quilt;
+  TriMesh rest;
+  QuiltEmbeddingStats embedding;
+  double scale = 0;
+};
+
+// Ivy grown over an upright plane with its sources kept, embedded as the tool does.
+Animated grow_ivy(const TriMesh& swatch) {
+  SurfaceQuiltingOptions o;
+  o.scale = 0.06;
+  o.keep_sources = true;
+  Animated a;
+  SurfaceQuiltingStats stats;
+  a.quilt = quilt_surface_vines(test::plane_grid(2, 1.5, 20, 15), swatch, o, {}, &stats);
+  a.scale = stats.swatch_scale;
+  TetStretchCpu stretch;
+  a.rest = embed_quilt(a.quilt, {}, stretch, &a.embedding);
+  return a;
+}
+
+// The vine swaying too (the cross-sections' path), or only the leaves (the default wind).
+class SwatchAnimationSway : public ::testing::TestWithParam<double> {};
+
+TEST_P(SwatchAnimationSway, IvyOnAPlaneMovesWithItsSwatch) {
+  const TriMesh swatch = ivy_swatch();
+  IvyWindOptions wind;
+  wind.frames = 8;
+  wind.vine_sway = GetParam();
+  const std::vector<TriMesh> frames = ivy_wind(swatch, wind);
+  const Animated a = grow_ivy(swatch);
+  ASSERT_GT(a.rest.num_faces(), 0);
+  SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
+  std::vector<SwatchMotion> motions;
+  double largest = 0;  // the swatch's largest vertex motion, at the output's scale
+  for (size_t k = 0; k < frames.size(); ++k) {
+    motions.push_back(swatch_motion(swatch, frames[k], a.scale, "frame"));
+    largest = std::max(largest, (frames[k].V - swatch.V).rowwise().norm().maxCoeff() * a.scale);
+  }
+  SettledMotionStats settled;
+  animation.settle(motions, &settled);
+  const auto elements = component_vertices(a.rest);
+  // Most elements move freely: on a plane nothing is bent, and leaves lift clear of their
+  // neighbours.
+  EXPECT_LT(settled.damped + settled.stilled, static_cast<int>(elements.size()) / 10)
+      << settled.damped << " damped, " << settled.stilled << " still of " << elements.size();
+  IntersectionOptions all;
+  all.between_components_only = false;
+  double moved = 0;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const TriMesh f = animation.frame(motions[k]);
+    ASSERT_TRUE(f.F == a.rest.F);
+    EXPECT_TRUE(f.face_kind == a.rest.face_kind);
+    if (k == 0) {
+      EXPECT_TRUE(f.V == a.rest.V);  // frame 0 is the static output, bit for bit
+    }
+    const double step = (f.V - a.rest.V).rowwise().norm().maxCoeff();
+    moved = std::max(moved, step);
+    // Each vertex moves as far as its source does, and where stems' repeats meet up to three
+    // times that (the periodic correction adds the difference of two sources).
+    EXPECT_LE(step, 3 * largest + 1e-12);
+    EXPECT_TRUE(intersecting_face_pairs(f.V, f.F, all).empty()) << "frame " << k;
+    // Leaves move as one (rigidly, or at half their motion: shrunk by cos(angle / 2), under 2%);
+    // a swaying stem's cross-sections move whole, sheared as little as the swatch's own vine
+    // (under 5%: its sway follows x, its rings lie across the wave).
+    EXPECT_LT(edge_strain(a.rest.V, f.V, a.rest.F), GetParam() > 0 ? 0.05 : 0.02) << "frame " << k;
+  }
+  EXPECT_GT(moved, 0.3 * largest);
+}
+
+INSTANTIATE_TEST_SUITE_P(LeavesOrAll, SwatchAnimationSway, ::testing::Values(0.0, 0.5));
+
+TEST(SwatchAnimation, SameFramesWhateverTheThreadCount) {
+  const TriMesh swatch = ivy_swatch();
+  IvyWindOptions wind;
+  wind.frames = 4;
+  const std::vector<TriMesh> frames = ivy_wind(swatch, wind);
+  std::vector<TriMesh> out[2];
+  for (const int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    const Animated a = grow_ivy(swatch);
+    SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
+    std::vector<SwatchMotion> motions;
+    for (const TriMesh& f : frames) motions.push_back(swatch_motion(swatch, f, a.scale, "f"));
+    animation.settle(motions);
+    for (const SwatchMotion& m : motions) out[threads - 1].push_back(animation.frame(m));
+  }
+  for (size_t k = 0; k < frames.size(); ++k) EXPECT_TRUE(out[0][k].V == out[1][k].V);
+}
+
+TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
+  const TriMesh swatch = ivy_swatch();
+  TriMesh other = swatch;
+  other.F.row(0) = other.F.row(0).reverse().eval();
+  EXPECT_THROW(swatch_motion(swatch, other, 1.0, "f"), InvalidInput);
+  TriMesh fewer = swatch;
+  fewer.V.conservativeResize(fewer.V.rows() - 1, 3);
+  EXPECT_THROW(swatch_motion(swatch, fewer, 1.0, "f"), InvalidInput);
+  TriMesh nan = swatch;
+  nan.V(3, 1) = std::nan("");
+  EXPECT_THROW(swatch_motion(swatch, nan, 1.0, "f"), InvalidInput);
+  // A chain mail quilt keeps no sources: its elements are rigid rings.
+  ChainMailOptions mail;
+  mail.rows = mail.cols = 4;
+  const TriMesh rings = chainmail_4in1(mail);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.3;
+  o.keep_sources = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt q =
+      quilt_surface_global(test::plane_grid(2, 1.5, 20, 15), rings, o, cpu, &stats);
+  QuiltEmbeddingStats e;
+  TetStretchCpu stretch;
+  const TriMesh rest = embed_quilt(q, {}, stretch, &e);
+  EXPECT_THROW(SwatchAnimation(q, e.kept, rest, rings, stats.swatch_scale), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mq
