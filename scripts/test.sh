@@ -52,6 +52,9 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   slow_under_asan+='|SurfaceMask.SpotsHeadByVertexWeights|ThreadTiling.OverASphereThreadsEndOnlyAtItsCones'
   slow_under_asan+='|ThreadTiling.AutoTakesThreadsForTheWeaveOnly|CliSize.ElementSizeGivesTheBytesOfTheSameScale'
   slow_under_asan+='|Reliability.EstimateIsOneLineAndHolds|CliDetail.APreviewIsTheFullRunsLayoutAtAShareOfTheFaces'
+  # The swatch animation's larger runs (the leaves-only plane run stays in).
+  slow_under_asan+='|SwatchAnimation.SameFramesWhateverTheThreadCount'
+  slow_under_asan+='|LeavesOrAll/SwatchAnimationSway.IvyOnAPlaneMovesWithItsSwatch/1'
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j"$jobs" -E "$slow_under_asan"
 fi
