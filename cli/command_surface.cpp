@@ -425,7 +425,14 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
     in.swatch_frames.push_back(read_mesh(f.swatch));
     swatch_motion(swatch, in.swatch_frames.back(), 1.0, f.swatch);
   }
-  if (cl.has("mask")) in.mask = read_surface_mask(cl.get("mask"), base);
+  if (cl.has("mask")) {
+    in.mask = read_surface_mask(cl.get("mask"), base);
+    // Vines grow within the mask (their long stems stop at its border); the other methods'
+    // elements are dropped whole outside it after the synthesis.
+    options.region = [&in](const TriMesh& refined) {
+      return mask_faces(in.mask, in.base, refined);
+    };
+  }
   if (cl.has("size-map")) options.size_map = read_size_map(cl.get("size-map"), base);
   if (cl.has("field")) {
     const Vector3d d(cl.get_double("field", 0), cl.get_double("field", 1),

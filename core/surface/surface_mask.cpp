@@ -30,11 +30,14 @@ double masked_area_share(const SurfaceMask& mask, const TriMesh& base) {
 
 std::vector<char> mask_quilt_faces(const SurfaceMask& mask, const TriMesh& base,
                                    const SurfaceQuilt& quilt) {
+  return mask_faces(mask, base, quilt.base);
+}
+
+std::vector<char> mask_faces(const SurfaceMask& mask, const TriMesh& base, const TriMesh& refined) {
   MQ_CHECK(mask.face.empty() ? mask.vertex_weight.size() == base.num_vertices()
                              : static_cast<int>(mask.face.size()) == base.num_faces(),
            InvalidInput, "the mask does not fit the base (", base.num_vertices(), " vertices, ",
            base.num_faces(), " faces)");
-  const TriMesh& refined = quilt.base;
   MatrixX3d centroids(refined.num_faces(), 3);
   for (int f = 0; f < refined.num_faces(); ++f)
     centroids.row(f) = (refined.V.row(refined.F(f, 0)) + refined.V.row(refined.F(f, 1)) +

@@ -1,7 +1,8 @@
 // Where a surface texture is wanted (issue 25, `meshquilt surface --mask`): the base is quilted
 // as usual, then whole elements over the rest are dropped, so that none is cut at the mask's
-// border; coverage is then judged over the mask alone. Its file is read by
-// core/surface/vertex_map_io.
+// border; coverage is then judged over the mask alone. Vines grow within it instead
+// (SurfaceQuiltingOptions::region, mask_faces): a stem kept whole would run on far past it. Its
+// file is read by core/surface/vertex_map_io.
 #pragma once
 
 #include <string>
@@ -26,6 +27,8 @@ struct SurfaceMask {
 // refinement of it, the nearest point of it under a simplified proxy.
 std::vector<char> mask_quilt_faces(const SurfaceMask& mask, const TriMesh& base,
                                    const SurfaceQuilt& quilt);
+// The same for the faces of `refined` (a refinement of base, or a proxy of it).
+std::vector<char> mask_faces(const SurfaceMask& mask, const TriMesh& base, const TriMesh& refined);
 
 // The share of the base's area (the base as given) in the mask, sampled at four points of each
 // face (its centroid and the middles of its corners' thirds): what the job's face estimate is

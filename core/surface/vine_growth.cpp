@@ -1154,6 +1154,20 @@ void check_options(const VineGrowthOptions& o) {
 
 // --- the method's steps ------------------------------------------------------------------------
 
+// The face adjacency TT with no face of the region (#F flags) adjacent to one outside it.
+MatrixX3i cut_at_region(const MatrixX3i& TT, const std::vector<char>& region) {
+  MQ_CHECK(static_cast<Eigen::Index>(region.size()) == TT.rows(), InternalError,
+           "vine growth: a region of ", region.size(), " faces for a base of ", TT.rows());
+  MatrixX3i out = TT;
+  for (Eigen::Index f = 0; f < TT.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int g = TT(f, k);
+      if (g >= 0 && region[static_cast<size_t>(f)] != region[static_cast<size_t>(g)])
+        out(f, k) = -1;
+    }
+  return out;
+}
+
 // The swatch as the vine method uses it: prepared at the detail given, its vine's model, and the
 // spacing between stems.
 struct VineSwatch {
@@ -1257,14 +1271,17 @@ struct StemLine {
 // field, seeded from the lowest face along so.up first so that the stems grow from the bottom,
 // and kept off the base's boundary. *short_lines: those traced but too short to grow.
 std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& walker,
-                                  const MatrixX3d& guide, const StreamlineOptions& so,
-                                  int* short_lines, ProgressSink* progress) {
+                                  const std::vector<char>& region, const MatrixX3d& guide,
+                                  const StreamlineOptions& so, int* short_lines,
+                                  ProgressSink* progress) {
   const TriMesh& base = job.base;
   const int nf = base.num_faces();
-  // The base's boundary, sampled, keeps the tubes off it.
+  const auto inside = [&](int f) { return region.empty() || region[static_cast<size_t>(f)]; };
+  // The base's boundary, and the region's, sampled, keep the tubes off them.
   std::vector<Vector3d> obstacles;
   for (int e = 0; e < job.topo.num_edges(); ++e) {
-    if (job.topo.edge_faces.degree(e) == 2) continue;
+    const int* faces = job.topo.edge_faces.begin(e);
+    if (job.topo.edge_faces.degree(e) == 2 && inside(faces[0]) == inside(faces[1])) continue;
     const Vector3d a = base.V.row(job.topo.E(e, 0)), b = base.V.row(job.topo.E(e, 1));
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * so.obstacle))));
     for (int k = 0; k <= n; ++k) obstacles.push_back(a + (b - a) * (static_cast<double>(k) / n));
@@ -1273,8 +1290,9 @@ std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& wa
   std::vector<std::pair<double, int>> order(static_cast<size_t>(nf));
   for (int f = 0; f < nf; ++f) order[static_cast<size_t>(f)] = {walker.centroid(f).dot(so.up), f};
   std::sort(order.begin(), order.end());
-  std::vector<int> seeds(static_cast<size_t>(nf));
-  for (int f = 0; f < nf; ++f) seeds[static_cast<size_t>(f)] = order[static_cast<size_t>(f)].second;
+  std::vector<int> seeds;
+  for (const auto& [height, f] : order)
+    if (inside(f)) seeds.push_back(f);
   Streamlines grower(walker, guide, job.field, obstacles, so);
   grower.grow(seeds, progress);
   std::vector<StemLine> stems;
@@ -1558,7 +1576,10 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   const VineSwatch vine = analyse_vine_swatch(job, times);
   const double H = vine.swatch.size.z();
   stats.shell_height = H;
-  const SurfaceWalker walker(job.base, job.TT);
+  // Under a region (a mask), its border is a boundary: stems stop there, leaves are laid within.
+  const std::vector<char> region = options.region ? options.region(job.base) : std::vector<char>{};
+  const MatrixX3i TT = region.empty() ? job.TT : cut_at_region(job.TT, region);
+  const SurfaceWalker walker(job.base, TT);
   Vector3d up;
   const MatrixX3d guide = stem_guide_field(job, options, vo, walker.normals(), &up);
   const StreamlineOptions so = stem_streamline_options(vo, vine.model, vine.spacing, up);
@@ -1575,7 +1596,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   std::vector<StemLine> stems;
   {
     ScopedStageTimer timer(times, Stage::Streamlines);
-    stems = trace_stems(job, walker, guide, so, &vs.streamlines_short, progress);
+    stems = trace_stems(job, walker, region, guide, so, &vs.streamlines_short, progress);
   }
   VinePlacement placement(job, walker, vine.model, so, H,
                           options.keep_sources ? &vine.swatch : nullptr);

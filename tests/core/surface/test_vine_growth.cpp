@@ -161,6 +161,44 @@ TEST(VineGrowth, StemsClimbAPlaneEvenlySpaced) {
   EXPECT_NEAR(gaps[gaps.size() / 2], g.stats.spacing, 0.01 * g.stats.spacing);
 }
 
+// Under a region (a mask, issue 25) stems stop at its border as at the base's and leaves lie
+// within it: no long stem is kept whole across it. The region: below a slanted line.
+TEST(VineGrowth, StemsStopAtTheRegionsBorder) {
+  const TriMesh plane = test::plane_grid(2, 1.5, 40, 30);
+  const auto below = [](const Vector3d& p) { return p.y() + 0.3 * p.x() - 0.9; };
+  SurfaceQuiltingOptions o;
+  o.scale = 0.06;
+  VineGrowthStats region_stats, all_stats;
+  const SurfaceQuilt all = quilt_surface_vines(plane, ivy_swatch(), o, {}, nullptr, &all_stats);
+  o.region = [&](const TriMesh& refined) {
+    std::vector<char> in(static_cast<size_t>(refined.num_faces()));
+    for (int f = 0; f < refined.num_faces(); ++f)
+      in[static_cast<size_t>(f)] =
+          below((refined.V.row(refined.F(f, 0)) + refined.V.row(refined.F(f, 1)) +
+                 refined.V.row(refined.F(f, 2)))
+                    .transpose() /
+                3.0) < 0;
+    return in;
+  };
+  const SurfaceQuilt part = quilt_surface_vines(plane, ivy_swatch(), o, {}, nullptr, &region_stats);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;
+  TetStretchCpu stretch;
+  const TriMesh mesh = embed_quilt(part, e, stretch);
+  // Within a face (0.05) of the border: the region is decided per face.
+  double beyond = -kInf;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    beyond = std::max(beyond, below(mesh.V.row(v).transpose()));
+  EXPECT_LT(beyond, 0.05);
+  EXPECT_TRUE(intersecting_face_pairs(mesh.V, mesh.F).empty());
+  // The region is 40% of the plane; the stems fill it as they fill the plane.
+  ASSERT_GT(region_stats.stems, 5);
+  const double share = region_stats.total_length / all_stats.total_length;
+  EXPECT_GT(share, 0.3);
+  EXPECT_LT(share, 0.45);
+  EXPECT_LT(part.elements.size(), all.elements.size());
+}
+
 // Each stem carries its leaves to its ends: the strips along the plane's foot and top, where
 // every stem starts and ends, are covered nearly as well as its middle (a leaf whose place lies
 // just past an end is moved onto the stem, as any leaf is moved to clear its neighbours).
