@@ -1,5 +1,5 @@
 """A screenshot of the add-on's panel in Blender's UI (README). Blender draws its UI only with a
-display, so this runs under a virtual one:
+display, so this runs under a virtual one (scripts/blender_panel_screenshot.sh does all of it):
 
     xvfb-run -s "-screen 0 1600x1000x24" blender --factory-startup --enable-event-simulate \
         EMPTY.blend --python scripts/blender_panel_screenshot.py -- ENGINE ADDON_DIR OUT.png
@@ -79,6 +79,6 @@ def shoot():
 
 
 bpy.app.timers.register(frame, first_interval=1.0)
-bpy.app.timers.register(click_tab, first_interval=2.0)
-bpy.app.timers.register(click_tab, first_interval=3.0)
-bpy.app.timers.register(shoot, first_interval=6.0)
+bpy.app.timers.register(click_tab, first_interval=4.0)
+bpy.app.timers.register(click_tab, first_interval=5.0)
+bpy.app.timers.register(shoot, first_interval=8.0)
