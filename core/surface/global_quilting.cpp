@@ -897,6 +897,20 @@ std::vector<char> intersecting_thread_pieces(const SurfaceJob& job, const Matrix
   return drop;
 }
 
+// Under a region (a mask, SurfaceQuiltingOptions::region: per face of job.base): the pieces most
+// of whose vertices lie outside it are dropped too, so that threads end (capped) at its border
+// rather than run on whole past it.
+void drop_pieces_outside(const std::vector<char>& region, const std::vector<PlacedPiece>& placed,
+                         std::vector<char>& drop) {
+  drop.resize(placed.size(), 0);
+  for (size_t k = 0; k < placed.size(); ++k) {
+    const std::vector<int>& faces = placed[k].element.face;
+    const auto outside = std::count_if(faces.begin(), faces.end(),
+                                       [&](int f) { return region[static_cast<size_t>(f)] == 0; });
+    if (2 * static_cast<size_t>(outside) > faces.size()) drop[k] = 1;
+  }
+}
+
 // A periodic swatch of threads (core/surface/thread_tiling) carried onto the base: every lattice
 // copy of every thread piece whose centre lies on the parameterised surface, placed through the
 // layout like place_lattice's elements, then welded end to end into threads. A piece is left out,
@@ -938,8 +952,9 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
   ThreadWeldStats ws;
   std::vector<std::vector<int>> face_piece;
   std::vector<SurfaceElement> threads = weld_threads(placed, tiling, welds, {}, &ws, &face_piece);
-  const std::vector<char> drop = intersecting_thread_pieces(
-      job, N, threads, face_piece, placed.size(), options.global.drop_folded_pieces, gstats);
+  std::vector<char> drop = intersecting_thread_pieces(job, N, threads, face_piece, placed.size(),
+                                                      options.global.drop_folded_pieces, gstats);
+  if (options.region) drop_pieces_outside(options.region(job.base), placed, drop);
   threads = weld_threads(placed, tiling, welds, drop, &ws, nullptr, kMinThreadPieces);
   gstats.thread_welds = ws.welds;
   gstats.thread_ends = ws.caps;

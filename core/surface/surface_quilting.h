@@ -99,10 +99,11 @@ struct SurfaceQuiltingOptions {
   // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch
   // animation (issue 25); followed by the vine method only.
   bool keep_sources = false;
-  // Where the vine method may grow (issue 25, `--mask`): per face of the refined base it is
-  // handed, whether that face is in; empty: everywhere. Stems stop at the region's border as at
-  // the base's, and leaves lie within it, so no long stem is kept whole across it. The other
-  // methods quilt everywhere (their elements are then kept or dropped whole).
+  // Where long elements may lie (issue 25, `--mask`): per face of the refined base it is
+  // handed, whether that face is in; empty: everywhere. The vine method's stems stop at the
+  // region's border as at the base's, and leaves lie within it; the global layout's threads end
+  // at it (their pieces outside left out), so no long element is kept whole across it. Compact
+  // elements are placed everywhere (and then kept or dropped whole by the caller).
   std::function<std::vector<char>(const TriMesh& refined_base)> region;
   // When the swatch given is one at lower detail (core/mesh/element_detail.h), the swatch it was
   // made from: its symmetry decides the method and the global layout's lattice, which the

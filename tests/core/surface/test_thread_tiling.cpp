@@ -342,6 +342,47 @@ void expect_whole_threads(const WeaveRun& r) {
   EXPECT_GE(r.embedding.coverage, 0.95);
 }
 
+// Under a region (a mask: a disk on a plane) threads end at its border, capped, instead of
+// running on whole past it: nothing lies beyond it by more than a period (a piece is left out when
+// most of it lies outside), and the threads are whole tubes.
+TEST(ThreadTiling, ThreadsEndAtTheRegionsBorder) {
+  const TriMesh base = test::plane_grid(10, 10, 40, 40);
+  const TriMesh swatch = weave();
+  const double spacing = 0.35;
+  SurfaceQuiltingOptions o;
+  o.scale = spacing * bounding_box(swatch.V).extent().head<2>().maxCoeff() /
+            bounding_box(base.V, base.F).extent().norm();
+  o.field = tangent_field_from_direction(base.V, base.F, Vector3d::UnitX());
+  const auto radius = [](const Vector3d& p) { return std::hypot(p.x() - 5, p.y() - 5); };
+  o.region = [&](const TriMesh& refined) {
+    std::vector<char> in(static_cast<size_t>(refined.num_faces()));
+    for (int f = 0; f < refined.num_faces(); ++f)
+      in[static_cast<size_t>(f)] =
+          radius((refined.V.row(refined.F(f, 0)) + refined.V.row(refined.F(f, 1)) +
+                  refined.V.row(refined.F(f, 2)))
+                     .transpose() /
+                 3.0) < 3;
+    return in;
+  };
+  TranslationCostCpu cost;
+  SurfaceQuiltingStats stats;
+  GlobalQuiltingStats global;
+  const SurfaceQuilt quilt = quilt_surface_global(base, swatch, o, cost, &stats, &global);
+  ASSERT_TRUE(global.threads);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;
+  TetStretchCpu stretch;
+  const TriMesh out = embed_quilt(quilt, e, stretch);
+  double farthest = 0;
+  for (int v = 0; v < out.num_vertices(); ++v)
+    farthest = std::max(farthest, radius(out.V.row(v).transpose()));
+  EXPECT_LT(farthest, 3 + 2 * spacing);  // a period is two thread spacings of the weave
+  EXPECT_GT(farthest, 3 - spacing);      // and the disk is filled to its border
+  EXPECT_GT(quilt.elements.size(), 20u);
+  expect_closed_outward_elements(out);
+  EXPECT_TRUE(intersecting_face_pairs(out.V, out.F).empty());
+}
+
 // Along the axis of an open cylinder: the warps run its whole height, the wefts close round it;
 // nothing ends but at the two border circles (within a period of them: a piece that would
 // reach beyond the border is left out whole).
