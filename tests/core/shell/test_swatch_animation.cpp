@@ -15,18 +15,13 @@
 #include "core/shell/swatch_animation.h"
 #include "core/surface/global_quilting.h"
 #include "core/surface/vine_growth.h"
+#include "tests/core/vine_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
-// The bench jobs' ivy (`swatch ivy --count 2 --length 2`).
-TriMesh ivy_swatch() {
-  IvyOptions o;
-  o.leaves = 2;
-  o.length = 2;
-  return ivy_section(o);
-}
+using test::ivy_swatch;
 
 // The vertices of each connected component of m.
 std::vector<std::vector<int>> component_vertices(const TriMesh& m) {

@@ -21,6 +21,7 @@
 #include "core/surface/thread_tiling.h"
 #include "tests/core/planar_checks.h"
 #include "tests/core/shell_fixtures.h"
+#include "tests/core/vine_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -354,16 +355,8 @@ TEST(ThreadTiling, ThreadsEndAtTheRegionsBorder) {
             bounding_box(base.V, base.F).extent().norm();
   o.field = tangent_field_from_direction(base.V, base.F, Vector3d::UnitX());
   const auto radius = [](const Vector3d& p) { return std::hypot(p.x() - 5, p.y() - 5); };
-  o.region = [&](const TriMesh& refined) {
-    std::vector<char> in(static_cast<size_t>(refined.num_faces()));
-    for (int f = 0; f < refined.num_faces(); ++f)
-      in[static_cast<size_t>(f)] =
-          radius((refined.V.row(refined.F(f, 0)) + refined.V.row(refined.F(f, 1)) +
-                  refined.V.row(refined.F(f, 2)))
-                     .transpose() /
-                 3.0) < 3;
-    return in;
-  };
+  o.region = test::centroid_region([&](const Vector3d& c) { return radius(c) < 3; });
+
   TranslationCostCpu cost;
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats global;

@@ -18,18 +18,13 @@
 #include "core/surface/global_quilting.h"
 #include "core/surface/tangent_field.h"
 #include "core/surface/vine_growth.h"
+#include "tests/core/vine_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
-// The sample ivy of the bench jobs (`swatch ivy --count 2 --length 2`): one vine, two leaves.
-TriMesh ivy_swatch() {
-  IvyOptions o;
-  o.leaves = 2;
-  o.length = 2;
-  return ivy_section(o);
-}
+using test::ivy_swatch;
 
 // The kind index of a name in a quilt.
 int kind_of(const SurfaceQuilt& q, const std::string& name) {
@@ -170,16 +165,8 @@ TEST(VineGrowth, StemsStopAtTheRegionsBorder) {
   o.scale = 0.06;
   VineGrowthStats region_stats, all_stats;
   const SurfaceQuilt all = quilt_surface_vines(plane, ivy_swatch(), o, {}, nullptr, &all_stats);
-  o.region = [&](const TriMesh& refined) {
-    std::vector<char> in(static_cast<size_t>(refined.num_faces()));
-    for (int f = 0; f < refined.num_faces(); ++f)
-      in[static_cast<size_t>(f)] =
-          below((refined.V.row(refined.F(f, 0)) + refined.V.row(refined.F(f, 1)) +
-                 refined.V.row(refined.F(f, 2)))
-                    .transpose() /
-                3.0) < 0;
-    return in;
-  };
+  o.region = test::centroid_region([&](const Vector3d& c) { return below(c) < 0; });
+
   const SurfaceQuilt part = quilt_surface_vines(plane, ivy_swatch(), o, {}, nullptr, &region_stats);
   QuiltEmbeddingOptions e;
   e.shell_map = false;
