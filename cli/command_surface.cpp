@@ -423,7 +423,7 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
   // swatch moved, fails the run before anything is written.
   for (const SurfaceRequest::Frame& f : r.frames) {
     in.swatch_frames.push_back(read_mesh(f.swatch));
-    swatch_motion(swatch, in.swatch_frames.back(), 1.0, f.swatch);
+    check_swatch_frame(swatch, in.swatch_frames.back(), f.swatch);
   }
   if (cl.has("mask")) {
     in.mask = read_surface_mask(cl.get("mask"), base);

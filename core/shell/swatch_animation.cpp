@@ -31,13 +31,17 @@ double seam_weight(double t) { return t * t * (3 - 2 * t); }
 
 }  // namespace
 
-SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double scale,
-                           const std::string& name) {
+void check_swatch_frame(const TriMesh& swatch, const TriMesh& frame, const std::string& name) {
   MQ_CHECK(frame.num_vertices() == swatch.num_vertices() && frame.F == swatch.F, InvalidInput, name,
            ": the swatch frame has ", frame.num_vertices(), " vertices and ", frame.num_faces(),
            " faces, not the swatch's ", swatch.num_vertices(), " and ", swatch.num_faces(),
            " faces in the same order (frames move the swatch's vertices only)");
   MQ_CHECK(frame.V.allFinite(), InvalidInput, name, ": non-finite vertex coordinates");
+}
+
+SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double scale,
+                           const std::string& name) {
+  check_swatch_frame(swatch, frame, name);
   const PreparedSwatch rest = prepared_at(swatch, scale), moved = prepared_at(frame, scale);
   // Each frame is prepared as the swatch is (its elements and their vertices in the same order,
   // by connectivity), then taken into the swatch's synthesis frame: prepare_swatch's rotation

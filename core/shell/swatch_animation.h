@@ -33,6 +33,10 @@ struct SwatchMotion {
 SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double scale,
                            const std::string& name);
 
+// The check swatch_motion makes first, alone (before a synthesis: nothing prepared). Throws as
+// swatch_motion.
+void check_swatch_frame(const TriMesh& swatch, const TriMesh& frame, const std::string& name);
+
 // The output's vertices with their sources located on the swatch and their frames, made once;
 // frame() is then a pass over the vertices per swatch frame.
 class SwatchAnimation {
