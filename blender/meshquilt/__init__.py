@@ -117,6 +117,10 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Detail", default=100, min=1, max=100, subtype="PERCENTAGE",
         description="The share of each swatch element's faces kept, each element simplified "
         "on its own; the layout is the same as at 100%. Lower is faster and lighter")
+    wind_frames: bpy.props.IntProperty(
+        name="Wind", default=0, min=0, max=250,
+        description="The Ivy sample's leaves turning in a looping wind of this many frames (0: "
+        "still): one shape key a frame, played from the scene's start frame. Needs Detail 100%")
     # The engine's last estimate (meshquilt.estimate) and the settings it was made for.
     estimate_key: bpy.props.StringProperty(options={"SKIP_SAVE"})
     estimate_faces: bpy.props.IntProperty(name="Estimated faces", options={"SKIP_SAVE"})
@@ -124,6 +128,14 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     estimate_seconds: bpy.props.FloatProperty(name="Estimated time (s)", options={"SKIP_SAVE"})
     estimate_fits: bpy.props.BoolProperty(name="Within the memory limit", options={"SKIP_SAVE"})
     estimate_error: bpy.props.StringProperty(options={"SKIP_SAVE"})
+
+
+def wind_frames(settings, preview=False):
+    """The frames of the wind a run animates: Wind for the Ivy sample, else 0 (a Preview shows
+    the still layout)."""
+    if preview or settings.swatch_source != "SAMPLE" or settings.sample != "ivy":
+        return 0
+    return settings.wind_frames
 
 
 def estimate_key(context, settings):
@@ -143,7 +155,7 @@ def estimate_key(context, settings):
         parts += ["sample", settings.sample]
     parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed,
               settings.stretch, settings.guidance, settings.detail, settings.mask_group,
-              settings.size_group, round(settings.smallest_size, 4)]
+              settings.size_group, round(settings.smallest_size, 4), wind_frames(settings)]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -325,8 +337,19 @@ class Run:
                                          % base.name)
             self.scale = self.element_size / diagonal
         self.base_matrix = np.array(base.matrix_world)
+        # Wind (docs/animation.md): the engine follows the sample's looping frames, one output
+        # a frame with frame 0's faces; the frames come in as shape keys. Such a result is not
+        # bound to its base (re-placing it would lose the wind).
+        self.wind = wind_frames(settings, preview)
+        if self.wind and self.detail < 1:
+            raise engine.EngineError("Wind moves the ivy as it is generated: set Detail to "
+                                     "100%, or Wind to 0")
+        self.output = os.path.join(self.dir, "result_%03d.ply") if self.wind else \
+            self.result_path
+        if self.wind:
+            self.result_path = self.output % 0
         # The quilt saved for following the base.
-        self.quilt_path = os.path.join(self.dir, "quilt.mqq")
+        self.quilt_path = None if self.wind else os.path.join(self.dir, "quilt.mqq")
         if settings.guidance == "AXIS":
             axis = {"X": 0, "Y": 1, "Z": 2}[settings.guide_axis]
             field = tuple(settings.guide_object.matrix_world.to_3x3().col[axis])
@@ -352,8 +375,12 @@ class Run:
             self.material_names = {_engine_kind_name(k): k for k in kinds}
         else:
             swatch_path = os.path.join(self.dir, "swatch_%s.ply" % settings.sample)
-            self.jobs.append(lambda: engine.swatch_job(self.engine, settings.sample, swatch_path,
-                                                       settings.seed))
+            made = swatch_path
+            if self.wind:
+                made = os.path.join(self.dir, "swatch_%s_%%03d.ply" % settings.sample)
+                swatch_path = made % 0
+            self.jobs.append(lambda: engine.swatch_job(self.engine, settings.sample, made,
+                                                       settings.seed, frames=self.wind))
         self.preparation = len(self.jobs)  # the jobs before the surface job
         self.paths = (base_path, swatch_path)
         self.stats_path = os.path.join(self.dir, "stats.json")
@@ -362,8 +389,10 @@ class Run:
                             field_file=field_file, max_memory=self.max_memory,
                             element_size=self.element_size, detail=self.detail, mask=mask_file,
                             size_map=size_file)
+        if self.wind:
+            self.options.update(swatch_frames=made, frames=(0, self.wind - 1))
         self.jobs.append(lambda: engine.surface_job(
-            self.engine, base_path, swatch_path, self.result_path, self.scale,
+            self.engine, base_path, swatch_path, self.output, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
         # The structure measured against the swatch for the report (optional: a failure
         # there leaves the result and the rest of the report).
@@ -493,7 +522,7 @@ class Run:
             if job.wait(60) != "done":
                 raise engine.EngineError(job.error)
         self.preparation = 0
-        return engine.estimate(self.engine, self.paths[0], self.paths[1], self.result_path,
+        return engine.estimate(self.engine, self.paths[0], self.paths[1], self.output,
                                self.scale, **self.options)
 
     # Shares of the whole run: the sample swatch before, the structure measure after.
@@ -565,6 +594,13 @@ class Run:
         if self.quilt_path and os.path.exists(self.quilt_path):
             follow.bind(obj, self.base, self.quilt_path, self.topology["T"],
                         self.topology["loops"], self.topology["totals"], self.base_matrix)
+        if self.wind:
+            frames = [result.V] + [exchange.read_ply(self.output % k).V
+                                   for k in range(1, self.wind)]
+            if any(len(V) != len(result.V) for V in frames):
+                raise engine.EngineError("the wind's frames do not match its first")
+            follow.keep_frames(obj, frames, context.scene.frame_start, loop=True)
+            obj["meshquilt_wind"] = self.wind
         try:
             store_report(obj, exchange.structure_report(self.stats_path, self.elements_path))
         except (OSError, ValueError, KeyError) as e:
@@ -1092,6 +1128,8 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             _labelled(layout, s, "swatch", "Swatch")
         else:
             _labelled(layout, s, "sample", "Sample")
+            if s.sample == "ivy":
+                layout.prop(s, "wind_frames")
         layout.prop(s, "scale")
         layout.prop(s, "element_size")
         _draw_element_size(layout, context, s)
@@ -1131,6 +1169,10 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             _draw_report(layout, obj)
             b = obj.meshquilt
             box = layout.box()
+            if obj.get("meshquilt_wind"):
+                box.label(text="In the wind: %d frames a loop" % obj["meshquilt_wind"],
+                          icon="FORCE_WIND")
+                return
             if not b.quilt:
                 box.label(text="No saved quilt: cannot follow its base", icon="INFO")
                 return

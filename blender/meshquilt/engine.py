@@ -272,18 +272,25 @@ class Job:
         return progress_text(self.overall, time.monotonic() - self._started, self.stage)
 
 
-def swatch_job(engine, kind, output, seed=1):
-    """Generates a sample swatch (chainmail, weave, apples, ivy)."""
-    return Job(engine, ["swatch", kind, "-o", output, "--seed", str(seed), "--quiet"],
-               progress=False)
+def swatch_job(engine, kind, output, seed=1, frames=0):
+    """Generates a sample swatch (chainmail, weave, apples, ivy); with frames > 0 (ivy only) a
+    looping wind of that many frames, output a pattern with one integer field (frame 0 is the
+    swatch itself)."""
+    args = ["swatch", kind, "-o", output, "--seed", str(seed), "--quiet"]
+    if frames > 0:
+        args += ["--frames", str(int(frames))]
+    return Job(engine, args, progress=False)
 
 
 def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
                  field_file=None, threads=0, save_quilt=None, max_memory=None, stats=None,
-                 element_size=0.0, detail=1.0, mask=None, size_map=None):
+                 element_size=0.0, detail=1.0, mask=None, size_map=None, swatch_frames=None,
+                 frames=None):
     """The arguments of a surface job (surface_job; estimate with the same settings); an
     element_size > 0 (the swatch's longer side in the base's units) replaces the scale; a
-    detail below 1 keeps that share of each swatch element's faces (the same layout)."""
+    detail below 1 keeps that share of each swatch element's faces (the same layout);
+    swatch_frames a pattern of the swatch's frames and frames (first, last) follow them, one
+    output each (output a pattern then)."""
     size = ["--element-size", repr(float(element_size))] if element_size and \
         element_size > 0 else ["--scale", repr(float(scale))]
     args = ["surface", "--base", base, "--swatch", swatch, "-o", output] + size + \
@@ -306,6 +313,8 @@ def surface_args(base, swatch, output, scale, seed=1, stretch=True, field=None,
         args += ["--mask", mask]
     if size_map:
         args += ["--size-map", size_map]
+    if swatch_frames:
+        args += ["--swatch-frames", swatch_frames, "--frames", "%d-%d" % tuple(frames)]
     return args
 
 

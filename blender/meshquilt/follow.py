@@ -228,9 +228,19 @@ def bake(context, obj):
                                  "again" % obj.name)
     b.follow = False
     clear_bake(obj)
+    keep_frames(obj, frames, first)
+    b.baked = True
+    b.status = ""
+    return count
+
+
+def keep_frames(obj, frames, first, loop=False):
+    """The positions of each frame (#V by 3, world = the object's space here) as absolute shape
+    keys, one a frame, played from scene frame `first` by keying the evaluation time linearly;
+    with loop, frame 0 follows the last and the keys repeat for ever (a Cycles modifier)."""
     me = obj.data
     me.vertices.foreach_set("co", frames[0].astype(np.float32).ravel())
-    for i, V in enumerate(frames):
+    for i, V in enumerate(list(frames) + ([frames[0]] if loop else [])):
         block = obj.shape_key_add(name="frame %d" % (first + i), from_mix=False)
         block.data.foreach_set("co", V.astype(np.float32).ravel())
         block.interpolation = "KEY_LINEAR"
@@ -242,10 +252,9 @@ def bake(context, obj):
     for fcurve in key.animation_data.action.fcurves:
         for point in fcurve.keyframe_points:
             point.interpolation = "LINEAR"
-    b.baked = True
-    b.status = ""
+        if loop:
+            fcurve.modifiers.new("CYCLES")
     me.update()
-    return count
 
 
 def remove_elements(context, obj, ids):

@@ -101,7 +101,7 @@ class FakeLayout:
         self.texts.append("op:%s" % idname)
 
     def prop(self, *args, **kw):
-        pass
+        self.texts.append("prop:%s" % (args[1] if len(args) > 1 else kw.get("property", "")))
 
     def row(self, **kw):
         return self
@@ -1117,6 +1117,66 @@ def sphere_with_top_cap(name, group_name):
     group.add([v.index for v in base.data.vertices if v.co.z > 0.2], 1.0, "REPLACE")
     s.base, s.sample, s.scale, s.detail = base, "chainmail", 0.25, 10
     return s, base
+
+
+@test
+def test_wind_turns_the_ivys_leaves_in_a_loop_of_shape_keys():
+    scene = new_scene()
+    base = sphere()
+    s = scene.meshquilt
+    s.base, s.swatch_source, s.sample, s.scale, s.stretch = base, "SAMPLE", "chainmail", 0.5, False
+    check("prop:wind_frames" not in drawn_panel(), "Wind offered for chain mail")
+    s.sample, s.wind_frames = "ivy", 6
+    check("prop:wind_frames" in drawn_panel(), "panel: %s" % drawn_panel())
+    start = time.monotonic()
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "wind run did not finish")
+    print("[blender]   ivy in a wind of 6 frames: %.1f s" % (time.monotonic() - start), flush=True)
+    obj = base.meshquilt.result
+    key = obj.data.shape_keys
+    check(key is not None and not key.use_relative and len(key.key_blocks) == 7,
+          "expected 6 absolute shape keys and frame 0 again, got %s"
+          % (len(key.key_blocks) if key else None))
+    check(obj.get("meshquilt_wind") == 6 and not obj.meshquilt.quilt, "bound to its base")
+    bpy.context.view_layer.objects.active = obj
+    check("In the wind: 6 frames a loop" in drawn_panel(), "panel: %s" % drawn_panel())
+    rest, first = positions(obj), scene.frame_start
+    V = []
+    for frame in range(first, first + 13):
+        scene.frame_set(frame)
+        V.append(positions(obj, evaluated=True))
+    scene.frame_set(first)
+    # Frame 0 is the still result (the engine's frame 0 is its static output byte for byte);
+    # the loop comes back to it every 6 frames and moves at every frame between.
+    check(np.allclose(V[0], rest, atol=1e-6), "frame 0 is not the still result")
+    check(np.allclose(V[6], V[0], atol=1e-5) and np.allclose(V[12], V[0], atol=1e-5),
+          "the wind does not loop")
+    for k in range(1, 6):
+        check(np.abs(V[k] - V[k - 1]).max() > 1e-4, "frame %d equals the one before" % k)
+    # The leaves turn, the vine holds still (the wind's default), and faces stay as they are.
+    names = [m.name for m in obj.data.materials]
+    material = np.empty(len(obj.data.polygons), dtype=np.int32)
+    obj.data.polygons.foreach_get("material_index", material)
+    loops = np.empty(3 * len(obj.data.polygons), dtype=np.int32)
+    obj.data.polygons.foreach_get("vertices", loops)
+    loops = loops.reshape(-1, 3)
+    leaf = np.zeros(len(rest), dtype=bool)
+    leaf[loops[material == names.index("leaf")].ravel()] = True
+    vine = np.zeros(len(rest), dtype=bool)
+    vine[loops[material == names.index("vine")].ravel()] = True
+    vine &= ~leaf
+    check(leaf.any() and vine.any(), "no leaves or no vine")
+    moved = np.linalg.norm(V[3] - V[0], axis=1)
+    check(moved[vine].max() < 1e-5, "the vine moved %g" % moved[vine].max())
+    check(moved[leaf].max() > 1e-3, "the leaves moved only %g" % moved[leaf].max())
+    # Wind needs the swatch as generated; a Preview shows the still layout.
+    s.detail = 50
+    message = reported(bpy.ops.meshquilt.run)
+    check("set Detail to 100%" in message, message)
+    check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "preview did not finish")
+    preview = base.meshquilt.result
+    check(preview.data.shape_keys is None and preview.get("meshquilt_wind") is None,
+          "a Preview in the wind")
+    s.detail, s.wind_frames = 100, 0
 
 
 @test
