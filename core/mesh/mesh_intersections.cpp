@@ -277,6 +277,83 @@ FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int
   return grid;
 }
 
+// Where each label's faces lie when every label's faces are consecutive (elements appended one
+// after another, as every output is): label l's faces are [begin[l], end[l]). Empty when a label
+// is not one run (or none is given): the broad phase then filters by label face by face.
+struct LabelRuns {
+  std::vector<int> begin, end;
+};
+
+LabelRuns label_runs(const std::vector<int>* label) {
+  LabelRuns runs;
+  if (!label || label->empty()) return runs;
+  const auto [lo, hi] = std::minmax_element(label->begin(), label->end());
+  if (*lo < 0) return runs;
+  const size_t n = static_cast<size_t>(*hi) + 1;
+  runs.begin.assign(n, -1);
+  runs.end.assign(n, -1);
+  for (int f = 0; f < static_cast<int>(label->size()); ++f) {
+    const auto l = static_cast<size_t>((*label)[static_cast<size_t>(f)]);
+    if (runs.begin[l] < 0) {
+      runs.begin[l] = f;
+    } else if (runs.end[l] != f) {
+      return {};  // label l seen again after another: not one run
+    }
+    runs.end[l] = f + 1;
+  }
+  return runs;
+}
+
+// The faces g that face f is tested against (see find_pairs) and that intersect it, appended to
+// hits: f's cells' buckets, each pair in the cell holding the min corner of the intersection of
+// the two boxes (per axis the larger of their first cells), the exact test taking the active
+// face first (the earlier if both are).
+void face_hits(const MatrixX3d& V, const MatrixX3i& F, const FaceGrid& grid, const LabelRuns& runs,
+               bool labelled, bool same_label, int f, bool f_first, std::vector<int>& hits) {
+  const std::vector<FaceBox>& box = grid.box;
+  const FaceBox a = box[static_cast<size_t>(f)];
+  for (int k = a.c0[2]; k <= a.c1[2]; ++k)
+    for (int j = a.c0[1]; j <= a.c1[1]; ++j)
+      for (int i = a.c0[0]; i <= a.c1[0]; ++i) {
+        const int c = grid.cell_index(i, j, k);
+        const int* first = grid.members.data() + grid.offsets[c];
+        const int* const last = grid.members.data() + grid.offsets[c + 1];
+        // Buckets are ascending: the faces after f start at its upper bound.
+        if (f_first) first = std::upper_bound(first, last, f);
+        const auto scan = [&](const int* from, const int* to) {
+          for (const int* m = from; m < to; ++m) {
+            const int g = *m;
+            const FaceBox& b = box[static_cast<size_t>(g)];
+            if (labelled && (a.label == b.label) != same_label) continue;
+            if (a.lo[0] > b.hi[0] || b.lo[0] > a.hi[0] || a.lo[1] > b.hi[1] || b.lo[1] > a.hi[1] ||
+                a.lo[2] > b.hi[2] || b.lo[2] > a.hi[2])
+              continue;
+            if (std::max(a.c0[0], b.c0[0]) != i || std::max(a.c0[1], b.c0[1]) != j ||
+                std::max(a.c0[2], b.c0[2]) != k)
+              continue;
+            if (f_first ? faces_intersect(V, F, f, g) : faces_intersect(V, F, g, f))
+              hits.push_back(g);
+          }
+        };
+        if (runs.begin.empty()) {
+          scan(first, last);
+          continue;
+        }
+        // With labels in runs, the bucket's faces of f's label are one stretch of it: skipped
+        // (or with same_label the only one scanned) by two binary searches instead of face by
+        // face. A chain mail output's buckets hold mostly their own ring's faces.
+        const auto l = static_cast<size_t>(a.label);
+        const int* const own_begin = std::lower_bound(first, last, runs.begin[l]);
+        const int* const own_end = std::lower_bound(own_begin, last, runs.end[l]);
+        if (same_label) {
+          scan(own_begin, own_end);
+        } else {
+          scan(first, own_begin);
+          scan(own_end, last);
+        }
+      }
+}
+
 // Shared implementation: when label is given, only pairs with different labels are tested, or
 // with same_label only pairs with the same label.
 // active (optional, #F): only pairs with at least one active face are tested.
@@ -291,15 +368,13 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
   const FaceGrid grid = face_grid(V, F, label, active);
-  const std::vector<FaceBox>& box = grid.box;
+  const LabelRuns runs = label_runs(label);
   const auto bucketed = [&](int f) { return !active || (*active)[f]; };
 
   // Narrow phase per face f against the bucketed faces g, each pair once: g later than f, or
-  // with an active set g active and f inactive or earlier. A pair is tested only in the cell
-  // holding the min corner of the intersection of the two boxes (per axis the larger of their
-  // first cells). The exact test takes the active face first (the earlier if both are).
-  // Found per block of faces (a vector per face would zero 24 bytes per face for nothing),
-  // joined in block order: the same pairs in the same order whatever the threads.
+  // with an active set g active and f inactive or earlier. Found per block of faces (a vector
+  // per face would zero 24 bytes per face for nothing), joined in block order: the same pairs
+  // in the same order whatever the threads.
   constexpr int kBlock = 4096;
   const int blocks = (nf + kBlock - 1) / kBlock;
   std::vector<std::vector<std::pair<int, int>>> found(static_cast<size_t>(blocks));
@@ -307,31 +382,8 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
     std::vector<std::pair<int, int>>& out = found[static_cast<size_t>(block)];
     std::vector<int> hits;
     for (int f = block * kBlock, end = std::min(nf, f + kBlock); f < end; ++f) {
-      const bool f_first = bucketed(f);
       hits.clear();
-      const FaceBox a = box[static_cast<size_t>(f)];
-      for (int k = a.c0[2]; k <= a.c1[2]; ++k)
-        for (int j = a.c0[1]; j <= a.c1[1]; ++j)
-          for (int i = a.c0[0]; i <= a.c1[0]; ++i) {
-            const int c = grid.cell_index(i, j, k);
-            // Buckets are ascending: the faces after f start at its upper bound.
-            const int* const first = grid.members.data() + grid.offsets[c];
-            const int* const last = grid.members.data() + grid.offsets[c + 1];
-            for (const int* m = f_first ? std::upper_bound(first, last, f) : first; m != last;
-                 ++m) {
-              const int g = *m;
-              const FaceBox& b = box[static_cast<size_t>(g)];
-              if (label && (a.label == b.label) != same_label) continue;
-              if (a.lo[0] > b.hi[0] || b.lo[0] > a.hi[0] || a.lo[1] > b.hi[1] ||
-                  b.lo[1] > a.hi[1] || a.lo[2] > b.hi[2] || b.lo[2] > a.hi[2])
-                continue;
-              if (std::max(a.c0[0], b.c0[0]) != i || std::max(a.c0[1], b.c0[1]) != j ||
-                  std::max(a.c0[2], b.c0[2]) != k)
-                continue;
-              if (f_first ? faces_intersect(V, F, f, g) : faces_intersect(V, F, g, f))
-                hits.push_back(g);
-            }
-          }
+      face_hits(V, F, grid, runs, label != nullptr, same_label, f, bucketed(f), hits);
       std::sort(hits.begin(), hits.end());
       for (const int g : hits) out.emplace_back(std::min(f, g), std::max(f, g));
     }

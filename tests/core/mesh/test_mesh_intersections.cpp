@@ -117,6 +117,58 @@ TEST(MeshIntersections, PairsAreThoseOfTestingEveryPair) {
   }
 }
 
+// Labels in runs (each element's faces one after another, as in every output) are skipped per
+// bucket by binary search; labels interleaved are filtered face by face. Both give the full
+// test's pairs filtered by label, with or without an active set, for different and for same
+// labels (two tori per label: the same-label pairs are those within a pair of tori).
+TEST(MeshIntersections, LabelsInRunsOrInterleavedGiveTheFullTestsPairs) {
+  const TriMesh a = test::torus(2.0, 0.4, 24, 8);
+  TriMesh both = a;
+  for (int i = 1; i <= 3; ++i) {
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(0.9 * i, Vector3d(0.2, 1, 0.4).normalized()).toRotationMatrix();
+    append_mesh(both, transformed(a, R, Vector3d(0.7 * i, -0.3 * i, 0.2 * i)));
+  }
+  const int nf = both.num_faces();
+  std::vector<int> perm(static_cast<size_t>(nf));  // shuffled face f is both's face perm[f]
+  for (int f = 0; f < nf; ++f) perm[static_cast<size_t>(f)] = f;
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(5));
+  TriMesh shuffled = both;
+  for (int f = 0; f < nf; ++f) shuffled.F.row(f) = both.F.row(perm[static_cast<size_t>(f)]);
+  IntersectionOptions all;
+  all.between_components_only = false;
+  const auto full = intersecting_face_pairs(both.V, both.F, all);
+  std::mt19937 rng(7);
+  for (const bool same : {false, true}) {
+    for (const double share : {0.05, 1.0}) {
+      std::vector<char> active(static_cast<size_t>(nf));
+      for (char& x : active) x = std::uniform_real_distribution<double>(0, 1)(rng) < share;
+      std::vector<int> label(static_cast<size_t>(nf));
+      for (int f = 0; f < nf; ++f) label[static_cast<size_t>(f)] = f / (2 * a.num_faces());
+      std::vector<std::pair<int, int>> expected;
+      for (const auto& [f, g] : full)
+        if ((active[f] || active[g]) && (label[f] == label[g]) == same) expected.emplace_back(f, g);
+      ASSERT_GT(expected.size(), 5u) << same << " " << share;
+      EXPECT_EQ(intersecting_face_pairs_touching(both.V, both.F, active, label, same), expected)
+          << "labels in runs, same " << same << ", active share " << share;
+      std::vector<char> active_s(static_cast<size_t>(nf));
+      std::vector<int> label_s(static_cast<size_t>(nf));
+      for (int f = 0; f < nf; ++f) {
+        active_s[static_cast<size_t>(f)] = active[perm[static_cast<size_t>(f)]];
+        label_s[static_cast<size_t>(f)] = label[perm[static_cast<size_t>(f)]];
+      }
+      std::vector<std::pair<int, int>> back;
+      for (const auto& [f, g] :
+           intersecting_face_pairs_touching(shuffled.V, shuffled.F, active_s, label_s, same)) {
+        const int u = perm[static_cast<size_t>(f)], v = perm[static_cast<size_t>(g)];
+        back.emplace_back(std::min(u, v), std::max(u, v));
+      }
+      std::sort(back.begin(), back.end());
+      EXPECT_EQ(back, expected) << "labels interleaved, same " << same << ", share " << share;
+    }
+  }
+}
+
 TEST(MeshIntersections, LinkedToriDoNotIntersectOverlappingDo) {
   const TriMesh a = test::torus(2.0, 0.4, 48, 12);
   // A chain link: rotated into the xz plane and shifted by R along x, through a's hole.
