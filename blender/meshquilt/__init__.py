@@ -121,6 +121,11 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
         name="Wind", default=0, min=0, max=250,
         description="The Ivy sample's leaves turning in a looping wind of this many frames (0: "
         "still): one shape key a frame, played from the scene's start frame. Needs Detail 100%")
+    swatch_motion: bpy.props.BoolProperty(
+        name="Swatch motion", default=False,
+        description="The swatch object's own animation (shape keys, armature, modifiers) over "
+        "the scene's frame range, followed by the result: one shape key a frame. A vine with "
+        "leaves (like the Ivy sample) only, at Detail 100%")
     # The engine's last estimate (meshquilt.estimate) and the settings it was made for.
     estimate_key: bpy.props.StringProperty(options={"SKIP_SAVE"})
     estimate_faces: bpy.props.IntProperty(name="Estimated faces", options={"SKIP_SAVE"})
@@ -130,12 +135,16 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     estimate_error: bpy.props.StringProperty(options={"SKIP_SAVE"})
 
 
-def wind_frames(settings, preview=False):
-    """The frames of the wind a run animates: Wind for the Ivy sample, else 0 (a Preview shows
-    the still layout)."""
-    if preview or settings.swatch_source != "SAMPLE" or settings.sample != "ivy":
+def swatch_frames(settings, preview=False):
+    """The swatch frames a run follows (docs/animation.md): Wind for the Ivy sample, the scene's
+    frame range for a swatch object with Swatch motion, else 0 (a Preview shows the still
+    layout)."""
+    if preview:
         return 0
-    return settings.wind_frames
+    if settings.swatch_source == "OBJECT":
+        scene = settings.id_data
+        return scene.frame_end - scene.frame_start + 1 if settings.swatch_motion else 0
+    return settings.wind_frames if settings.sample == "ivy" else 0
 
 
 def estimate_key(context, settings):
@@ -155,7 +164,7 @@ def estimate_key(context, settings):
         parts += ["sample", settings.sample]
     parts += [round(settings.scale, 6), round(settings.element_size, 6), settings.seed,
               settings.stretch, settings.guidance, settings.detail, settings.mask_group,
-              settings.size_group, round(settings.smallest_size, 4), wind_frames(settings)]
+              settings.size_group, round(settings.smallest_size, 4), swatch_frames(settings)]
     if settings.guidance == "AXIS" and settings.guide_object is not None:
         parts += [settings.guide_object.name, settings.guide_axis,
                   [round(x, 4) for x in settings.guide_object.matrix_world.to_3x3().col[
@@ -337,19 +346,23 @@ class Run:
                                          % base.name)
             self.scale = self.element_size / diagonal
         self.base_matrix = np.array(base.matrix_world)
-        # Wind (docs/animation.md): the engine follows the sample's looping frames, one output
-        # a frame with frame 0's faces; the frames come in as shape keys. Such a result is not
-        # bound to its base (re-placing it would lose the wind).
-        self.wind = wind_frames(settings, preview)
-        if self.wind and self.detail < 1:
-            raise engine.EngineError("Wind moves the ivy as it is generated: set Detail to "
-                                     "100%, or Wind to 0")
-        self.output = os.path.join(self.dir, "result_%03d.ply") if self.wind else \
+        # Swatch frames (docs/animation.md): the sample's looping wind or the swatch object's
+        # motion over the scene's frames; the engine writes one output a frame with frame 0's
+        # faces, kept as shape keys. Such a result is not bound to its base (re-placing it
+        # would drop the motion).
+        self.frames = swatch_frames(settings, preview)
+        self.loop = settings.swatch_source == "SAMPLE"
+        if self.frames and self.detail < 1:
+            raise engine.EngineError(
+                "Wind moves the ivy as it is generated: set Detail to 100%, or Wind to 0"
+                if self.loop else "Swatch motion follows the swatch as it is: set Detail to "
+                "100%, or clear Swatch motion")
+        self.output = os.path.join(self.dir, "result_%05d.ply") if self.frames else \
             self.result_path
-        if self.wind:
+        if self.frames:
             self.result_path = self.output % 0
         # The quilt saved for following the base.
-        self.quilt_path = None if self.wind else os.path.join(self.dir, "quilt.mqq")
+        self.quilt_path = None if self.frames else os.path.join(self.dir, "quilt.mqq")
         if settings.guidance == "AXIS":
             axis = {"X": 0, "Y": 1, "Z": 2}[settings.guide_axis]
             field = tuple(settings.guide_object.matrix_world.to_3x3().col[axis])
@@ -371,16 +384,21 @@ class Run:
             "the sample %s" % settings.sample
         if settings.swatch_source == "OBJECT":
             swatch_path = os.path.join(self.dir, "swatch.ply")
-            kinds = self._export(depsgraph, settings.swatch, swatch_path, with_kinds=True)[2]
+            if self.frames:
+                made = os.path.join(self.dir, "swatch_%05d.ply")
+                kinds = self._export_motion(context, settings.swatch, made, self.frames)
+                swatch_path = made % 0
+            else:
+                kinds = self._export(depsgraph, settings.swatch, swatch_path, with_kinds=True)[2]
             self.material_names = {_engine_kind_name(k): k for k in kinds}
         else:
             swatch_path = os.path.join(self.dir, "swatch_%s.ply" % settings.sample)
             made = swatch_path
-            if self.wind:
-                made = os.path.join(self.dir, "swatch_%s_%%03d.ply" % settings.sample)
+            if self.frames:
+                made = os.path.join(self.dir, "swatch_%s_%%05d.ply" % settings.sample)
                 swatch_path = made % 0
             self.jobs.append(lambda: engine.swatch_job(self.engine, settings.sample, made,
-                                                       settings.seed, frames=self.wind))
+                                                       settings.seed, frames=self.frames))
         self.preparation = len(self.jobs)  # the jobs before the surface job
         self.paths = (base_path, swatch_path)
         self.stats_path = os.path.join(self.dir, "stats.json")
@@ -389,8 +407,8 @@ class Run:
                             field_file=field_file, max_memory=self.max_memory,
                             element_size=self.element_size, detail=self.detail, mask=mask_file,
                             size_map=size_file)
-        if self.wind:
-            self.options.update(swatch_frames=made, frames=(0, self.wind - 1))
+        if self.frames:
+            self.options.update(swatch_frames=made, frames=(0, self.frames - 1))
         self.jobs.append(lambda: engine.surface_job(
             self.engine, base_path, swatch_path, self.output, self.scale,
             save_quilt=self.quilt_path, stats=self.stats_path, **self.options))
@@ -430,6 +448,37 @@ class Run:
         V = V @ W[:3, :3].T + W[:3, 3]
         exchange.write_ply(path, V, T, kinds, M if kinds else None)
         return V, T, kinds or []
+
+    @staticmethod
+    def _export_motion(context, swatch, pattern, count):
+        """The swatch object as evaluated at each of the scene's frames from its start (its
+        shape keys, armature, modifiers and placement), one file a frame; returns its kinds.
+        Refuses a swatch whose mesh changes over the frames, or that does not move."""
+        scene = context.scene
+        was = scene.frame_current, scene.frame_subframe
+        first = scene.frame_start
+        rest, moved, kinds = None, False, []
+        try:
+            for i in range(count):
+                scene.frame_set(first + i)
+                V, T, kinds = Run._export(context.evaluated_depsgraph_get(), swatch, pattern % i,
+                                          with_kinds=True)
+                if rest is None:
+                    rest = V, T
+                elif len(V) != len(rest[0]) or not np.array_equal(T, rest[1]):
+                    raise engine.EngineError(
+                        "the swatch %s changes its mesh over frames %d-%d, not only where its "
+                        "vertices are: Swatch motion needs the same mesh in every frame"
+                        % (swatch.name, first, first + count - 1))
+                else:
+                    moved = moved or not np.allclose(V, rest[0], rtol=0, atol=1e-9)
+        finally:
+            scene.frame_set(was[0], subframe=was[1])
+        if not moved:
+            raise engine.EngineError("the swatch %s does not move over frames %d-%d: animate "
+                                     "it, or clear Swatch motion"
+                                     % (swatch.name, first, first + count - 1))
+        return kinds
 
     @staticmethod
     def _export_field(depsgraph, obj, name, path, count):
@@ -594,13 +643,14 @@ class Run:
         if self.quilt_path and os.path.exists(self.quilt_path):
             follow.bind(obj, self.base, self.quilt_path, self.topology["T"],
                         self.topology["loops"], self.topology["totals"], self.base_matrix)
-        if self.wind:
+        if self.frames:
             frames = [result.V] + [exchange.read_ply(self.output % k).V
-                                   for k in range(1, self.wind)]
+                                   for k in range(1, self.frames)]
             if any(len(V) != len(result.V) for V in frames):
-                raise engine.EngineError("the wind's frames do not match its first")
-            follow.keep_frames(obj, frames, context.scene.frame_start, loop=True)
-            obj["meshquilt_wind"] = self.wind
+                raise engine.EngineError("the result's frames do not match its first")
+            follow.keep_frames(obj, frames, context.scene.frame_start, loop=self.loop)
+            obj["meshquilt_frames"] = self.frames
+            obj["meshquilt_loop"] = self.loop
         try:
             store_report(obj, exchange.structure_report(self.stats_path, self.elements_path))
         except (OSError, ValueError, KeyError) as e:
@@ -1126,6 +1176,7 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
         layout.prop(s, "swatch_source", expand=True)
         if s.swatch_source == "OBJECT":
             _labelled(layout, s, "swatch", "Swatch")
+            layout.prop(s, "swatch_motion")
         else:
             _labelled(layout, s, "sample", "Sample")
             if s.sample == "ivy":
@@ -1169,9 +1220,10 @@ class MESHQUILT_PT_panel(bpy.types.Panel):
             _draw_report(layout, obj)
             b = obj.meshquilt
             box = layout.box()
-            if obj.get("meshquilt_wind"):
-                box.label(text="In the wind: %d frames a loop" % obj["meshquilt_wind"],
-                          icon="FORCE_WIND")
+            if obj.get("meshquilt_frames"):
+                box.label(text=("In the wind: %d frames a loop" if obj.get("meshquilt_loop")
+                                else "Following the swatch's motion: %d frames")
+                          % obj["meshquilt_frames"], icon="FORCE_WIND")
                 return
             if not b.quilt:
                 box.label(text="No saved quilt: cannot follow its base", icon="INFO")

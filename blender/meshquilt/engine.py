@@ -433,6 +433,9 @@ def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch"
     if text.startswith("a size map is followed by the global layout only"):
         return ("meshquilt: the Size group varies chain mail and weave (lattices of elements "
                 "and threads), not %s: clear Size in the panel" % swatch)
+    if text.startswith("--swatch-frames: a swatch animation is followed by the vine method"):
+        return ("meshquilt: Swatch motion follows a vine with leaves (like the Ivy sample) "
+                "only, and %s is laid out otherwise: clear Swatch motion" % swatch)
     if text.startswith("the size map's largest value"):
         return "meshquilt: the Size group's sizes are too far apart: raise Smallest in the panel"
     if text.startswith("no element of the swatch could be placed"):

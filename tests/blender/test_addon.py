@@ -1119,6 +1119,23 @@ def sphere_with_top_cap(name, group_name):
     return s, base
 
 
+def leaf_and_vine_vertices(obj):
+    """An ivy result's vertices of leaf faces, and those of vine faces only (by material)."""
+    names = [m.name for m in obj.data.materials]
+    material = np.empty(len(obj.data.polygons), dtype=np.int32)
+    obj.data.polygons.foreach_get("material_index", material)
+    loops = np.empty(3 * len(obj.data.polygons), dtype=np.int32)
+    obj.data.polygons.foreach_get("vertices", loops)
+    loops = loops.reshape(-1, 3)
+    leaf = np.zeros(len(obj.data.vertices), dtype=bool)
+    leaf[loops[material == names.index("leaf")].ravel()] = True
+    vine = np.zeros(len(obj.data.vertices), dtype=bool)
+    vine[loops[material == names.index("vine")].ravel()] = True
+    vine &= ~leaf
+    check(leaf.any() and vine.any(), "no leaves or no vine")
+    return leaf, vine
+
+
 @test
 def test_wind_turns_the_ivys_leaves_in_a_loop_of_shape_keys():
     scene = new_scene()
@@ -1136,7 +1153,8 @@ def test_wind_turns_the_ivys_leaves_in_a_loop_of_shape_keys():
     check(key is not None and not key.use_relative and len(key.key_blocks) == 7,
           "expected 6 absolute shape keys and frame 0 again, got %s"
           % (len(key.key_blocks) if key else None))
-    check(obj.get("meshquilt_wind") == 6 and not obj.meshquilt.quilt, "bound to its base")
+    check(obj.get("meshquilt_frames") == 6 and obj.get("meshquilt_loop") and
+          not obj.meshquilt.quilt, "bound to its base")
     bpy.context.view_layer.objects.active = obj
     check("In the wind: 6 frames a loop" in drawn_panel(), "panel: %s" % drawn_panel())
     rest, first = positions(obj), scene.frame_start
@@ -1153,18 +1171,7 @@ def test_wind_turns_the_ivys_leaves_in_a_loop_of_shape_keys():
     for k in range(1, 6):
         check(np.abs(V[k] - V[k - 1]).max() > 1e-4, "frame %d equals the one before" % k)
     # The leaves turn, the vine holds still (the wind's default), and faces stay as they are.
-    names = [m.name for m in obj.data.materials]
-    material = np.empty(len(obj.data.polygons), dtype=np.int32)
-    obj.data.polygons.foreach_get("material_index", material)
-    loops = np.empty(3 * len(obj.data.polygons), dtype=np.int32)
-    obj.data.polygons.foreach_get("vertices", loops)
-    loops = loops.reshape(-1, 3)
-    leaf = np.zeros(len(rest), dtype=bool)
-    leaf[loops[material == names.index("leaf")].ravel()] = True
-    vine = np.zeros(len(rest), dtype=bool)
-    vine[loops[material == names.index("vine")].ravel()] = True
-    vine &= ~leaf
-    check(leaf.any() and vine.any(), "no leaves or no vine")
+    leaf, vine = leaf_and_vine_vertices(obj)
     moved = np.linalg.norm(V[3] - V[0], axis=1)
     check(moved[vine].max() < 1e-5, "the vine moved %g" % moved[vine].max())
     check(moved[leaf].max() > 1e-3, "the leaves moved only %g" % moved[leaf].max())
@@ -1174,9 +1181,95 @@ def test_wind_turns_the_ivys_leaves_in_a_loop_of_shape_keys():
     check("set Detail to 100%" in message, message)
     check(bpy.ops.meshquilt.preview() == {"FINISHED"}, "preview did not finish")
     preview = base.meshquilt.result
-    check(preview.data.shape_keys is None and preview.get("meshquilt_wind") is None,
+    check(preview.data.shape_keys is None and preview.get("meshquilt_frames") is None,
           "a Preview in the wind")
     s.detail, s.wind_frames = 100, 0
+
+
+@test
+def test_swatch_motion_follows_an_animated_swatch_object():
+    scene = new_scene()
+    base = sphere()
+    import meshquilt
+    from meshquilt import engine, exchange
+    sw_path = os.path.join(WORK, "ivy_motion.ply")
+    check(engine.swatch_job(ENGINE, "ivy", sw_path).wait(60) == "done", "swatch failed")
+    me = exchange.build_mesh(bpy, "ivy", exchange.read_ply(sw_path), meshquilt.material_for)
+    swatch = bpy.data.objects.new("Vine", me)
+    scene.collection.objects.link(swatch)
+    s = scene.meshquilt
+    s.base, s.swatch_source, s.swatch, s.scale, s.stretch = base, "OBJECT", swatch, 0.5, False
+    check("prop:swatch_motion" in drawn_panel(), "panel: %s" % drawn_panel())
+    s.swatch_motion = True
+    scene.frame_start, scene.frame_end = 1, 5
+    # A swatch that does not move: said before any work.
+    message = reported(bpy.ops.meshquilt.run)
+    check("Vine does not move over frames 1-5" in message, message)
+    # A gust lifting the leaves (a shape key keyed from 0 at frame 1 to 1 at frame 5).
+    swatch.shape_key_add(name="Basis", from_mix=False)
+    gust = swatch.shape_key_add(name="gust", from_mix=False)
+    material = np.empty(len(me.polygons), dtype=np.int32)
+    me.polygons.foreach_get("material_index", material)
+    loops = np.empty(3 * len(me.polygons), dtype=np.int32)
+    me.polygons.foreach_get("vertices", loops)
+    leaf = np.unique(loops.reshape(-1, 3)[material == 1].ravel())
+    V = positions(swatch)
+    lift = 0.05 * (V.max(0) - V.min(0)).max()
+    for v in leaf:
+        gust.data[int(v)].co.z += lift
+    for frame, value in ((1, 0.0), (5, 1.0)):
+        gust.value = value
+        gust.keyframe_insert("value", frame=frame)
+    scene.frame_set(3)
+    start = time.monotonic()
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "swatch motion run did not finish")
+    print("[blender]   ivy following its swatch's 5 frames: %.1f s"
+          % (time.monotonic() - start), flush=True)
+    check(scene.frame_current == 3, "the run left the scene at frame %d" % scene.frame_current)
+    obj = base.meshquilt.result
+    key = obj.data.shape_keys
+    check(key is not None and len(key.key_blocks) == 5 and not obj.get("meshquilt_loop"),
+          "expected 5 shape keys and no loop, got %s" % (len(key.key_blocks) if key else None))
+    bpy.context.view_layer.objects.active = obj
+    check("Following the swatch's motion: 5 frames" in drawn_panel(), "panel: %s"
+          % drawn_panel())
+    frames = []
+    for frame in range(1, 6):
+        scene.frame_set(frame)
+        frames.append(positions(obj, evaluated=True))
+    check(np.allclose(frames[0], positions(obj), atol=1e-6), "frame 1 is not the still result")
+    moved = np.linalg.norm(frames[4] - frames[0], axis=1)
+    # The leaves rise with the gust; the vine, which the gust does not move, holds still.
+    leaf, vine = leaf_and_vine_vertices(obj)
+    print("[blender]   gust: leaves moved up to %.4f, vine %.2g (swatch lift %.4f, unscaled)"
+          % (moved[leaf].max(), moved[vine].max(), lift), flush=True)
+    check(moved[leaf].max() > 1e-3, "the leaves moved only %g" % moved[leaf].max())
+    check(moved[vine].max() < 1e-5, "the vine moved %g" % moved[vine].max())
+    check(np.linalg.norm(frames[2] - frames[0], axis=1).max() < moved.max(),
+          "frame 3 moved as far as frame 5")
+    # A swatch the engine lays out as a lattice (chain mail) is refused in the panel's words.
+    mail_path = os.path.join(WORK, "mail_motion.ply")
+    check(engine.swatch_job(ENGINE, "chainmail", mail_path).wait(60) == "done", "no chain mail")
+    mail = bpy.data.objects.new("Mail", exchange.build_mesh(
+        bpy, "Mail", exchange.read_ply(mail_path), meshquilt.material_for))
+    scene.collection.objects.link(mail)
+    mail.shape_key_add(name="Basis", from_mix=False)
+    mail.shape_key_add(name="up", from_mix=False).data[0].co.z += 0.1
+    for frame, value in ((1, 0.0), (5, 1.0)):
+        mail.data.shape_keys.key_blocks["up"].value = value
+        mail.data.shape_keys.key_blocks["up"].keyframe_insert("value", frame=frame)
+    s.swatch = mail
+    run = meshquilt.Run(bpy.context, s)
+    try:
+        start = time.monotonic()
+        while run.step() == "running":
+            check(time.monotonic() - start < 120, "no answer within 120 s")
+            time.sleep(0.05)
+        check(run.state == "failed" and "Swatch motion follows a vine with leaves" in run.error
+              and "Mail" in run.error, "%s: %s" % (run.state, run.error))
+    finally:
+        run.cleanup()
+    s.swatch_motion = False
 
 
 @test
