@@ -20,7 +20,7 @@
 namespace mq {
 namespace {
 
-struct Run {
+struct ArtistRun {
   TriMesh output;
   SurfaceQuiltingStats stats;
   GlobalQuiltingStats global;
@@ -29,8 +29,8 @@ struct Run {
   bool used_global = false;
 };
 
-Run quilt(const TriMesh& base, const TriMesh& swatch, double scale) {
-  Run r;
+ArtistRun quilt_artist_base(const TriMesh& base, const TriMesh& swatch, double scale) {
+  ArtistRun r;
   SurfaceQuiltingOptions o;
   o.scale = scale;
   TranslationCostCpu cost;
@@ -68,7 +68,7 @@ struct Keep {
   double density_lo = 0.9, density_hi = 1.1;
 };
 
-void expect_even_mail(const std::string& name, const Run& r, const Keep& k) {
+void expect_even_mail(const std::string& name, const ArtistRun& r, const Keep& k) {
   SCOPED_TRACE(name);
   const StructureComparison& c = r.structure.comparison;
   const StructureReport& s = r.structure.output;
@@ -98,21 +98,22 @@ TriMesh blender(const std::string& name) { return read_mesh(test::blender_base(n
 
 TEST(ArtistBases, BlenderPrimitivesWithTheSampleMail) {
   const TriMesh mail = sample_mail();
-  expect_even_mail("UV sphere 32 x 16", quilt(blender("uv_sphere_32x16.obj"), mail, 0.08), {});
-  expect_even_mail("cube (2 x 1 x 0.5)", quilt(blender("cube.obj"), mail, 0.08), {});
+  expect_even_mail("UV sphere 32 x 16",
+                   quilt_artist_base(blender("uv_sphere_32x16.obj"), mail, 0.08), {});
+  expect_even_mail("cube (2 x 1 x 0.5)", quilt_artist_base(blender("cube.obj"), mail, 0.08), {});
   // Missed by a little (README): the ico sphere's 99th percentile (1.31, its 12 sharp
   // vertices), the cylinder's (1.36: its caps are fans of 32 thin triangles with a sharp rim),
   // the torus's median aspect (1.11: the shell's outer layer is 1 + H / r wider round the
   // tube, r a quarter of the radius).
   Keep ico;
   ico.size_p99 = 1.35;
-  expect_even_mail("ico sphere", quilt(blender("ico_sphere.obj"), mail, 0.08), ico);
+  expect_even_mail("ico sphere", quilt_artist_base(blender("ico_sphere.obj"), mail, 0.08), ico);
   Keep cylinder;
   cylinder.size_p99 = 1.4;
-  expect_even_mail("cylinder", quilt(blender("cylinder.obj"), mail, 0.08), cylinder);
+  expect_even_mail("cylinder", quilt_artist_base(blender("cylinder.obj"), mail, 0.08), cylinder);
   Keep torus;
   torus.aspect = 1.13;
-  expect_even_mail("torus", quilt(blender("torus.obj"), mail, 0.08), torus);
+  expect_even_mail("torus", quilt_artist_base(blender("torus.obj"), mail, 0.08), torus);
 }
 
 TEST(ArtistBases, SquarePatternOnPrimitives) {
@@ -120,8 +121,9 @@ TEST(ArtistBases, SquarePatternOnPrimitives) {
   Keep sphere;
   sphere.aspect = 1.12;  // 1.10 measured; the connectors stand upright, their tops lifted most
   expect_even_mail("square 4-in-1 on the UV sphere",
-                   quilt(blender("uv_sphere_32x16.obj"), mail, 0.08), sphere);
-  expect_even_mail("square 4-in-1 on the cube", quilt(blender("cube.obj"), mail, 0.08), {});
+                   quilt_artist_base(blender("uv_sphere_32x16.obj"), mail, 0.08), sphere);
+  expect_even_mail("square 4-in-1 on the cube", quilt_artist_base(blender("cube.obj"), mail, 0.08),
+                   {});
 }
 
 // A base of many small rough parts (the wicker chair: 77 parts, 471 cones in its layout) bends
@@ -135,11 +137,11 @@ TEST(ArtistBases, AutoLeavesTheThreadLayoutWhereItBreaksThreads) {
   w.tube_segments = 8;
   const TriMesh weave = plain_weave(w);
   const TriMesh chair = read_mesh(test::shared_data("base/wicker_chair_17k.obj"));
-  const ::mq::Run on_chair = quilt(chair, weave, 0.073);
+  const ::mq::ArtistRun on_chair = quilt_artist_base(chair, weave, 0.073);
   EXPECT_FALSE(on_chair.used_global);
   EXPECT_GT(on_chair.embedding.coverage, 0.6);
-  const ::mq::Run on_cup =
-      quilt(read_mesh(test::shared_data("base/cup_mug_11k.off")), weave, 0.145);
+  const ::mq::ArtistRun on_cup =
+      quilt_artist_base(read_mesh(test::shared_data("base/cup_mug_11k.off")), weave, 0.145);
   EXPECT_TRUE(on_cup.used_global);
   EXPECT_GT(on_cup.embedding.coverage, 0.95);
 }

@@ -14,7 +14,8 @@
 namespace mq {
 namespace {
 
-TriMesh quilt(const TriMesh& swatch, double L, double W, PlanarQuiltingStats* stats = nullptr) {
+TriMesh quilt_plane_sized(const TriMesh& swatch, double L, double W,
+                          PlanarQuiltingStats* stats = nullptr) {
   PlanarQuiltingOptions o;
   o.length = L;
   o.width = W;
@@ -25,7 +26,7 @@ TriMesh quilt(const TriMesh& swatch, double L, double W, PlanarQuiltingStats* st
 TEST(PlanarQuiltingSlow, ChainMailDefaultSwatch20x20) {
   const TriMesh swatch = chainmail_4in1();
   PlanarQuiltingStats stats;
-  const TriMesh out = quilt(swatch, 20, 20, &stats);
+  const TriMesh out = quilt_plane_sized(swatch, 20, 20, &stats);
   test::expect_valid_quilt(swatch, out, 20, 20);
   EXPECT_GT(stats.elements, 36 * 4);
 }
@@ -34,7 +35,7 @@ TEST(PlanarQuiltingSlow, AppleLayerDefaultSwatch) {
   const TriMesh swatch = apple_layer();
   const BoundingBox b = bounding_box(swatch.V, swatch.F);
   const double L = 2.5 * b.extent().x(), W = 2.5 * b.extent().y();
-  const TriMesh out = quilt(swatch, L, W);
+  const TriMesh out = quilt_plane_sized(swatch, L, W);
   test::expect_valid_quilt(swatch, out, L, W);
 }
 
@@ -43,7 +44,7 @@ TEST(PlanarQuiltingSlow, WeaveDefaultSwatch) {
   const BoundingBox b = bounding_box(swatch.V, swatch.F);
   const double L = 2.5 * b.extent().x(), W = 2.5 * b.extent().y();
   PlanarQuiltingStats stats;
-  const TriMesh out = quilt(swatch, L, W, &stats);
+  const TriMesh out = quilt_plane_sized(swatch, L, W, &stats);
   test::QuiltExpectations expect;
   expect.check_diameters = false;
   test::expect_valid_quilt(swatch, out, L, W, expect);
@@ -60,7 +61,7 @@ TEST(PlanarQuiltingSlow, IvyDefaultSwatch) {
   const TriMesh swatch = ivy_section();
   const BoundingBox b = bounding_box(swatch.V, swatch.F);
   const double L = 2.5 * b.extent().x(), W = 2.5 * b.extent().y();
-  const TriMesh out = quilt(swatch, L, W);
+  const TriMesh out = quilt_plane_sized(swatch, L, W);
   test::QuiltExpectations expect;
   expect.check_diameters = false;
   expect.check_coverage = false;
@@ -76,7 +77,7 @@ void expect_quilts_or_refuses(const std::string& file, double scale) {
   Vector3d e = bounding_box(swatch.V, swatch.F).extent();
   std::sort(e.data(), e.data() + 3);
   try {
-    const TriMesh out = quilt(swatch, scale * e(2), scale * e(1));
+    const TriMesh out = quilt_plane_sized(swatch, scale * e(2), scale * e(1));
     ASSERT_GT(out.num_faces(), 0);
     if (closed_input) {
       for (const TriMesh& part : test::components(out)) EXPECT_TRUE(topology_report(part).closed());

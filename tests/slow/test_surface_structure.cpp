@@ -31,7 +31,7 @@ struct Result {
 };
 
 // The surface command's pipeline with its defaults.
-Result quilt(const TriMesh& base, const TriMesh& swatch, double scale) {
+Result quilt_by_default(const TriMesh& base, const TriMesh& swatch, double scale) {
   Result r;
   SurfaceQuiltingOptions o;
   o.scale = scale;
@@ -81,17 +81,18 @@ void expect_chain_mail(const char* name, const Result& r, const Targets& t) {
 
 TEST(SurfaceStructure, SpotDefaultJob) {
   const TriMesh base = read_mesh(std::string(MESHQUILT_SOURCE_DIR) + "/data/spot_6k.obj");
-  expect_chain_mail("Spot (default job)", quilt(base, mail(3, 3, 16), 0.08), {0.9, 0.015});
+  expect_chain_mail("Spot (default job)", quilt_by_default(base, mail(3, 3, 16), 0.08),
+                    {0.9, 0.015});
 }
 
 TEST(SurfaceStructure, BunnyAndLink) {
   const TriMesh base = read_mesh(test::shared_data("base/bunny_igl_7k.off"));
-  expect_chain_mail("bunny + link", quilt(base, mail(2, 4), 0.099), {0.84, 0.03});
+  expect_chain_mail("bunny + link", quilt_by_default(base, mail(2, 4), 0.099), {0.84, 0.03});
 }
 
 TEST(SurfaceStructure, ChainMailOnTheCup) {
   const TriMesh base = read_mesh(test::shared_data("base/cup_mug_11k.off"));
-  expect_chain_mail("cup, chain mail", quilt(base, mail(5, 6), 0.145), {0.92, 0.01});
+  expect_chain_mail("cup, chain mail", quilt_by_default(base, mail(5, 6), 0.145), {0.92, 0.01});
 }
 
 // The armor job: at --scale 0.13 a ring (0.042 across) is as wide as the knight's arms are in
@@ -102,8 +103,8 @@ TEST(SurfaceStructure, ChainMailOnTheCup) {
 // knight with rings half the size keeps 90%.
 TEST(SurfaceStructure, ArmorJobOnTheKnight) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
-  expect_chain_mail("armor (knight)", quilt(base, mail(5, 6), 0.13), {0.68, 0.06});
-  expect_chain_mail("knight, rings half the armor job's", quilt(base, mail(5, 6), 0.065),
+  expect_chain_mail("armor (knight)", quilt_by_default(base, mail(5, 6), 0.13), {0.68, 0.06});
+  expect_chain_mail("knight, rings half the armor job's", quilt_by_default(base, mail(5, 6), 0.065),
                     {0.88, 0.03});
 }
 
@@ -116,7 +117,7 @@ TEST(SurfaceStructure, CylinderAndSphereAtATenthOfTheRadius) {
     const double diagonal = bounding_box(cylinder.V, cylinder.F).extent().norm();
     SurfaceQuiltingOptions o;
     const double side = bounding_box(ring_sheet.V).extent().head<2>().maxCoeff();
-    Result r = quilt(cylinder, ring_sheet, 1.0 / ring * side / diagonal);
+    Result r = quilt_by_default(cylinder, ring_sheet, 1.0 / ring * side / diagonal);
     Targets t;
     t.share = 0.95;
     expect_chain_mail("cylinder", r, t);
@@ -126,7 +127,7 @@ TEST(SurfaceStructure, CylinderAndSphereAtATenthOfTheRadius) {
     sphere.V *= 10;
     const double diagonal = bounding_box(sphere.V, sphere.F).extent().norm();
     const double side = bounding_box(ring_sheet.V).extent().head<2>().maxCoeff();
-    Result r = quilt(sphere, ring_sheet, 1.0 / ring * side / diagonal);
+    Result r = quilt_by_default(sphere, ring_sheet, 1.0 / ring * side / diagonal);
     Targets t;
     t.share = 0.95;
     t.density = 0.9;
@@ -156,7 +157,7 @@ TEST(SurfaceStructure, WeaveThreadsOnTheCupAndTheBunny) {
                                     {"base/bunny_igl_7k.off", 0.1}}) {
     SCOPED_TRACE(name);
     const TriMesh base = read_mesh(test::shared_data(name));
-    const Result r = quilt(base, swatch, scale);
+    const Result r = quilt_by_default(base, swatch, scale);
     EXPECT_TRUE(r.global) << "a weave is a lattice of threads: the global layout";
     const StructureReport& s = r.structure.output;
     const StructureComparison& c = r.structure.comparison;
