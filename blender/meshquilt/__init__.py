@@ -458,6 +458,8 @@ class Run:
         was = scene.frame_current, scene.frame_subframe
         first = scene.frame_start
         rest, moved, kinds = None, False, []
+        # Results following their bases stay where they are while the frames are stepped.
+        follow.set_stepping(True)
         try:
             for i in range(count):
                 scene.frame_set(first + i)
@@ -474,6 +476,7 @@ class Run:
                     moved = moved or not np.allclose(V, rest[0], rtol=0, atol=1e-9)
         finally:
             scene.frame_set(was[0], subframe=was[1])
+            follow.set_stepping(False)
         if not moved:
             raise engine.EngineError("the swatch %s does not move over frames %d-%d: animate "
                                      "it, or clear Swatch motion"

@@ -200,7 +200,7 @@ def bake(context, obj):
     directory = tempfile.mkdtemp(prefix="meshquilt-bake-")
     wm = context.window_manager
     wm.progress_begin(0, count + 1)
-    _state["baking"] = True
+    set_stepping(True)
     try:
         names = {}
         for i in range(count):
@@ -211,7 +211,7 @@ def bake(context, obj):
             names[path] = "the base at frame %d" % (first + i)
             wm.progress_update(i)
     finally:
-        _state["baking"] = False
+        set_stepping(False)
         scene.frame_set(was[0], subframe=was[1])
     try:
         base_pattern = os.path.join(directory, "base_%05d.ply")
@@ -297,6 +297,12 @@ def remove_elements(context, obj, ids):
 
 
 @bpy.app.handlers.persistent
+def set_stepping(on):
+    """While on, frame changes do not re-place following results (a bake, or a swatch's motion
+    exported frame by frame, steps through the frames itself)."""
+    _state["baking"] = on
+
+
 def on_frame_change(scene, depsgraph=None):
     """frame_change_post: every result following its base placed on it; one that cannot be
     (its base changed connectivity, the engine failed) stops following with the reason."""
