@@ -197,19 +197,26 @@ def test_run_on_a_sphere_with_sample_chain_mail():
     check(np.array_equal(sel, ids == 7), "selection is not element 7")
 
 
+def ivy_swatch_object(scene, name):
+    """The engine's ivy swatch as an object of the scene named `name`, read by the add-on's
+    reader: two materials, vine and leaf."""
+    import meshquilt
+    from meshquilt import engine, exchange
+    path = os.path.join(WORK, "%s.ply" % name)
+    check(engine.swatch_job(ENGINE, "ivy", path).wait(60) == "done", "swatch failed")
+    me = exchange.build_mesh(bpy, name, exchange.read_ply(path), meshquilt.material_for)
+    obj = bpy.data.objects.new(name, me)
+    scene.collection.objects.link(obj)
+    return obj
+
+
 @test
 def test_object_swatch_kinds_come_from_its_materials():
     scene = new_scene()
     base = sphere()
-    # A swatch object with two materials: the engine's ivy, imported through the add-on's reader.
-    sw_path = os.path.join(WORK, "ivy_swatch.ply")
-    import meshquilt
-    from meshquilt import engine, exchange
-    check(engine.swatch_job(ENGINE, "ivy", sw_path).wait(60) == "done", "swatch failed")
-    result = exchange.read_ply(sw_path)
-    me = exchange.build_mesh(bpy, "ivy", result, meshquilt.material_for)
-    swatch = bpy.data.objects.new("ivy", me)
-    scene.collection.objects.link(swatch)
+    # A swatch object with two materials: the engine's ivy.
+    swatch = ivy_swatch_object(scene, "ivy")
+    me = swatch.data
     check([m.name for m in me.materials] == ["vine", "leaf"], "swatch materials %s"
           % [m.name for m in me.materials])
     # A material name with a space: the result reuses the swatch's own material.
@@ -1192,11 +1199,8 @@ def test_swatch_motion_follows_an_animated_swatch_object():
     base = sphere()
     import meshquilt
     from meshquilt import engine, exchange
-    sw_path = os.path.join(WORK, "ivy_motion.ply")
-    check(engine.swatch_job(ENGINE, "ivy", sw_path).wait(60) == "done", "swatch failed")
-    me = exchange.build_mesh(bpy, "ivy", exchange.read_ply(sw_path), meshquilt.material_for)
-    swatch = bpy.data.objects.new("Vine", me)
-    scene.collection.objects.link(swatch)
+    swatch = ivy_swatch_object(scene, "Vine")
+    me = swatch.data
     s = scene.meshquilt
     s.base, s.swatch_source, s.swatch, s.scale, s.stretch = base, "OBJECT", swatch, 0.5, False
     check("prop:swatch_motion" in drawn_panel(), "panel: %s" % drawn_panel())

@@ -19,6 +19,18 @@ TriMesh transformed(TriMesh m, const Eigen::Matrix3d& R, const Vector3d& t) {
   return m;
 }
 
+// Four copies of a torus (radii 2 and 0.4), copy i turned about axis by i * angle and moved by
+// i * step: tori through each other every which way, each copy's faces after the one before.
+TriMesh four_tori(int around, int tube, double angle, const Vector3d& axis, const Vector3d& step) {
+  const TriMesh a = test::torus(2.0, 0.4, around, tube);
+  TriMesh all = a;
+  for (int i = 1; i <= 3; ++i) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(angle * i, axis.normalized()).toRotationMatrix();
+    append_mesh(all, transformed(a, R, i * step));
+  }
+  return all;
+}
+
 TEST(TriangleIntersection, BasicConfigurations) {
   const Vector3d a0(0, 0, 0), a1(1, 0, 0), a2(0, 1, 0);
   // Piercing.
@@ -63,13 +75,7 @@ TEST(MeshIntersections, MeshesIntersectAgreesWithTheFullPairTest) {
 // The re-test after some faces moved: exactly the full test's pairs that hold an active face,
 // for masks from none to all (both orders of a pair with one active face are reached).
 TEST(MeshIntersections, PairsTouchingActiveFacesAreTheFullTestsFiltered) {
-  const TriMesh a = test::torus(2.0, 0.4, 32, 10);
-  TriMesh both = a;
-  for (int i = 1; i <= 3; ++i) {
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(0.5 * i, Vector3d(1, 0.3, 0.1).normalized()).toRotationMatrix();
-    append_mesh(both, transformed(a, R, Vector3d(0.4 * i, 0.1 * i, 0.05 * i)));
-  }
+  const TriMesh both = four_tori(32, 10, 0.5, Vector3d(1, 0.3, 0.1), Vector3d(0.4, 0.1, 0.05));
   IntersectionOptions all;
   all.between_components_only = false;
   const auto full = intersecting_face_pairs(both.V, both.F, all);
@@ -92,13 +98,7 @@ TEST(MeshIntersections, PairsTouchingActiveFacesAreTheFullTestsFiltered) {
 // every which way through each other and at scales where float rounding matters.
 TEST(MeshIntersections, PairsAreThoseOfTestingEveryPair) {
   for (const double scale : {1.0, 1e-4, 3e5}) {
-    const TriMesh a = test::torus(2.0, 0.4, 24, 8);
-    TriMesh both = a;
-    for (int i = 1; i <= 3; ++i) {
-      const Eigen::Matrix3d R =
-          Eigen::AngleAxisd(0.9 * i, Vector3d(0.2, 1, 0.4).normalized()).toRotationMatrix();
-      append_mesh(both, transformed(a, R, Vector3d(0.7 * i, -0.3 * i, 0.2 * i)));
-    }
+    TriMesh both = four_tori(24, 8, 0.9, Vector3d(0.2, 1, 0.4), Vector3d(0.7, -0.3, 0.2));
     both.V *= scale;
     both.V.array() += 7.0 * scale;  // away from the origin, where floats are coarser
     std::vector<int> part;
@@ -122,13 +122,7 @@ TEST(MeshIntersections, PairsAreThoseOfTestingEveryPair) {
 // test's pairs filtered by label, with or without an active set, for different and for same
 // labels (two tori per label: the same-label pairs are those within a pair of tori).
 TEST(MeshIntersections, LabelsInRunsOrInterleavedGiveTheFullTestsPairs) {
-  const TriMesh a = test::torus(2.0, 0.4, 24, 8);
-  TriMesh both = a;
-  for (int i = 1; i <= 3; ++i) {
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(0.9 * i, Vector3d(0.2, 1, 0.4).normalized()).toRotationMatrix();
-    append_mesh(both, transformed(a, R, Vector3d(0.7 * i, -0.3 * i, 0.2 * i)));
-  }
+  const TriMesh both = four_tori(24, 8, 0.9, Vector3d(0.2, 1, 0.4), Vector3d(0.7, -0.3, 0.2));
   const int nf = both.num_faces();
   std::vector<int> perm(static_cast<size_t>(nf));  // shuffled face f is both's face perm[f]
   for (int f = 0; f < nf; ++f) perm[static_cast<size_t>(f)] = f;
@@ -144,7 +138,7 @@ TEST(MeshIntersections, LabelsInRunsOrInterleavedGiveTheFullTestsPairs) {
       std::vector<char> active(static_cast<size_t>(nf));
       for (char& x : active) x = std::uniform_real_distribution<double>(0, 1)(rng) < share;
       std::vector<int> label(static_cast<size_t>(nf));
-      for (int f = 0; f < nf; ++f) label[static_cast<size_t>(f)] = f / (2 * a.num_faces());
+      for (int f = 0; f < nf; ++f) label[static_cast<size_t>(f)] = f / (nf / 2);
       std::vector<std::pair<int, int>> expected;
       for (const auto& [f, g] : full)
         if ((active[f] || active[g]) && (label[f] == label[g]) == same) expected.emplace_back(f, g);
