@@ -1200,7 +1200,6 @@ def test_swatch_motion_follows_an_animated_swatch_object():
     import meshquilt
     from meshquilt import engine, exchange
     swatch = ivy_swatch_object(scene, "Vine")
-    me = swatch.data
     s = scene.meshquilt
     s.base, s.swatch_source, s.swatch, s.scale, s.stretch = base, "OBJECT", swatch, 0.5, False
     check("prop:swatch_motion" in drawn_panel(), "panel: %s" % drawn_panel())
@@ -1212,11 +1211,7 @@ def test_swatch_motion_follows_an_animated_swatch_object():
     # A gust lifting the leaves (a shape key keyed from 0 at frame 1 to 1 at frame 5).
     swatch.shape_key_add(name="Basis", from_mix=False)
     gust = swatch.shape_key_add(name="gust", from_mix=False)
-    material = np.empty(len(me.polygons), dtype=np.int32)
-    me.polygons.foreach_get("material_index", material)
-    loops = np.empty(3 * len(me.polygons), dtype=np.int32)
-    me.polygons.foreach_get("vertices", loops)
-    leaf = np.unique(loops.reshape(-1, 3)[material == 1].ravel())
+    leaf = np.flatnonzero(leaf_and_vine_vertices(swatch)[0])
     V = positions(swatch)
     lift = 0.05 * (V.max(0) - V.min(0)).max()
     for v in leaf:
