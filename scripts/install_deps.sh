@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages meshquilt builds against, skipping those already present.
 set -euo pipefail
-packages=(build-essential cmake pkg-config
+packages=(build-essential cmake ninja-build pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libtbb-dev libeigen3-dev libembree-dev libtet1.5-dev libboost-graph-dev
   libpng-dev libgtest-dev libbenchmark-dev libtinygltf-dev python3

@@ -7,13 +7,18 @@
 #include <utility>
 #include <vector>
 
-// GCC 12 reports a false -Wmaybe-uninitialized inside Boost's edge iterator (boost::optional).
+// GCC 12 reports a false -Wmaybe-uninitialized inside Boost's edge iterator (boost::optional);
+// clang (the sanitizer build) has no such warning and would warn about the unknown name.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 #include <boost/graph/compressed_sparse_row_graph.hpp>
 #include <boost/range/iterator_range.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include "core/common/errors.h"
 #include "core/mesh/mesh_topology.h"

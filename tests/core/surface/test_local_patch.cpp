@@ -72,14 +72,12 @@ TEST_P(LocalPatchOnRealMeshes, PatchesAreFlattenedDisks) {
   LocalPatchOptions o;
   o.max_area = GetParam().patch_faces * mean_area;
   const int seeds = 40;
-  int shrunk = 0;
   size_t total = 0;
   for (int i = 0; i < seeds; ++i) {
     const int seed = static_cast<int>((static_cast<long long>(i) * 7919 + 13) % base.num_faces());
     if (face_areas(base.V, base.F)(seed) <= 0) continue;
     const LocalPatch p = builder.grow(seed, o);
     expect_valid_patch(base, p, seed, o, GetParam().file);
-    shrunk += p.shrink_steps > 0;
     total += p.faces.size();
   }
   // Most patches reach a substantial fraction of the requested size.
