@@ -5,6 +5,13 @@ cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/install_blender.sh
 jobs=$(nproc)
+# Each stage's wall time in the log ("ci: NAME: N s"), to see where CI's 30 minutes go.
+stage_start=$SECONDS
+stage() {
+  echo "ci: $1: $((SECONDS - stage_start)) s"
+  stage_start=$SECONDS
+}
+stage "dependencies and Blender"
 # Ninja for a new build directory: it compiles the test programs while the library's last
 # sources still build (make waits for each target). An existing directory keeps its generator.
 generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
@@ -16,12 +23,16 @@ cmake -S . -B build $(generator build) -DCMAKE_BUILD_TYPE=Release -DMESHQUILT_WE
 # bases are exported by headless Blender.
 cmake --build build -j"$jobs" --target meshquilt test_core test_host test_cli test_slow \
   blender_bases
+stage "Release build"
 # clang-format on the whole tree, clang-tidy on the sources changed since main (issue 24).
 bash scripts/lint.sh
+stage "lint"
 ctest --test-dir build --output-on-failure -j"$jobs"
+stage "Release tests"
 # The Blender add-on in real Blender, headless (issue 15); installs Blender when missing.
 if [ "${MESHQUILT_SKIP_BLENDER:-0}" != 1 ]; then
   bash scripts/test_blender.sh build/meshquilt
+  stage "Blender tests"
 fi
 if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   # -O1 with line tables only: sanitizer reports keep file:line, and the build takes far less
@@ -35,6 +46,7 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
         -DMESHQUILT_SANITIZE=ON -DMESHQUILT_BUILD_BENCH=OFF -DMESHQUILT_BUILD_SLOW_TESTS=OFF \
         -DCMAKE_UNITY_BUILD=ON
   cmake --build build-asan -j"$jobs" --target all blender_bases
+  stage "sanitizer build"
   # PoCL's compiler and the ICD loader keep allocations alive past exit; leaks are not checked.
   # Left out under the sanitizers (they run in Release above): the brute-force references on
   # real meshes, and the larger runs of code the small ones cover (the generated sphere through
@@ -69,8 +81,10 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   slow_under_asan+='|GlobalQuilting.SizeMapVariesTheRingsSmoothly'
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j"$jobs" -E "$slow_under_asan"
+  stage "sanitizer tests"
 fi
 # The readers under libFuzzer with ASan + UBSan, 12 s per target (issue 14).
 if [ "${MESHQUILT_SKIP_FUZZ:-0}" != 1 ]; then
   bash scripts/fuzz.sh 12
+  stage "fuzz build and runs"
 fi
