@@ -7,11 +7,12 @@
 #     in a fresh clone of main) HEAD~1; with no parent commit nothing is tidied. The diff is to
 #     the work tree, so uncommitted changes are tidied too. A changed header is tidied through
 #     its .cpp (or, with none, the first source that includes it); sources not in the
-#     compilation database (the fuzz targets, tests/data) are skipped, and so are tests/ and
-#     bench/ (not made tidy-clean yet: core/ cli/ host/ are).
+#     compilation database (the fuzz targets, tests/data) are skipped, and so is bench/ (not
+#     made tidy-clean yet). A test file built as part of a unity source (scripts/test.sh's
+#     build) is tidied through that source, its findings in any test file reported.
 # Needs $MESHQUILT_LINT_BUILD (default build)/compile_commands.json and the generated kernel
 # headers, i.e. a configured and built build directory. Exits non-zero on any finding.
-# MESHQUILT_LINT_ALL=1 tidies every source of core/ cli/ host/ instead of the changed ones.
+# MESHQUILT_LINT_ALL=1 tidies every source of core/ cli/ host/ tests/ instead of the changed ones.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${MESHQUILT_LINT_BUILD:-build}
@@ -31,11 +32,16 @@ if [ ! -f "$database" ]; then
   exit 1
 fi
 in_database() { grep -qF "\"file\": \"$PWD/$1\"" "$database"; }
+# The unity source of the build that includes test file $1, if any.
+unity_of() {
+  grep -lF "#include \"$PWD/$1\"" "$build"/CMakeFiles/test_*.dir/Unity/*.cxx 2>/dev/null |
+    head -1 || true
+}
 
 changed=()
 if [ "${MESHQUILT_LINT_ALL:-0}" = 1 ]; then
-  mapfile -t changed < <(git ls-files 'core/*.cpp' 'cli/*.cpp' 'host/*.cpp')
-  echo "lint: clang-tidy: every source of core/ cli/ host/"
+  mapfile -t changed < <(git ls-files 'core/*.cpp' 'cli/*.cpp' 'host/*.cpp' 'tests/*.cpp')
+  echo "lint: clang-tidy: every source of core/ cli/ host/ tests/"
 else
   base=""
   if [ -n "${MESHQUILT_LINT_BASE:-}" ]; then
@@ -66,11 +72,19 @@ for f in "${changed[@]}"; do
       else
         # A header without a .cpp: the first source in the database that includes it.
         while IFS= read -r includer; do
-          if in_database "$includer"; then
+          if in_database "$includer" || [ -n "$(unity_of "$includer")" ]; then
             source=$includer
             break
           fi
         done < <(git grep -l -F "#include \"$f\"" -- '*.cpp' || true)
+      fi
+      ;;
+  esac
+  case "$source" in
+    tests/*)
+      if ! in_database "$source"; then
+        source=$(unity_of "$source")
+        source=${source#"$PWD/"}
       fi
       ;;
   esac
@@ -79,10 +93,10 @@ for f in "${changed[@]}"; do
     continue
   fi
   case "$source" in
-    core/* | cli/* | host/*) ;;
+    core/* | cli/* | host/* | tests/* | */Unity/*) ;;
     *)
-      # tests/ and bench/ have not been made tidy-clean yet: tidying them would fail on old code.
-      echo "lint: clang-tidy: skipping $f (only core/ cli/ host/ are tidied)"
+      # bench/ has not been made tidy-clean yet: tidying it would fail on old code.
+      echo "lint: clang-tidy: skipping $f (bench/ is not tidied)"
       continue
       ;;
   esac
@@ -95,8 +109,16 @@ if [ ${#sources[@]} -gt 0 ]; then
   # One clang-tidy per source, $jobs at a time; each prints its findings at once when done
   # (so parallel outputs do not interleave) and fails on any (WarningsAsErrors in .clang-tidy).
   # shellcheck disable=SC2016
+  # Tests: findings in the test files themselves (a unity source's included .cpp files are not
+  # suspicious), without two checks that cost a test's readability for nothing (building a
+  # command line with +, reserving a fixture's few elements).
   if ! printf '%s\0' "${sources[@]}" | xargs -0 -n 1 -P "$jobs" bash -c '
-      if out=$(clang-tidy-14 -p "$0" --quiet "$1" 2>&1); then
+      extra=()
+      case "$1" in
+        tests/* | */Unity/*)
+          extra=(--header-filter=tests/ --checks=-bugprone-suspicious-include,-performance-inefficient-string-concatenation,-performance-inefficient-vector-operation) ;;
+      esac
+      if out=$(clang-tidy-14 -p "$0" --quiet "${extra[@]}" "$1" 2>&1); then
         exit 0
       fi
       printf "%s\n%s\n" "lint: clang-tidy: $1:" "$out" | grep -v " warnings\? generated\.$"

@@ -221,7 +221,7 @@ TEST(Cli, ProgressLinesOnStderrWhenNotATerminal) {
   ASSERT_FALSE(lines.empty());
   // Plain lines (no carriage returns: stderr is a file), ending with the stage at 100%.
   EXPECT_EQ(r.err.find('\r'), std::string::npos);
-  for (const std::string& line : lines) EXPECT_EQ(line.rfind("[", 0), 0u) << line;
+  for (const std::string& line : lines) EXPECT_EQ(line.rfind('[', 0), 0u) << line;
   EXPECT_NE(lines.back().find("writing 100%"), std::string::npos) << lines.back();
   EXPECT_NE(r.err.find("quilting 100%"), std::string::npos) << r.err;
   // The summary goes to stdout, not stderr.

@@ -20,7 +20,7 @@ inline TriMesh ivy_swatch() {
 
 // A region for SurfaceQuiltingOptions::region: the faces whose centroid satisfies `inside`.
 inline std::function<std::vector<char>(const TriMesh&)> centroid_region(
-    std::function<bool(const Vector3d&)> inside) {
+    const std::function<bool(const Vector3d&)>& inside) {
   return [inside](const TriMesh& refined) {
     std::vector<char> in(static_cast<size_t>(refined.num_faces()));
     for (int f = 0; f < refined.num_faces(); ++f)

@@ -103,7 +103,7 @@ TEST_P(TetStretchPaths, MatchesReferenceOnPerturbedBunnyShell) {
 }
 
 TEST_P(TetStretchPaths, MovingTextureReusesTheShellBuffers) {
-  const StretchProblem base = bunny_shell();
+  const StretchProblem& base = bunny_shell();
   for (std::uint64_t seed = 1; seed <= 3; ++seed) expect_agreement(perturbed(base, 1e-4, seed));
   if (auto* ocl = dynamic_cast<TetStretchOpenCL*>(evaluator_.get())) {
     EXPECT_EQ(ocl->num_shell_uploads(), 1);

@@ -42,8 +42,10 @@ TranslationCostProblem self_subpatch(const TriMesh& m, int stride, const Vector3
     pb.point_normals.row(i) = n.normalized();
   }
   pb.offsets.resize(25, 3);
-  for (int i = 0; i < 25; ++i)
-    pb.offsets.row(i) = shift + Vector3d(step * (i % 5 - 2), step * (i / 5 - 2), 0.0);
+  for (int i = 0; i < 25; ++i) {
+    const int row = i / 5;  // a 5 x 5 grid of offsets around the shift
+    pb.offsets.row(i) = shift + Vector3d(step * (i % 5 - 2), step * (row - 2), 0.0);
+  }
   return pb;
 }
 

@@ -58,7 +58,10 @@ TEST(LongestEdgeBisection, RefinesOnlyWhereEdgesAreLong) {
   EXPECT_LE(longest_edge(fine), bound);
   // 1-to-4 subdivision halves every edge per level and multiplies the face count by 4.
   long long uniform_faces = wall.num_faces();
-  for (double e = longest_edge(wall); e > bound; e *= 0.5) uniform_faces *= 4;
+  for (double e = longest_edge(wall); e > bound;) {
+    e *= 0.5;
+    uniform_faces *= 4;
+  }
   EXPECT_LT(4LL * fine.num_faces(), uniform_faces);
   EXPECT_EQ(topology_report(fine).num_boundary_edges > 0,
             topology_report(wall).num_boundary_edges > 0);

@@ -40,7 +40,7 @@ TriMesh two_cubes() {
 
 // Frames moving the first `moving` vertices (the small cube) and, with `both`, the large one back
 // towards it by reach[k] times the amplitude.
-FramePositions towards(const TriMesh& m, int moving, std::vector<double> reach, bool both) {
+FramePositions towards(const TriMesh& m, int moving, const std::vector<double>& reach, bool both) {
   return [&m, moving, reach, both](int k, const std::vector<double>& a) {
     MatrixX3d V = m.V;
     for (Eigen::Index v = 0; v < V.rows(); ++v) {

@@ -245,7 +245,10 @@ TEST(TranslationCost, CpuIsIndependentOfThreadCount) {
   const TriMesh torus = test::torus(2.0, 0.5, 32, 16);
   TranslationCostProblem pb = torus_vertex_problem(torus, 100);
   pb.offsets.resize(9, 3);
-  for (int i = 0; i < 9; ++i) pb.offsets.row(i) << 0.1 * (i % 3), 0.1 * (i / 3), 0.0;
+  for (int i = 0; i < 9; ++i) {
+    const int row = i / 3;  // a 3 x 3 grid of offsets
+    pb.offsets.row(i) << 0.1 * (i % 3), 0.1 * row, 0.0;
+  }
   const SwatchFaceTree tree(torus.V, torus.F);
   TranslationCostCpu cpu;
   Eigen::VectorXd one, two;
@@ -302,7 +305,10 @@ TEST(TranslationCost, CpuLeastCostOffsetsAreThoseOfSortingEveryCost) {
   TranslationCostProblem pb = torus_vertex_problem(torus, 40);
   // 7 x 7 offsets around zero, the last rows repeating earlier ones: exact ties.
   pb.offsets.resize(56, 3);
-  for (int i = 0; i < 49; ++i) pb.offsets.row(i) << 0.3 * (i % 7 - 3), 0.3 * (i / 7 - 3), 0.0;
+  for (int i = 0; i < 49; ++i) {
+    const int row = i / 7;
+    pb.offsets.row(i) << 0.3 * (i % 7 - 3), 0.3 * (row - 3), 0.0;
+  }
   for (int i = 49; i < 56; ++i) pb.offsets.row(i) = pb.offsets.row((i - 49) * 7 + 3);
   const SwatchFaceTree tree(torus.V, torus.F);
   TranslationCostCpu cpu;

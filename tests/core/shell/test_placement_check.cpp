@@ -61,8 +61,10 @@ TEST(PlacementCheck, VerticesNearAMeasuredOneNeedNoQuery) {
   const TriMesh cube = test::unit_cube();
   const SignedHeight base(cube.V, cube.F);
   MatrixX3d V(1000, 3);
-  for (int i = 0; i < 1000; ++i)
-    V.row(i) << 0.5 + 0.002 * (i % 10), 0.5 + 0.002 * ((i / 10) % 10), 1.05 + 0.002 * (i / 100);
+  for (int i = 0; i < 1000; ++i) {
+    const int row = (i / 10) % 10, layer = i / 100;  // a 10 x 10 x 10 block of points
+    V.row(i) << 0.5 + 0.002 * (i % 10), 0.5 + 0.002 * row, 1.05 + 0.002 * layer;
+  }
   PlacementCheckOptions o;
   o.height = 0.1;
   const std::vector<ElementHeights> h = check_element_heights(base, V, {0, 1000}, o);

@@ -178,7 +178,7 @@ TEST(TextureStructure, ShapeFiguresAgainstTheSwatchElementAtTheOutputScale) {
   for (const bool copy : {true, false}) {
     SCOPED_TRACE(copy ? "by correspondence" : "by principal extents");
     const StructureReport r =
-        measure_structure(with_ring([&](TriMesh ring) {
+        measure_structure(with_ring([&](const TriMesh& ring) {
                             return copy ? stretch_x(ring) : reordered(stretch_x(ring));
                           }),
                           so);
@@ -230,7 +230,8 @@ TriMesh chain_through(const TriMesh& t) {
 
 // The same map with x and y exchanged: bends along x (through the partners' crossings) rather
 // than across.
-std::function<Vector3d(const Vector3d&)> along_x(std::function<Vector3d(const Vector3d&)> f) {
+std::function<Vector3d(const Vector3d&)> along_x(
+    const std::function<Vector3d(const Vector3d&)>& f) {
   return [f](const Vector3d& p) {
     const Vector3d q = f(Vector3d(p.y(), p.x(), p.z()));
     return Vector3d(q.y(), q.x(), q.z());
