@@ -47,8 +47,11 @@ Fixture make_fixture(int stride, int offsets_per_axis, double lambda_cells = 0) 
   }
   const int n = offsets_per_axis;
   pb.offsets.resize(n * n, 3);
-  for (int i = 0; i < n * n; ++i)
-    pb.offsets.row(i) = shift + Vector3d(h * (i % n - n / 2), h * (i / n - n / 2), 0);
+  const int half = n / 2;  // the grid of offsets centred on the shift
+  for (int i = 0; i < n * n; ++i) {
+    const int row = i / n;
+    pb.offsets.row(i) = shift + Vector3d(h * (i % n - half), h * (row - half), 0);
+  }
   if (lambda_cells > 0) pb.lambda = 1.0 / (lambda_cells * h);
   return fx;
 }

@@ -7,12 +7,12 @@
 #     in a fresh clone of main) HEAD~1; with no parent commit nothing is tidied. The diff is to
 #     the work tree, so uncommitted changes are tidied too. A changed header is tidied through
 #     its .cpp (or, with none, the first source that includes it); sources not in the
-#     compilation database (the fuzz targets, tests/data) are skipped, and so is bench/ (not
-#     made tidy-clean yet). A test file built as part of a unity source (scripts/test.sh's
-#     build) is tidied through that source, its findings in any test file reported.
+#     compilation database (the fuzz targets, tests/data) are skipped. A test file built as
+#     part of a unity source (scripts/test.sh's build) is tidied through that source, its
+#     findings in any test file reported.
 # Needs $MESHQUILT_LINT_BUILD (default build)/compile_commands.json and the generated kernel
 # headers, i.e. a configured and built build directory. Exits non-zero on any finding.
-# MESHQUILT_LINT_ALL=1 tidies every source of core/ cli/ host/ tests/ instead of the changed ones.
+# MESHQUILT_LINT_ALL=1 tidies every source (core/ cli/ host/ tests/ bench/), not the changed ones.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${MESHQUILT_LINT_BUILD:-build}
@@ -40,8 +40,9 @@ unity_of() {
 
 changed=()
 if [ "${MESHQUILT_LINT_ALL:-0}" = 1 ]; then
-  mapfile -t changed < <(git ls-files 'core/*.cpp' 'cli/*.cpp' 'host/*.cpp' 'tests/*.cpp')
-  echo "lint: clang-tidy: every source of core/ cli/ host/ tests/"
+  mapfile -t changed < <(git ls-files 'core/*.cpp' 'cli/*.cpp' 'host/*.cpp' 'tests/*.cpp' \
+    'bench/*.cpp')
+  echo "lint: clang-tidy: every source of core/ cli/ host/ tests/ bench/"
 else
   base=""
   if [ -n "${MESHQUILT_LINT_BASE:-}" ]; then
@@ -93,10 +94,9 @@ for f in "${changed[@]}"; do
     continue
   fi
   case "$source" in
-    core/* | cli/* | host/* | tests/* | */Unity/*) ;;
+    core/* | cli/* | host/* | tests/* | bench/* | */Unity/*) ;;
     *)
-      # bench/ has not been made tidy-clean yet: tidying it would fail on old code.
-      echo "lint: clang-tidy: skipping $f (bench/ is not tidied)"
+      echo "lint: clang-tidy: skipping $f (not in core/ cli/ host/ tests/ bench/)"
       continue
       ;;
   esac
@@ -109,14 +109,19 @@ if [ ${#sources[@]} -gt 0 ]; then
   # One clang-tidy per source, $jobs at a time; each prints its findings at once when done
   # (so parallel outputs do not interleave) and fails on any (WarningsAsErrors in .clang-tidy).
   # shellcheck disable=SC2016
-  # Tests: findings in the test files themselves (a unity source's included .cpp files are not
-  # suspicious), without two checks that cost a test's readability for nothing (building a
+  # Tests and benchmarks: findings in their own files (a unity source's included .cpp files are
+  # not suspicious), without two checks that cost their readability for nothing (building a
   # command line with +, reserving a fixture's few elements).
   if ! printf '%s\0' "${sources[@]}" | xargs -0 -n 1 -P "$jobs" bash -c '
       extra=()
+      loose=-performance-inefficient-string-concatenation,-performance-inefficient-vector-operation
       case "$1" in
         tests/* | */Unity/*)
-          extra=(--header-filter=tests/ --checks=-bugprone-suspicious-include,-performance-inefficient-string-concatenation,-performance-inefficient-vector-operation) ;;
+          extra=(--header-filter=tests/ "--checks=-bugprone-suspicious-include,$loose") ;;
+        bench/*)
+          # Google Benchmark idioms: BM_ names, and the unused _ of "for (auto _ : state)".
+          extra=(--header-filter=bench/ "--checks=-clang-analyzer-deadcode.DeadStores,$loose"
+            "--config={InheritParentConfig: true, CheckOptions: [{key: readability-identifier-naming.FunctionIgnoredRegexp, value: \"BM_.*\"}]}") ;;
       esac
       if out=$(clang-tidy-14 -p "$0" --quiet "${extra[@]}" "$1" 2>&1); then
         exit 0
