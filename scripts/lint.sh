@@ -108,10 +108,10 @@ if [ ${#sources[@]} -gt 0 ]; then
   start=$SECONDS
   # One clang-tidy per source, $jobs at a time; each prints its findings at once when done
   # (so parallel outputs do not interleave) and fails on any (WarningsAsErrors in .clang-tidy).
-  # shellcheck disable=SC2016
   # Tests and benchmarks: findings in their own files (a unity source's included .cpp files are
   # not suspicious), without two checks that cost their readability for nothing (building a
   # command line with +, reserving a fixture's few elements).
+  # shellcheck disable=SC2016
   if ! printf '%s\0' "${sources[@]}" | xargs -0 -n 1 -P "$jobs" bash -c '
       extra=()
       loose=-performance-inefficient-string-concatenation,-performance-inefficient-vector-operation

@@ -13,12 +13,12 @@ stage() {
 }
 stage "dependencies and Blender"
 # Ninja for a new build directory: it compiles the test programs while the library's last
-# sources still build (make waits for each target). An existing directory keeps its generator.
-generator() { [ -f "$1/CMakeCache.txt" ] || echo "-GNinja"; }
+# sources still build (make waits for each target). CMake reads this only for a new directory;
+# an existing one keeps its generator.
+export CMAKE_GENERATOR=${CMAKE_GENERATOR:-Ninja}
 # Warnings are errors here (issue 24): a warning fails CI, not just a log line.
 # The test programs as unity builds (a clean build 6.8 min instead of 10.6 on 2 cores).
-cmake -S . -B build $(generator build) -DCMAKE_BUILD_TYPE=Release -DMESHQUILT_WERROR=ON \
-  -DMESHQUILT_UNITY_TESTS=ON
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHQUILT_WERROR=ON -DMESHQUILT_UNITY_TESTS=ON
 # What the tests need (the benchmarks are built by scripts/setup.sh and bench/); the artist
 # bases are exported by headless Blender.
 cmake --build build -j"$jobs" --target meshquilt test_core test_host test_cli test_slow \
@@ -41,8 +41,8 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   # source on its own, so a missing include still fails there. Built by clang (as the fuzz
   # targets are): 6.7 min against GCC's 9.4 (GCC's UBSan doubles the largest sources' time), and
   # a second compiler's warnings; its tests took 766 s in all here, GCC's 891 s in the last CI.
-  cmake -S . -B build-asan $(generator build-asan) -DCMAKE_CXX_COMPILER=clang++ \
-        -DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
+  cmake -S . -B build-asan -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
+        -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" \
         -DMESHQUILT_SANITIZE=ON -DMESHQUILT_BUILD_BENCH=OFF -DMESHQUILT_BUILD_SLOW_TESTS=OFF \
         -DCMAKE_UNITY_BUILD=ON
   cmake --build build-asan -j"$jobs" --target all blender_bases
