@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -141,19 +142,68 @@ bool flat_tet(const MatrixX3d& S, const TetIndices& T, Eigen::Index t) {
   return !(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2));
 }
 
+// The pairs of the shell S with boundary faces B that a full test would find, given an earlier
+// shell's (cache: the same vertex count): the earlier pairs of two faces that are in both
+// shells with bitwise the same corners, renumbered, and a test of the faces that are new or
+// moved against all.
+std::vector<std::pair<int, int>> pairs_after(const MatrixX3d& S, const MatrixX3i& B,
+                                             const OffsetPairCache& cache) {
+  const auto key = [](const MatrixX3i& M, Eigen::Index f) {
+    return std::array<int, 3>{M(f, 0), M(f, 1), M(f, 2)};
+  };
+  std::vector<std::pair<std::array<int, 3>, int>> old_rows(static_cast<size_t>(cache.B.rows()));
+  for (Eigen::Index f = 0; f < cache.B.rows(); ++f)
+    old_rows[static_cast<size_t>(f)] = {key(cache.B, f), static_cast<int>(f)};
+  std::sort(old_rows.begin(), old_rows.end());
+  std::vector<char> same_vertex(static_cast<size_t>(S.rows()));
+  for (Eigen::Index v = 0; v < S.rows(); ++v)
+    same_vertex[static_cast<size_t>(v)] = S.row(v) == cache.S.row(v) ? 1 : 0;
+  std::vector<char> moved(static_cast<size_t>(B.rows()), 1);
+  std::vector<int> new_row(static_cast<size_t>(cache.B.rows()), -1);
+  for (Eigen::Index f = 0; f < B.rows(); ++f) {
+    const std::array<int, 3> k = key(B, f);
+    const auto it = std::lower_bound(old_rows.begin(), old_rows.end(), std::make_pair(k, -1));
+    if (it == old_rows.end() || it->first != k) continue;
+    if (!same_vertex[static_cast<size_t>(k[0])] || !same_vertex[static_cast<size_t>(k[1])] ||
+        !same_vertex[static_cast<size_t>(k[2])])
+      continue;
+    moved[static_cast<size_t>(f)] = 0;
+    new_row[static_cast<size_t>(it->second)] = static_cast<int>(f);
+  }
+  std::vector<std::pair<int, int>> kept;
+  for (const auto& [a, b] : cache.pairs) {
+    const int f = new_row[static_cast<size_t>(a)], g = new_row[static_cast<size_t>(b)];
+    if (f >= 0 && g >= 0) kept.emplace_back(std::min(f, g), std::max(f, g));
+  }
+  std::sort(kept.begin(), kept.end());
+  const std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(kept.size() + fresh.size());
+  std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs));
+  return pairs;
+}
+
 // Intersecting pairs of shell boundary faces, kept from round to round. A round re-tests only
 // the pairs with a face that moved (an offset vertex lowered): the others keep last round's
 // answer, so every round sees exactly the pairs a full test would, at the cost of the faces
 // that moved (on a 1.1M-face base the full test every round was most of the shell's cost).
+// The first round starts from an earlier call's (cache) when there is one.
 class ShellPairs {
  public:
+  explicit ShellPairs(OffsetPairCache* cache) : cache_(cache) {}
+
   // The pairs of the shell S (base then offset vertices, n each) with offset heights `heights`.
   const std::vector<std::pair<int, int>>& update(const MatrixX3d& S, const MatrixX3i& B, int n,
                                                  const Eigen::VectorXd& heights) {
     if (first_) {
-      IntersectionOptions all_pairs;
-      all_pairs.between_components_only = false;
-      pairs_ = intersecting_face_pairs(S, B, all_pairs);
+      if (cache_ && cache_->S.rows() == S.rows()) {
+        pairs_ = pairs_after(S, B, *cache_);
+      } else {
+        IntersectionOptions all_pairs;
+        all_pairs.between_components_only = false;
+        pairs_ = intersecting_face_pairs(S, B, all_pairs);
+      }
+      if (cache_) *cache_ = OffsetPairCache{S, B, pairs_};
       first_ = false;
     } else {
       std::vector<char> moved(static_cast<size_t>(B.rows()), 0);
@@ -174,6 +224,7 @@ class ShellPairs {
   }
 
  private:
+  OffsetPairCache* cache_;
   bool first_ = true;
   std::vector<std::pair<int, int>> pairs_;
   Eigen::VectorXd tested_heights_;
@@ -355,7 +406,7 @@ MatrixX3d offset_directions(const MatrixX3d& V, const MatrixX3i& F, const Offset
 }
 
 bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
-                        OffsetSurface& out, OffsetFailure& failure) {
+                        OffsetSurface& out, OffsetFailure& failure, OffsetPairCache* cache) {
   failure = OffsetFailure();
   options.validate();
   MQ_CHECK(V.allFinite(), InvalidInput, "offset surface: vertices contain NaN or infinite values");
@@ -376,7 +427,7 @@ bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOpti
   const double floor_h = options.min_fraction * options.height;
   MatrixX3d S(2 * n, 3);  // shell vertices: base then offset
   S.topRows(n) = V;
-  ShellPairs shell_pairs;
+  ShellPairs shell_pairs(cache);
   for (int round = 0;; ++round) {
     out.V = V + out.heights.asDiagonal() * out.directions;
     S.bottomRows(n) = out.V;

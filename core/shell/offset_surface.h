@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -92,10 +93,25 @@ struct OffsetFailure {
   std::vector<int> faces;
 };
 
+// The first round's shell of a try_offset_surface call: its vertices (base then offset, at
+// full height), boundary faces and their intersecting pairs. Passed to the next call on the
+// same vertices (ShellMap's per-region fallback: most of the base again, a few regions left
+// out), that call re-tests only the boundary faces that are new or moved and keeps the other
+// pairs, so it finds exactly the pairs a full test would at a fraction of the cost (the ivy
+// wall's 530k boundary faces: 0.45 s of each attempt's 0.6 s was the full test).
+struct OffsetPairCache {
+  MatrixX3d S;  // #2V by 3
+  MatrixX3i B;  // boundary faces, as shell_boundary_faces
+  std::vector<std::pair<int, int>> pairs;
+};
+
 // offset_surface without the TopologyError: returns false with `failure` filled instead (`out`
 // is then unspecified), so that a caller can leave the offending region out of the shell and
-// try again (ShellMap's per-region fallback). Same arguments and other throws.
+// try again (ShellMap's per-region fallback). Same arguments and other throws. cache
+// (optional): read when it holds an earlier call's first round on as many vertices, then
+// replaced by this call's; the result does not depend on it.
 bool try_offset_surface(const MatrixX3d& V, const MatrixX3i& F, const OffsetOptions& options,
-                        OffsetSurface& out, OffsetFailure& failure);
+                        OffsetSurface& out, OffsetFailure& failure,
+                        OffsetPairCache* cache = nullptr);
 
 }  // namespace mq

@@ -61,7 +61,8 @@ void ShellMap::build_offset(const MatrixX3d& V, const MatrixX3i& F,
   OffsetOptions oo = options.offset;
   oo.height = options.height;
   OffsetFailure failure;
-  if (try_offset_surface(base_V_, F_, oo, offset_, failure)) return;
+  OffsetPairCache cache;  // each attempt of the fallback tests only what changed
+  if (try_offset_surface(base_V_, F_, oo, offset_, failure, &cache)) return;
   if (!options.repair_folds && !options.exclude_regions) MQ_THROW(TopologyError, failure.reason);
   // Section 3.2 needs a valid shell; a folded base has none, so the shell is built over a
   // relaxed copy, which may slide a little along the base but not leave it (see
@@ -75,14 +76,14 @@ void ShellMap::build_offset(const MatrixX3d& V, const MatrixX3i& F,
     repair_ = repair_folds(V, F, fo);
     base_V_ = repair_.V;
   }
-  exclude_until_valid(V, F, options, oo, failure);
+  exclude_until_valid(V, F, options, oo, failure, cache);
 }
 
 // Leaves out the faces where the offset surface fails, with rings of faces around them, and
 // tries again, until it holds or the attempts or the excluded share run out (TopologyError).
 void ShellMap::exclude_until_valid(const MatrixX3d& V, const MatrixX3i& F,
                                    const ShellMapOptions& options, const OffsetOptions& oo,
-                                   OffsetFailure& failure) {
+                                   OffsetFailure& failure, OffsetPairCache& cache) {
   const int n = static_cast<int>(V.rows());
   const Adjacency vf = vertex_faces(F, n);
   const Eigen::VectorXd area = face_areas(V, F);
@@ -97,7 +98,7 @@ void ShellMap::exclude_until_valid(const MatrixX3d& V, const MatrixX3i& F,
       F_.resize(static_cast<Eigen::Index>(kept.size()), 3);
       for (size_t i = 0; i < kept.size(); ++i)
         F_.row(static_cast<Eigen::Index>(i)) = F.row(kept[i]);
-      if (try_offset_surface(base_V_, F_, oo, offset_, failure)) break;
+      if (try_offset_surface(base_V_, F_, oo, offset_, failure, &cache)) break;
     }
     MQ_CHECK(options.exclude_regions && attempt < options.max_exclusion_attempts, TopologyError,
              failure.reason);

@@ -139,7 +139,7 @@ class ShellMap {
   // The constructor's steps, in order (V, F as given).
   void build_offset(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions& options);
   void exclude_until_valid(const MatrixX3d& V, const MatrixX3i& F, const ShellMapOptions& options,
-                           const OffsetOptions& oo, OffsetFailure& failure);
+                           const OffsetOptions& oo, OffsetFailure& failure, OffsetPairCache& cache);
   void number_shell_faces(Eigen::Index num_faces);
   void build_problem(int num_vertices);
   void mark_fixed_corners(int num_vertices);

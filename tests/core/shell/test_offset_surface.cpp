@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/common/errors.h"
 #include "core/mesh/geometry_measures.h"
@@ -192,6 +194,58 @@ TEST(OffsetSurface, ImpossibleShellThrows) {
   const TriMesh flat = test::plane_grid(4.0, 1.0, 16, 4);
   EXPECT_TRUE(try_offset_surface(flat.V, flat.F, opt, out, failure));
   EXPECT_TRUE(failure.faces.empty() && failure.reason.empty());
+}
+
+// The same faces as F but those listed (ascending) left out.
+MatrixX3i faces_without(const MatrixX3i& F, const std::vector<int>& out) {
+  std::vector<int> kept;
+  for (int f = 0; f < F.rows(); ++f)
+    if (!std::binary_search(out.begin(), out.end(), f)) kept.push_back(f);
+  MatrixX3i K(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i) K.row(static_cast<Eigen::Index>(i)) = F.row(kept[i]);
+  return K;
+}
+
+TEST(OffsetSurface, AnEarlierCallsPairsGiveTheSameShell) {
+  // ShellMap's fallback: a failed shell, then the same vertices with regions left out (and, after
+  // a fold repair, some vertices moved). With the first call's pairs passed on, each later call
+  // must decide exactly as a call on its own: same heights, same success, same failure.
+  TriMesh g = test::plane_grid(4.0, 1.0, 32, 8);  // a valley too narrow at its floor
+  for (int i = 0; i < g.num_vertices(); ++i) g.V(i, 2) = 20.0 * std::abs(g.V(i, 0) - 2.0);
+  OffsetOptions opt;
+  opt.height = 5.0;
+  opt.smoothing_iterations = 0;
+  opt.min_fraction = 0.9;
+  OffsetPairCache cache;
+  OffsetSurface out;
+  OffsetFailure failure;
+  ASSERT_FALSE(try_offset_surface(g.V, g.F, opt, out, failure, &cache));
+  ASSERT_GT(failure.faces.size(), 4u);
+  ASSERT_EQ(cache.S.rows(), 2 * g.num_vertices());
+  ASSERT_FALSE(cache.pairs.empty());  // the valley's walls meet: pairs to carry over
+  const std::vector<int> all = failure.faces;
+  const std::vector<int> half(all.begin(), all.begin() + static_cast<long>(all.size() / 2));
+  MatrixX3d moved = g.V;
+  moved.row(g.F(all.back(), 0)) += Vector3d(0.01, 0.0, 0.0).transpose();
+  struct Case {
+    MatrixX3d V;
+    MatrixX3i F;
+  };
+  int kept_pairs = 0;
+  for (const Case& c : {Case{g.V, faces_without(g.F, half)}, Case{g.V, faces_without(g.F, all)},
+                        Case{moved, faces_without(g.F, half)}, Case{g.V, g.F}}) {
+    kept_pairs += static_cast<int>(cache.pairs.size());
+    OffsetSurface with, alone;
+    OffsetFailure with_failure, alone_failure;
+    const bool ok = try_offset_surface(c.V, c.F, opt, with, with_failure, &cache);
+    ASSERT_EQ(ok, try_offset_surface(c.V, c.F, opt, alone, alone_failure));
+    EXPECT_TRUE(with.heights == alone.heights);
+    EXPECT_TRUE(with.V == alone.V);
+    EXPECT_EQ(with_failure.reason, alone_failure.reason);
+    EXPECT_EQ(with_failure.faces, alone_failure.faces);
+    EXPECT_EQ(with_failure.vertices, alone_failure.vertices);
+  }
+  EXPECT_GT(kept_pairs, 0);
 }
 
 TEST(OffsetSurface, InvalidInputThrows) {
