@@ -8,6 +8,7 @@
 #include <cmath>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <queue>
 #include <unordered_map>
 #include <utility>
@@ -578,7 +579,7 @@ class TriangleGrid {
             const auto it = cells_.find(key(x, y, z));
             if (it == cells_.end()) continue;
             for (const int t : it->second) {
-              const Tri& o = tris_[static_cast<size_t>(t)];
+              const Tri& o = tri(t);
               if ((o.lo.array() > hi.array()).any() || (o.hi.array() < lo.array()).any()) continue;
               if (triangles_intersect(a, b, c, o.p[0], o.p[1], o.p[2])) return o.owner;
             }
@@ -602,9 +603,11 @@ class TriangleGrid {
       for (int k = 0; k < 3; ++k) t.p[static_cast<size_t>(k)] = V.row(F(f, k)).transpose();
       t.lo = t.p[0].cwiseMin(t.p[1]).cwiseMin(t.p[2]);
       t.hi = t.p[0].cwiseMax(t.p[1]).cwiseMax(t.p[2]);
-      const int id = static_cast<int>(tris_.size());
+      const int id = size_;
       const Eigen::Array3i l = cell_of(t.lo), h = cell_of(t.hi);
-      tris_.push_back(t);
+      if (size_ % kChunk == 0) chunks_.emplace_back(new Tri[kChunk]);  // pages not touched
+      chunks_.back()[static_cast<size_t>(size_ % kChunk)] = t;
+      ++size_;
       for (int x = l(0); x <= h(0); ++x)
         for (int y = l(1); y <= h(1); ++y)
           for (int z = l(2); z <= h(2); ++z) cells_[key(x, y, z)].push_back(id);
@@ -615,7 +618,7 @@ class TriangleGrid {
   struct Tri {
     std::array<Vector3d, 3> p;
     Vector3d lo, hi;
-    int owner = -1;
+    int owner;
   };
   Eigen::Array3i cell_of(const Vector3d& p) const {
     return (p / cell_).array().floor().cast<int>();
@@ -624,8 +627,18 @@ class TriangleGrid {
     return (static_cast<long long>(x) * 73856093LL) ^ (static_cast<long long>(y) * 19349663LL) ^
            (static_cast<long long>(z) * 83492791LL);
   }
+  // Stored in chunks that never move: a growing vector copied its ~1M triangles over and over
+  // (ivy wall: 0.6 s of the leaves and stems, most of it faulting in the new copies' pages).
+  // A chunk is 32 MiB, which glibc maps on its own and gives back when freed (smaller ones
+  // stayed in the heap: the ivy wall's peak memory rose 100 MB); a Tri's constructor writes
+  // nothing, so only the pages used are touched.
+  static constexpr int kChunk = 1 << 18;
+  const Tri& tri(int t) const {
+    return chunks_[static_cast<size_t>(t / kChunk)][static_cast<size_t>(t % kChunk)];
+  }
   double cell_;
-  std::vector<Tri> tris_;
+  std::vector<std::unique_ptr<Tri[]>> chunks_;
+  int size_ = 0;
   std::unordered_map<long long, std::vector<int>> cells_;
 };
 
