@@ -9,6 +9,7 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "cli/huge_pages.h"
 #include "cli/json_writer.h"
 #include "cli/result_check.h"
 #include "cli/run_context.h"
@@ -189,6 +190,7 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("estimated_bytes", estimated_faces * kBytesPerOutputFace + kBaseBytes)
       .value("limit_bytes", memory_limit_bytes)
       .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
+      .value("huge_pages", huge_pages_on())
       .end_object()
       .value("swatch_coverage", swatch_cover)
       .value("min_coverage", min_coverage);

@@ -7,6 +7,7 @@
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
+#include "cli/huge_pages.h"
 #include "core/common/errors.h"
 #include "core/mesh/atomic_file.h"
 
@@ -54,7 +55,8 @@ int main(int argc, char** argv) {
     std::puts("meshquilt 0.1.0");
     return 0;
   }
-  mq::install_temporary_file_cleanup();  // no .NAME.tmp-* left behind on SIGINT or SIGTERM
+  mq::cli::restart_with_huge_pages(argv);  // returns when it does not restart
+  mq::install_temporary_file_cleanup();    // no .NAME.tmp-* left behind on SIGINT or SIGTERM
   for (const Command& c : kCommands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
     try {

@@ -508,5 +508,51 @@ TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
   EXPECT_TRUE(t1 == slurp(dir + "/cl/q.obj")) << "--device cpu and opencl differ";
 }
 
+// Whether this machine and build can run on transparent huge pages on request (cli/huge_pages.h):
+// glibc 2.35 or later, the kernel's THP mode "madvise", no sanitizer.
+bool huge_pages_possible() {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+  return false;
+#endif
+#endif
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 35))
+  return slurp("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") !=
+         std::string::npos;
+#else
+  return false;
+#endif
+}
+
+TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
+  // The engine restarts itself once on huge pages where it can (--stats says so); the bytes must
+  // not depend on it, and MESHQUILT_HUGE_PAGES=0 or the tunable set by the caller stop the restart.
+  const std::string dir = test::temp_dir();
+  const std::string sw = small_swatch(dir);
+  write_obj(dir + "/grid.obj", test::plane_grid(6, 6, 12, 12));
+  const std::string job = "surface --base grid.obj --swatch " + sw + " --scale 0.1 --quiet";
+  for (const char* sub : {"on", "off", "set"}) fs::create_directory(dir + "/" + sub);
+  ASSERT_EQ(meshquilt(dir, job + " -o on/q.obj --stats on/q.json").status, 0);
+  ASSERT_EQ(setenv("MESHQUILT_HUGE_PAGES", "0", 1), 0);
+  const CliRun off = meshquilt(dir, job + " -o off/q.obj --stats off/q.json");
+  unsetenv("MESHQUILT_HUGE_PAGES");
+  ASSERT_EQ(off.status, 0) << off.err;
+  ASSERT_EQ(setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=0", 1), 0);
+  const CliRun set = meshquilt(dir, job + " -o set/q.obj --stats set/q.json");
+  unsetenv("GLIBC_TUNABLES");
+  ASSERT_EQ(set.status, 0) << set.err;
+  EXPECT_EQ(json_value(slurp(dir + "/on/q.json"), "huge_pages"),
+            huge_pages_possible() ? "true" : "false");
+  EXPECT_EQ(json_value(slurp(dir + "/off/q.json"), "huge_pages"), "false");
+  EXPECT_EQ(json_value(slurp(dir + "/set/q.json"), "huge_pages"), "false");
+  const std::string on = slurp(dir + "/on/q.obj");
+  ASSERT_FALSE(on.empty());
+  EXPECT_TRUE(on == slurp(dir + "/off/q.obj"));
+  EXPECT_TRUE(on == slurp(dir + "/set/q.obj"));
+}
+
 }  // namespace
 }  // namespace mq
