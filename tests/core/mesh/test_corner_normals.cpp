@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "core/common/errors.h"
@@ -29,6 +31,39 @@ TEST(CornerNormals, SmoothSurfaceHasOneNormalPerVertexEqualToTheVertexNormal) {
   const MatrixX3d VN = vertex_normals(t.V, t.F);
   for (int f = 0; f < t.num_faces(); ++f)
     for (int k = 0; k < 3; ++k) ASSERT_LT((c.N.row(c.FN(f, k)) - VN.row(t.F(f, k))).norm(), 1e-9);
+}
+
+TEST(CornerNormals, ManyVerticesAreNumberedInVertexOrderWhateverTheThreads) {
+  // 1,000 cubes (8,000 vertices: the normals are gathered per block of vertices) in a row.
+  const TriMesh cube = test::unit_cube();
+  TriMesh m;
+  m.V.resize(8000, 3);
+  m.F.resize(12000, 3);
+  for (int c = 0; c < 1000; ++c) {
+    // Each turned its own way, so that no two cubes share a normal.
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.001 * c, Vector3d::UnitZ()).toRotationMatrix();
+    m.V.middleRows(8 * c, 8) =
+        (cube.V * turn.transpose()).rowwise() + Eigen::RowVector3d(2.0 * c, 0, 0);
+    m.F.middleRows(12 * c, 12) = cube.F.array() + 8 * c;
+  }
+  const CornerNormals c = corner_normals(m.V, m.F, 60);
+  ASSERT_EQ(c.N.rows(), 24000);
+  const MatrixX3d FN = face_normals(m.V, m.F);
+  for (int f = 0; f < m.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      // Vertex v's three normals are rows 3v to 3v + 2: numbered in vertex order.
+      const int v = m.F(f, k);
+      ASSERT_GE(c.FN(f, k), 3 * v);
+      ASSERT_LT(c.FN(f, k), 3 * v + 3);
+      ASSERT_LT((c.N.row(c.FN(f, k)) - FN.row(f)).norm(), 1e-12);
+    }
+  CornerNormals one;
+  {
+    tbb::global_control g(tbb::global_control::max_allowed_parallelism, 1);
+    one = corner_normals(m.V, m.F, 60);
+  }
+  EXPECT_TRUE(one.N == c.N);
+  EXPECT_TRUE(one.FN == c.FN);
 }
 
 TEST(CornerNormals, CreaseAngleDecidesAndBadInputIsRefused) {
