@@ -81,8 +81,9 @@ void restart_with_huge_pages(char** argv) {
 
 bool huge_pages_on() {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  return glibc_with_tunable() && !sanitized() && contains(tunables, "glibc.malloc.hugetlb=") &&
-         !contains(tunables, "glibc.malloc.hugetlb=0");
+  const std::string set = std::string(kTunable) + "=", off = set + "0";
+  return glibc_with_tunable() && !sanitized() && contains(tunables, set.c_str()) &&
+         !contains(tunables, off.c_str());
 }
 
 }  // namespace mq::cli

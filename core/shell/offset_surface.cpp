@@ -142,6 +142,18 @@ bool flat_tet(const MatrixX3d& S, const TetIndices& T, Eigen::Index t) {
   return !(tet_volume(p[0], p[1], p[2], p[3]) > kMinRelativeVolume * l2 * std::sqrt(l2));
 }
 
+// kept (pairs of faces that did not move, sorted) and the pairs with a moved face, merged in
+// order: what a full test of the shell S with boundary faces B finds.
+std::vector<std::pair<int, int>> with_moved_pairs(const std::vector<std::pair<int, int>>& kept,
+                                                  const MatrixX3d& S, const MatrixX3i& B,
+                                                  const std::vector<char>& moved) {
+  const std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(kept.size() + fresh.size());
+  std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs));
+  return pairs;
+}
+
 // The pairs of the shell S with boundary faces B that a full test would find, given an earlier
 // shell's (cache: the same vertex count): the earlier pairs of two faces that are in both
 // shells with bitwise the same corners, renumbered, and a test of the faces that are new or
@@ -176,11 +188,7 @@ std::vector<std::pair<int, int>> pairs_after(const MatrixX3d& S, const MatrixX3i
     if (f >= 0 && g >= 0) kept.emplace_back(std::min(f, g), std::max(f, g));
   }
   std::sort(kept.begin(), kept.end());
-  const std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(kept.size() + fresh.size());
-  std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs));
-  return pairs;
+  return with_moved_pairs(kept, S, B, moved);
 }
 
 // Intersecting pairs of shell boundary faces, kept from round to round. A round re-tests only
@@ -215,9 +223,7 @@ class ShellPairs {
       std::vector<std::pair<int, int>> kept;
       for (const auto& [f, g] : pairs_)
         if (!moved[f] && !moved[g]) kept.emplace_back(f, g);
-      std::vector<std::pair<int, int>> fresh = intersecting_face_pairs_touching(S, B, moved);
-      pairs_.clear();
-      std::merge(kept.begin(), kept.end(), fresh.begin(), fresh.end(), std::back_inserter(pairs_));
+      pairs_ = with_moved_pairs(kept, S, B, moved);
     }
     tested_heights_ = heights;
     return pairs_;
