@@ -224,8 +224,8 @@ void declare_surface_options(CommandLine& cl) {
             "vertices lie); coverage is judged over the mask");
   cl.option("size-map", "FILE",
             "vary the element size: one factor per base vertex (1: the size --scale or "
-            "--element-size sets; the largest at most 8 times the smallest), followed smoothly "
-            "by the global layout (lattices and threads: --method auto or global)");
+            "--element-size sets; the largest at most 8 times the smallest), followed by the "
+            "global layout and the local patches (not by vines)");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");

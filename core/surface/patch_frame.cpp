@@ -36,8 +36,8 @@ Vector3d triangle_barycentric_2d(const Vector2d& p, const Vector2d& a, const Vec
 }  // namespace
 
 PatchFrame::PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction,
-                       const EmbreeDevice& device)
-    : base_(base), patch_(std::move(patch)), device_(device) {
+                       const EmbreeDevice& device, double size)
+    : base_(base), patch_(std::move(patch)), size_(size), device_(device) {
   const MatrixX3i& F = patch_.mesh.F;
   for (int f = 0; f < F.rows(); ++f) local_of_[patch_.faces[f]] = f;
   // The seed face's affine map takes the 3D field direction into the UV plane.
@@ -56,6 +56,7 @@ PatchFrame::PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& di
     const Vector2d q = patch_.uv.row(v).transpose() - origin;
     uv_.row(v) << q.dot(d), q.x() * -d.y() + q.y() * d.x();
   }
+  uv_ /= size_;
   build_grid();
 }
 

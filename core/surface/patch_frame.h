@@ -19,11 +19,17 @@ class PatchFrame {
  public:
   // `patch` grown on `base` (its first face the seed), `direction` the guidance field at the seed
   // (a 3D tangent). device: where the BVH for points beyond the patch is built when first needed.
-  // `base` and `device` must outlive the frame. Throws nothing.
+  // `size` (> 0): the element size wanted around the seed, as a factor of the swatch's (a size
+  // map's, issue 25); the frame is the surface divided by it, so that the swatch, unchanged in
+  // the frame, lands at that size on the surface. `base` and `device` must outlive the frame.
+  // Throws nothing.
   PatchFrame(const TriMesh& base, LocalPatch patch, const Vector3d& direction,
-             const EmbreeDevice& device);
+             const EmbreeDevice& device, double size = 1);
 
   const LocalPatch& patch() const { return patch_; }
+  // Surface length per frame length (the size given): a height h over the base is h / size in
+  // the frame.
+  double size() const { return size_; }
   // #V(patch) by 2: the patch's vertices in the frame.
   const MatrixX2d& uv() const { return uv_; }
   // The patch face that base face `base_face` is, or -1.
@@ -48,6 +54,7 @@ class PatchFrame {
   const TriMesh& base_;
   LocalPatch patch_;
   MatrixX2d uv_;
+  double size_ = 1;
   std::unordered_map<int, int> local_of_;
   Vector2d lo_ = Vector2d::Zero();
   double cell_ = 1;

@@ -554,16 +554,23 @@ void LocalPatchSynthesis::run_patch(ProgressSink* progress) {
 // guidance field orients; null for a degenerate seed triangle.
 std::unique_ptr<PatchFrame> LocalPatchSynthesis::grow_patch(int seed) {
   ScopedStageTimer timer(times_, Stage::Parameterization);
+  // Under a size map (issue 25) the frame is the surface over the size wanted at the seed: the
+  // swatch lands that much smaller, on a patch that much smaller. Sizes vary smoothly, so an
+  // element of a neighbouring patch comes into this frame within a few percent of its swatch
+  // element's size, like the conformal map's own distortion.
+  const double size = nominal_size(job_, seed);
+  LocalPatchOptions patch_options = patch_options_;
+  patch_options.max_area *= size * size;
   LocalPatch patch;
   try {
-    patch = builder_.grow(seed, patch_options_);
+    patch = builder_.grow(seed, patch_options);
   } catch (const InvalidInput&) {
     return nullptr;
   }
   if (patch.shrink_steps > 0) ++stats_.patches_shrunk;
   stats_.patch_faces += static_cast<long long>(patch.faces.size());
   return std::make_unique<PatchFrame>(job_.base, std::move(patch), job_.field.row(seed).transpose(),
-                                      embree_);
+                                      embree_, size);
 }
 
 // The output near the patch, flattened into the frame, by id.
@@ -582,7 +589,7 @@ std::map<int, Element> LocalPatchSynthesis::flatten_output(const PatchFrame& fra
     e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
     for (size_t v = 0; v < s.face.size(); ++v) {
       const Vector2d q = frame.to_frame(s.face[v], s.barycentric.row(v).transpose());
-      e.V.row(v) << q.x(), q.y(), s.height(v);
+      e.V.row(v) << q.x(), q.y(), s.height(v) / frame.size();
     }
     e.update();
     flat.emplace(id, std::move(e));
@@ -650,7 +657,7 @@ void LocalPatchSynthesis::store_changed(const PatchFrame& frame, const FramedOut
         s.face[v] = hit.face;
         s.barycentric.row(v) = hit.barycentric.transpose();
       }
-      s.height(v) = std::clamp(e.V(v, 2), 0.0, H_);
+      s.height(v) = std::clamp(e.V(v, 2), 0.0, H_) * frame.size();
     }
     store_.elements[id] = std::move(s);
     store_.index(id);
@@ -722,9 +729,6 @@ SurfaceQuilt quilt_prepared_surface(SurfaceJob job, SurfaceQuiltingStats stats,
                                     const SurfaceQuiltingOptions& options,
                                     TranslationCostEvaluator& evaluator,
                                     SurfaceQuiltingStats* stats_out, ProgressSink* progress) {
-  MQ_CHECK(job.log_size.size() == 0, InvalidInput,
-           "a size map is followed by the global layout only (lattices of elements and "
-           "threads); this swatch takes the local patches");
   LocalPatchSynthesis synthesis(job, options, evaluator, stats);
   while (!synthesis.finished()) synthesis.run_patch(progress);
   SurfaceQuilt quilt = synthesis.take_quilt(job);

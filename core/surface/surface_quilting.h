@@ -92,8 +92,9 @@ struct SurfaceQuiltingOptions {
   MatrixX3d field;
   // Element size per vertex of the base as given, as a factor of the size set by scale or
   // element_size (issue 25, `--size-map`): each > 0, the largest at most kMaxSizeMapRange times
-  // the smallest; interpolated over the faces. Followed by the global layout (lattices and
-  // threads) only, as the log scale its cones are placed for; empty: one size.
+  // the smallest; interpolated over the faces. The global layout (lattices and threads) places its
+  // cones for it as a log scale; the local patches take each patch at its seed's size; the vine
+  // method refuses it. Empty: one size.
   Eigen::VectorXd size_map;
   static constexpr double kMaxSizeMapRange = 8;
   // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch

@@ -1582,8 +1582,8 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
                                   VineGrowthStats* vine_stats, ProgressSink* progress) {
   check_options(vo);
   MQ_CHECK(job.log_size.size() == 0, InvalidInput,
-           "a size map is followed by the global layout only (lattices of elements and "
-           "threads); vines grow at one size");
+           "a size map is followed by the global layout and the local patches; vines grow at "
+           "one size");
   StageTimes& times = stats.times;
   VineGrowthStats vs;
   const VineSwatch vine = analyse_vine_swatch(job, times);

@@ -132,10 +132,11 @@ TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
     EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
   }
   EXPECT_FALSE(fs::exists(dir + "/x.obj"));
-  // The local patches do not follow a size map: refused in one line.
-  const CliRun patches = meshquilt(dir, job + " --size-map sizes.txt --method patches -o x.obj");
-  EXPECT_EQ(patches.status, 1);
-  EXPECT_EQ(patches.err_lines().size(), 1u) << patches.err;
+  // Vines grow at one size: refused in one line.
+  const CliRun vines = meshquilt(dir, job + " --size-map sizes.txt --method vines -o x.obj");
+  EXPECT_EQ(vines.status, 1);
+  EXPECT_EQ(vines.err_lines().size(), 1u) << vines.err;
+  EXPECT_NE(vines.err.find("vines grow at one size"), std::string::npos) << vines.err;
   EXPECT_FALSE(fs::exists(dir + "/x.obj"));
 }
 

@@ -220,8 +220,8 @@ TEST(GlobalQuilting, SizeMapOutOfRangeIsRefused) {
   EXPECT_THROW(quilt_surface_global(base, swatch, o, cost), InvalidInput);
   o.size_map = Eigen::VectorXd::Ones(base.num_vertices() - 1);
   EXPECT_THROW(quilt_surface_global(base, swatch, o, cost), InvalidInput);
-  // The local patches do not follow a size map: refused rather than ignored.
-  o.size_map = Eigen::VectorXd::Ones(base.num_vertices());
+  // The local patches check it where it enters as well.
+  o.size_map(0) = 0.1;
   EXPECT_THROW(quilt_surface(base, swatch, o, cost), InvalidInput);
 }
 

@@ -6,12 +6,16 @@
 #include "core/common/errors.h"
 #include "core/mesh/closest_point_query.h"
 #include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/planar/swatch_generators.h"
 #include "core/planar/translation_cost.h"
+#include "core/shell/quilt_embedding.h"
+#include "core/structure/texture_structure.h"
 #include "core/surface/surface_quilting.h"
 #include "tests/core/planar_checks.h"
+#include "tests/core/shell_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -51,6 +55,87 @@ TEST(SurfaceQuilting, LocalCoordinatesMapBackToTheInputBase) {
   ASSERT_GT(quilt.base.num_faces(), 20 * base.num_faces());
   test::expect_same_points_on_coarse(
       quilt.base, base, 97, [&quilt](int& face, Vector3d& b) { to_input_base(quilt, face, b); });
+}
+
+// Apples quilted by the local patches on a sphere of radius 3, embedded by normal displacement
+// (the patches decide the sizes; the shell map is tested on its own): each element's size ratio
+// on the cap above z = 0.3 R (top) and the cap below -0.3 R (bottom), two caps of equal area.
+struct CapSizes {
+  std::vector<double> top, bottom;
+  double coverage = 0;
+  bool intersecting = false, within_shell = true;
+};
+
+CapSizes apples_on_caps(const Eigen::VectorXd& size_map) {
+  TriMesh base = test::icosphere(3);
+  base.V *= 3.0;
+  AppleOptions ao;
+  ao.count = 12;
+  ao.resolution = 8;
+  const TriMesh swatch = apple_layer(ao);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.2;
+  o.size_map = size_map;
+  TranslationCostCpu cost;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt quilt = quilt_surface(base, swatch, o, cost, &stats);
+  QuiltEmbeddingOptions e;
+  e.shell_map = false;
+  TetStretchCpu stretch;
+  QuiltEmbeddingStats es;
+  const TriMesh out = embed_quilt(quilt, e, stretch, &es);
+  CapSizes r;
+  r.coverage = es.coverage;
+  r.intersecting = !intersecting_face_pairs(out.V, out.F).empty();
+  for (const SurfaceElement& el : quilt.elements)
+    r.within_shell &= el.height.maxCoeff() <= quilt.shell_height * (1 + 1e-12);
+  const StructureSummary s = summarize_structure(out, swatch, &base, stats.swatch_scale);
+  for (const ElementStructure& el : s.output.elements) {
+    if (el.size_ratio <= 0) continue;
+    const double z = el.centre.z() / el.centre.norm();
+    if (z > 0.24) r.top.push_back(el.size_ratio);
+    if (z < -0.24) r.bottom.push_back(el.size_ratio);
+  }
+  return r;
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// A size map under the local patches (issue 25): each patch is flattened at its seed's size, so
+// the apples are half as large over the sphere's top as without the map, as large over its
+// bottom, four times as many there as at the bottom, whole and apart.
+TEST(SurfaceQuilting, SizeMapSizesThePatchesElements) {
+  const TriMesh base = test::icosphere(3);
+  // Half size above z = 0.3 R, whole below -0.3 R, a ramp between (the icosphere's unit radius).
+  Eigen::VectorXd map(base.num_vertices());
+  for (int v = 0; v < base.num_vertices(); ++v)
+    map(v) = 1.0 - 0.5 * std::clamp((base.V(v, 2) + 0.3) / 0.6, 0.0, 1.0);
+  const CapSizes plain = apples_on_caps(Eigen::VectorXd()), sized = apples_on_caps(map);
+  ASSERT_GT(plain.top.size(), 10u);
+  ASSERT_GT(sized.bottom.size(), 10u);
+  const double top = median_of(sized.top) / median_of(plain.top);
+  const double bottom = median_of(sized.bottom) / median_of(plain.bottom);
+  const double per_area =
+      static_cast<double>(sized.top.size()) / static_cast<double>(sized.bottom.size());
+  std::printf(
+      "[ measure  ] patches with a size map on a sphere: apples on the top / bottom cap %zu / "
+      "%zu (%zu / %zu without it); median size against the run without it: top %.3f (0.5 "
+      "wanted), bottom %.3f; %.1f%% covered\n",
+      sized.top.size(), sized.bottom.size(), plain.top.size(), plain.bottom.size(), top, bottom,
+      100 * sized.coverage);
+  // The swatch's apples vary by +-25% in size: medians within 15% of what the map asks.
+  EXPECT_NEAR(top / 0.5, 1.0, 0.15);
+  EXPECT_NEAR(bottom, 1.0, 0.15);
+  // Caps of equal area: half the size, four times the apples (within a third).
+  EXPECT_GT(per_area, 4.0 / 1.33);
+  EXPECT_LT(per_area, 4.0 * 1.33);
+  EXPECT_GE(sized.coverage, 0.9);
+  EXPECT_FALSE(sized.intersecting);
+  EXPECT_TRUE(sized.within_shell);
 }
 
 // A base far finer than the texture (issue 14) is simplified before quilting: a gently curved
