@@ -274,7 +274,8 @@ void declare_surface_options(CommandLine& cl) {
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
             "again on the base moved (posed, animated) without a new synthesis");
   cl.option("swatch-frames", "PATTERN",
-            "animate the result with the swatch (vines: ivy): frames of the swatch, the same mesh "
+            "animate the result with the swatch (vines: ivy; lattices: chain mail): frames of the "
+            "swatch, the same mesh "
             "with its vertices moved, named by a pattern with one frame number (%d or %0Nd; "
             "'meshquilt swatch ivy --frames N' makes some). Each output vertex moves as the point "
             "of the swatch it came from, in its own frame on the base; with --frames A-B, -o is a "
@@ -660,10 +661,16 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
   SurfaceOutcome o;
   SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
-  MQ_CHECK(r.frames.empty() || o.vines, InvalidInput,
-           "--swatch-frames: a swatch animation is followed by the vine method (a swatch of one "
-           "vine with leaves, like 'meshquilt swatch ivy') only; this swatch took the ",
-           o.global ? "global" : "patches", " method");
+  // Elements that are copies of swatch elements know their sources (issue 25): the vines' and the
+  // global layout's lattice; cut and stitched ones (patches, a quilted plane) and welded thread
+  // pieces do not.
+  const bool lattice = o.global && o.global_stats.tiled && !o.global_stats.threads;
+  MQ_CHECK(r.frames.empty() || o.vines || lattice, InvalidInput,
+           "--swatch-frames: a swatch animation is followed by the vine method (ivy) and the "
+           "global layout's lattice of separate elements (chain mail) only; this swatch took ",
+           o.global ? (o.global_stats.threads ? "the global layout's threads"
+                                              : "the global layout's plane quilt")
+                    : "the local patches");
   if (cl.has("mask")) {
     r.embedding.coverage_faces = mask_quilt_faces(in.mask, in.base, quilt);
     drop_unmasked_elements(quilt, r.embedding.coverage_faces);

@@ -42,24 +42,21 @@ void check_swatch_frame(const TriMesh& swatch, const TriMesh& frame, const std::
 SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double scale,
                            const std::string& name) {
   check_swatch_frame(swatch, frame, name);
-  const PreparedSwatch rest = prepared_at(swatch, scale), moved = prepared_at(frame, scale);
-  // Each frame is prepared as the swatch is (its elements and their vertices in the same order,
-  // by connectivity), then taken into the swatch's synthesis frame: prepare_swatch's rotation
-  // (an axis permutation) and translation depend on the frame's bounding box.
+  // The motion in the swatch's own axes, exactly zero where a vertex did not move (a frame equal
+  // to the swatch moves nothing, bit for bit: frame 0 of a sequence is the static output), taken
+  // into the synthesis frame's axes (prepare_swatch's rotation, an axis permutation: exact) and
+  // split into elements as prepare_swatch splits the swatch (by connectivity, which the frame
+  // shares). Not the difference of the two prepared swatches: each is translated by its own
+  // bounding box, so a frame that moves every vertex alike (a layer lifted) would move none.
+  const Eigen::Matrix3d rotation = prepared_at(swatch, scale).rotation;
+  TriMesh motion = swatch;
+  motion.V = ((frame.V - swatch.V) * scale * rotation.transpose()).eval();
+  remove_unreferenced_vertices(motion);
+  std::vector<int> fc;
+  const int n = connected_components(motion.F, motion.num_vertices(), fc);
   SwatchMotion out;
-  out.displacement.resize(rest.elements.size());
-  for (size_t e = 0; e < rest.elements.size(); ++e) {
-    const MatrixX3d input =
-        (moved.elements[e].V.rowwise() - moved.translation.transpose()) * moved.rotation;
-    MatrixX3d in_rest = input * rest.rotation.transpose();
-    in_rest.rowwise() += rest.translation.transpose();
-    out.displacement[e] = in_rest - rest.elements[e].V;
-    // A frame equal to the swatch moves nothing, bit for bit (frame 0 of a sequence is the
-    // static output).
-    for (Eigen::Index v = 0; v < input.rows(); ++v)
-      if (moved.elements[e].V.row(v) == rest.elements[e].V.row(v))
-        out.displacement[e].row(v).setZero();
-  }
+  for (const std::vector<int>& faces : component_faces(fc, n))
+    out.displacement.push_back(extract_faces(motion, faces).V);
   return out;
 }
 
@@ -109,8 +106,9 @@ MatrixX3d SwatchAnimation::gather_sources(const SurfaceQuilt& quilt, const std::
     MQ_CHECK(e.source.rows() == n && e.source_element >= 0 &&
                  e.source_element < static_cast<int>(prepared.elements.size()),
              InvalidInput,
-             "a swatch animation is followed by the vine method (ivy) only: this result's "
-             "elements do not say where in the swatch they come from");
+             "a swatch animation is followed by the vine method (ivy) and the global layout's "
+             "lattice (chain mail) only: this result's elements do not say where in the swatch "
+             "they come from");
     MQ_CHECK(v0 + n <= nv, InternalError,
              "swatch animation: the output is smaller than its elements");
     source.middleRows(v0, n) = e.source;

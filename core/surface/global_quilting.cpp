@@ -635,6 +635,12 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
       ok[static_cast<size_t>(i)] = place_lattice_copy(gp, job, P, centre, c.face, differential,
                                                       swatch.size.z(), options.global, s, by_copy);
       copied[static_cast<size_t>(i)] = by_copy;
+      // A copy of the swatch element vertex for vertex: each vertex's source is its own place
+      // there (issue 25, swatch animation).
+      if (options.keep_sources) {
+        s.source_element = tiling.reps[c.rep];
+        s.source = e.V;
+      }
     });
   }
   std::vector<SurfaceElement> placed;

@@ -45,7 +45,8 @@ struct SurfaceElement {
   // animation; core/shell/swatch_animation): a point on the prepared swatch's element
   // `source_element` (the swatch scaled to the output, in its synthesis frame), or beyond it
   // along SurfaceQuilt::repeat for the element repeated so. Kept with
-  // SurfaceQuiltingOptions::keep_sources, by the vine method.
+  // SurfaceQuiltingOptions::keep_sources, by the vine method and the global layout's lattice
+  // (each copy's vertices are its swatch element's).
   int source_element = -1;
   MatrixX3d source;
 };
@@ -98,7 +99,8 @@ struct SurfaceQuiltingOptions {
   Eigen::VectorXd size_map;
   static constexpr double kMaxSizeMapRange = 8;
   // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch
-  // animation (issue 25); followed by the vine method only.
+  // animation (issue 25); followed by the vine method and the global layout's lattice (not by
+  // its threads or plane quilt, nor by the local patches, whose elements are cut and stitched).
   bool keep_sources = false;
   // Where long elements may lie (issue 25, `--mask`): per face of the refined base it is
   // handed, whether that face is in; empty: everywhere. The vine method's stems stop at the

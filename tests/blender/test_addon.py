@@ -1246,11 +1246,12 @@ def test_swatch_motion_follows_an_animated_swatch_object():
     check(moved[vine].max() < 1e-5, "the vine moved %g" % moved[vine].max())
     check(np.linalg.norm(frames[2] - frames[0], axis=1).max() < moved.max(),
           "frame 3 moved as far as frame 5")
-    # A swatch the engine lays out as a lattice (chain mail) is refused in the panel's words.
-    mail_path = os.path.join(WORK, "mail_motion.ply")
-    check(engine.swatch_job(ENGINE, "chainmail", mail_path).wait(60) == "done", "no chain mail")
-    mail = bpy.data.objects.new("Mail", exchange.build_mesh(
-        bpy, "Mail", exchange.read_ply(mail_path), meshquilt.material_for))
+    # A swatch the engine lays out as threads (the weave: pieces welded into threads keep no
+    # place in the swatch) is refused in the panel's words.
+    mail_path = os.path.join(WORK, "weave_motion.ply")
+    check(engine.swatch_job(ENGINE, "weave", mail_path).wait(60) == "done", "no weave")
+    mail = bpy.data.objects.new("Weave", exchange.build_mesh(
+        bpy, "Weave", exchange.read_ply(mail_path), meshquilt.material_for))
     scene.collection.objects.link(mail)
     mail.shape_key_add(name="Basis", from_mix=False)
     mail.shape_key_add(name="up", from_mix=False).data[0].co.z += 0.1
@@ -1265,7 +1266,7 @@ def test_swatch_motion_follows_an_animated_swatch_object():
             check(time.monotonic() - start < 120, "no answer within 120 s")
             time.sleep(0.05)
         check(run.state == "failed" and "Swatch motion follows a vine with leaves" in run.error
-              and "Mail" in run.error, "%s: %s" % (run.state, run.error))
+              and "Weave" in run.error, "%s: %s" % (run.state, run.error))
     finally:
         run.cleanup()
     s.swatch_motion = False
@@ -1324,8 +1325,17 @@ def test_a_vertex_group_sets_the_element_size():
           % (low, low_plain, high, high_plain), flush=True)
     check(low > 2.5 * low_plain, "%d elements below the cap, %d at one size" % (low, low_plain))
     check(high < 2.0 * max(high_plain, 1), "%d on the cap, %d at one size" % (high, high_plain))
-    # A swatch the size map does not apply to: said in the panel's terms.
+    # Apples (the local patches) follow the group too: smaller below the cap.
     s.sample = "apples"
+    check(bpy.ops.meshquilt.run() == {"FINISHED"}, "sized apples did not finish")
+    apples = element_heights(base)
+    print("[blender]   size group, apples: %d elements below, %d on the cap"
+          % (np.sum(apples < -0.2), np.sum(apples > 0.2)), flush=True)
+    # Below z -0.2 and above 0.2 are caps of equal area: half the size, about four times the
+    # apples (twice asked, for the apples' own spread of sizes).
+    check(np.sum(apples < -0.2) > 2 * np.sum(apples > 0.2), "apples: too few below the cap")
+    # A swatch the size map does not apply to (vines): said in the panel's terms.
+    s.sample = "ivy"
     message = reported(bpy.ops.meshquilt.run)
     check("clear Size" in message, message)
     s.size_group = ""

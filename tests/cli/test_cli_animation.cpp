@@ -1,8 +1,11 @@
 // Swatch animation from the command line (issue 25 item 5): `swatch ivy --frames N` writes a
 // looping wind, `surface --swatch-frames P --frames A-B` one output per frame, frame 0 the static
-// output byte for byte; missing or mismatched frames, and swatches whose method keeps no sources,
-// fail in one line before anything is written.
+// output byte for byte; chain mail (the global layout's lattice) follows its swatch's frames too;
+// missing or mismatched frames, and swatches whose method keeps no sources, fail in one line
+// before anything is written.
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_io.h"
@@ -42,6 +45,59 @@ TEST(CliAnimation, IvyFramesFollowTheSwatchAndFrameZeroIsTheStaticOutput) {
   }
 }
 
+// The global layout's lattice keeps its sources (each ring a copy of its swatch ring), so chain
+// mail follows a swatch frame that lifts the whole layer by a fifth of its thickness and shifts it
+// by a twentieth: on a plane every vertex by one vector, of that length at the output's scale; on
+// an open cylinder along the surface's own normal there; nothing meets in either.
+TEST(CliAnimation, ChainMailFollowsALiftedLayer) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(meshquilt(dir, "swatch chainmail --rows 4 --cols 4 -o mail.obj --quiet").status, 0);
+  TriMesh lifted = read_mesh(dir + "/mail.obj");
+  const double H = lifted.V.col(2).maxCoeff() - lifted.V.col(2).minCoeff();
+  lifted.V.col(0).array() += 0.05 * H;
+  lifted.V.col(2).array() += 0.2 * H;
+  write_mesh(dir + "/mail_1.obj", lifted);
+  fs::copy_file(dir + "/mail.obj", dir + "/mail_0.obj");
+  const double lift = std::hypot(0.05, 0.2);  // of the layer's thickness
+  write_mesh(dir + "/plane.obj", test::plane_grid(2, 1.5, 20, 15));
+  write_mesh(dir + "/tube.obj", test::open_cylinder(0.5, 2, 48, 24));
+  for (const std::string base : {"plane", "tube"}) {
+    SCOPED_TRACE(base);
+    const CliRun run =
+        meshquilt(dir, "surface --base " + base + ".obj --swatch mail.obj --scale " +
+                           (base == "plane" ? "0.3" : "0.25") +
+                           " --swatch-frames 'mail_%d.obj' --frames 0-1 -o '" + base + "_%d.obj'");
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("0 elements move at half their motion and 0 stay still"),
+              std::string::npos)
+        << run.out;
+    const TriMesh rest = read_mesh(dir + "/" + base + "_0.obj"),
+                  moved = read_mesh(dir + "/" + base + "_1.obj");
+    ASSERT_TRUE(moved.F == rest.F);
+    ASSERT_GT(rest.num_vertices(), 10'000);
+    const double shell = std::stod(run.out.substr(run.out.find("shell height ") + 13));
+    const MatrixX3d d = moved.V - rest.V;
+    int along_normal = 0;
+    for (int v = 0; v < rest.num_vertices(); ++v) {
+      // Within the printed shell height's 4 digits; the OBJ's 9 digits for one vector.
+      ASSERT_NEAR(d.row(v).norm(), lift * shell, 1e-3 * shell) << v;
+      if (base == "plane") {
+        ASSERT_LT((d.row(v) - d.row(0)).norm(), 1e-6 * shell) << v;
+        continue;
+      }
+      // The tube's normal at the vertex: radial, away from its axis (z).
+      const Vector3d radial = Vector3d(rest.V(v, 0), rest.V(v, 1), 0).normalized();
+      along_normal += d.row(v).dot(radial) > 0.9 * 0.2 * shell;
+    }
+    if (base == "plane") {
+      EXPECT_NEAR(d(0, 2), 0.2 * shell, 1e-3 * shell);
+    } else {
+      EXPECT_GT(along_normal, 0.95 * rest.num_vertices());
+    }
+    EXPECT_TRUE(intersecting_face_pairs(moved.V, moved.F).empty());
+  }
+}
+
 TEST(CliAnimation, BadFramesAndMethodsAreRefusedBeforeAnyWork) {
   const std::string dir = test::temp_dir();
   ASSERT_EQ(meshquilt(dir, std::string(kIvy) + " -o sw.obj").status, 0);
@@ -70,14 +126,15 @@ TEST(CliAnimation, BadFramesAndMethodsAreRefusedBeforeAnyWork) {
     EXPECT_EQ(r.status, c.status) << c.args << ": " << r.err;
     EXPECT_EQ(r.err_lines().size(), 1u) << c.args << ": " << r.err;
   }
-  // The chain mail's rings keep no sources (the global layout): refused in one line.
+  // The local patches cut and stitch elements, which so keep no sources: refused in one line.
   fs::copy_file(dir + "/mail.obj", dir + "/mail_0.obj");
-  const CliRun mail =
-      meshquilt(dir,
-                "surface --base base.obj --swatch mail.obj --scale 0.2 --quiet --swatch-frames "
-                "'mail_%d.obj' --frames 0-0 -o 'x_%d.ply'");
+  const CliRun mail = meshquilt(dir,
+                                "surface --base base.obj --swatch mail.obj --scale 0.2 --quiet "
+                                "--method patches --swatch-frames 'mail_%d.obj' --frames 0-0 -o "
+                                "'x_%d.ply'");
   EXPECT_EQ(mail.status, 1) << mail.err;
   EXPECT_EQ(mail.err_lines().size(), 1u) << mail.err;
+  EXPECT_NE(mail.err.find("the local patches"), std::string::npos) << mail.err;
   for (const char* name : {"x_0.ply", "x_1.ply", "x.ply"})
     EXPECT_FALSE(fs::exists(dir + "/" + name));
   // Only the ivy has a wind.

@@ -181,7 +181,8 @@ TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
   TriMesh nan = swatch;
   nan.V(3, 1) = std::nan("");
   EXPECT_THROW(swatch_motion(swatch, nan, 1.0, "f"), InvalidInput);
-  // A chain mail quilt keeps no sources: its elements are rigid rings.
+  // Chain mail by the local patches keeps no sources (its elements are cut and stitched); by
+  // the global layout's lattice it does (each ring a copy of its swatch ring).
   ChainMailOptions mail;
   mail.rows = mail.cols = 4;
   const TriMesh rings = chainmail_4in1(mail);
@@ -189,12 +190,15 @@ TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
   o.scale = 0.3;
   o.keep_sources = true;
   TranslationCostCpu cpu;
-  SurfaceQuiltingStats stats;
-  const SurfaceQuilt q =
-      quilt_surface_global(test::plane_grid(2, 1.5, 20, 15), rings, o, cpu, &stats);
-  QuiltEmbeddingStats e;
+  SurfaceQuiltingStats stats, global_stats;
+  const TriMesh plane = test::plane_grid(2, 1.5, 20, 15);
+  const SurfaceQuilt q = quilt_surface(plane, rings, o, cpu, &stats);
+  const SurfaceQuilt g = quilt_surface_global(plane, rings, o, cpu, &global_stats);
+  QuiltEmbeddingStats e, ge;
   TetStretchCpu stretch;
   const TriMesh rest = embed_quilt(q, {}, stretch, &e);
+  const TriMesh global_rest = embed_quilt(g, {}, stretch, &ge);
+  EXPECT_NO_THROW(SwatchAnimation(g, ge.kept, global_rest, rings, global_stats.swatch_scale));
   EXPECT_THROW(SwatchAnimation(q, e.kept, rest, rings, stats.swatch_scale), InvalidInput);
 }
 
