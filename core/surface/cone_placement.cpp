@@ -68,7 +68,7 @@ void move_cones(const TrivialConnection& solver, const Adjacency& adj,
       ++moved;
     }
     if (moved == 0) break;
-    const Eigen::VectorXd u_next = solver.log_scale(next);
+    const Eigen::VectorXd u_next = solver.log_scale(next, options.target);
     const double e_next = scale_energy(solver, u_next, options.target);
     ++rep.rounds;
     if (e_next < energy) {
@@ -145,7 +145,7 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
       ++rep.split_poles;
     }
   }
-  Eigen::VectorXd u = solver.log_scale(index);
+  Eigen::VectorXd u = solver.log_scale(index, options.target);
   double energy = scale_energy(solver, u, options.target);
   rep.energy_before = energy;
   move_cones(solver, adj, options, index, u, energy, stamp, mark, rep);

@@ -1031,7 +1031,8 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
   gstats.cone_moves = report.moves;
   gstats.scale_energy_before = report.energy_before;
   gstats.scale_energy = report.energy_after;
-  const ConeMetric metric = connection.solve(cones, job.field);
+  // On a boundary the metric's scale is free: held to the size map's there (0 without one).
+  const ConeMetric metric = connection.solve(cones, job.field, placement.target);
   df = metric.field;
   // A metric that scales the surface unevenly (e^u, log-normal with variance E) is followed
   // only partly, e^(a u): normalised to keep the typical element's size, the lattice fills the

@@ -327,7 +327,25 @@ Eigen::VectorXd TrivialConnection::solve_poisson(const Eigen::VectorXd& rhs) con
   return u;
 }
 
-Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index) const {
+Eigen::VectorXd TrivialConnection::boundary_rotation(const Eigen::VectorXd& boundary) const {
+  const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(topo_.num_edges());
+  if (boundary.size() == 0) return y;
+  MQ_CHECK(boundary.size() == nv && boundary.allFinite(), InvalidInput,
+           "trivial connection: ", boundary.size(), " boundary values for ", nv,
+           " vertices, or not finite");
+  for (int f = 0; f < nf; ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int v = F_(f, c);
+      if (interior_[v]) continue;
+      const int e = topo_.FE(f, (c + 2) % 3);
+      y(e) += crossing_sign(topo_, e, f) * boundary(v);
+    }
+  return weight_.cwiseProduct(y);
+}
+
+Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index,
+                                             const Eigen::VectorXd& boundary) const {
   const int nv = static_cast<int>(V_.rows());
   MQ_CHECK(static_cast<int>(index.size()) == nv, InvalidInput, "trivial connection: ", index.size(),
            " indices for ", nv, " vertices");
@@ -340,17 +358,25 @@ Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index) cons
   const double unit = kTwoPi / N_;
   for (int v = 0; v < nv; ++v)
     rhs(v) = interior_[v] ? index[static_cast<size_t>(v)] * unit - K_(v) : 0.0;
-  return solve_poisson(rhs);
+  if (boundary.size() == 0) return solve_poisson(rhs);
+  // The known boundary values moved to the right-hand side: (-Delta)_II u_I = b - A_I W A_B^T u_B.
+  const Eigen::VectorXd coupling = A_.topRows(vertex_rows_) * boundary_rotation(boundary);
+  for (int v = 0; v < nv; ++v)
+    if (row_of_vertex_[v] >= 0) rhs(v) -= coupling(row_of_vertex_[v]);
+  Eigen::VectorXd u = solve_poisson(rhs);
+  for (int v = 0; v < nv; ++v)
+    if (!interior_[v]) u(v) = boundary(v);
+  return u;
 }
 
-ConeMetric TrivialConnection::solve(const std::vector<int>& index,
-                                    const MatrixX3d& guidance) const {
+ConeMetric TrivialConnection::solve(const std::vector<int>& index, const MatrixX3d& guidance,
+                                    const Eigen::VectorXd& boundary) const {
   const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
   const int ne = topo_.num_edges();
   MQ_CHECK(guidance.rows() == nf, InvalidInput, "trivial connection: ", guidance.rows(),
            " guidance vectors for ", nf, " faces");
   ConeMetric out;
-  out.u = log_scale(index);
+  out.u = log_scale(index, boundary);
   const double unit = kTwoPi / N_;
   // Minimal rotation (in the cotangent-weighted norm) with the prescribed holonomy around every
   // interior vertex and generator: x = W A^T (A W A^T)^-1 b.
@@ -361,10 +387,14 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index,
     const double h = generator_holonomy_[g];
     b(vertex_rows_ + static_cast<int>(g)) = unit * std::round(h / unit) - h;
   }
+  // With boundary values, x = W A^T lambda + y, y their own rotation: A x = b still holds.
+  const Eigen::VectorXd y = boundary_rotation(boundary);
+  if (boundary.size()) b -= A_ * y;
   const Eigen::VectorXd lambda = augmented_.solve(b);
   MQ_CHECK(augmented_.info() == Eigen::Success && lambda.allFinite(), SolverFailure,
            "trivial connection: the generator solve failed");
   out.rotation = weight_.cwiseProduct(A_.transpose() * lambda);
+  if (boundary.size()) out.rotation += y;
 
   // The field: parallel along a dual spanning tree for transport + rotation, which by the
   // holonomy constraints makes it parallel across every interior edge up to whole turns.

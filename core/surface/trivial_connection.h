@@ -62,18 +62,24 @@ class TrivialConnection {
   // Returns the first closed component where it is not, or -1.
   int unbalanced_component(const std::vector<int>& index) const;
 
-  // u for the given indices (ConeMetric::u): one back-substitution.
+  // u for the given indices (ConeMetric::u): one back-substitution. boundary (#V, or empty: 0)
+  // gives u at the vertices that are not interior (a flat metric leaves them free; issue 25: a
+  // size map's log scale, which u held to 0 there could follow only through cones, on an open
+  // plane not at all); entries at interior vertices are ignored.
   // Throws InvalidInput for a size mismatch or unbalanced indices.
-  Eigen::VectorXd log_scale(const std::vector<int>& index) const;
+  Eigen::VectorXd log_scale(const std::vector<int>& index,
+                            const Eigen::VectorXd& boundary = Eigen::VectorXd()) const;
 
   // The Laplacian's inverse applied to a right-hand side per vertex (rows of boundary vertices
   // ignored; result 0 there; mean zero on closed components): for the gradient of a distortion
   // energy with respect to moving cones.
   Eigen::VectorXd solve_poisson(const Eigen::VectorXd& rhs) const;
 
-  // The metric and the field for the given indices; guidance #F by 3 (zero rows ignored).
+  // The metric and the field for the given indices; guidance #F by 3 (zero rows ignored);
+  // boundary as for log_scale (the rotation is then the metric's with those values).
   // Throws InvalidInput for sizes that do not match or unbalanced indices; SolverFailure.
-  ConeMetric solve(const std::vector<int>& index, const MatrixX3d& guidance) const;
+  ConeMetric solve(const std::vector<int>& index, const MatrixX3d& guidance,
+                   const Eigen::VectorXd& boundary = Eigen::VectorXd()) const;
 
  private:
   // The constructor's steps, in order.
@@ -85,6 +91,9 @@ class TrivialConnection {
   int add_generator_rows(const std::vector<char>& in_tree,
                          std::vector<Eigen::Triplet<double>>& t);  // returns all rows
   void factorise(const std::vector<Eigen::Triplet<double>>& t, int rows);
+  // #E: W A_B^T u_B, the rotation the boundary values alone give (A_B the signed incidence of the
+  // vertices that are not interior, built as the vertex rows'). Empty boundary: zero.
+  Eigen::VectorXd boundary_rotation(const Eigen::VectorXd& boundary) const;
 
   MatrixX3d V_;
   MatrixX3i F_;

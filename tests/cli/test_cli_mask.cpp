@@ -105,13 +105,14 @@ TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
     sizes += std::to_string(1.0 - 0.5 * std::clamp((grid.V(v, 0) - 4) / 2, 0.0, 1.0)) + "\n";
   spit(dir + "/sizes.txt", sizes);
   const std::string job =
-      "surface --base grid.obj --swatch sw.obj --field 1 0 0 --scale 0.07 --quiet";
+      "surface --base grid.obj --swatch sw.obj --field 1 0 0 --scale 0.1 --quiet";
   const CliRun plain = meshquilt(dir, job + " -o p.obj");
   ASSERT_EQ(plain.status, 0) << plain.err;
   const CliRun m = meshquilt(dir, job + " --size-map sizes.txt -o m.obj --stats m.json");
   ASSERT_EQ(m.status, 0) << m.err;
   const TriMesh a = read_mesh(dir + "/p.obj"), b = read_mesh(dir + "/m.obj");
-  // The right half holds four times the rings: about 2.5 times the faces in all.
+  // Where half the size is asked, four times the rings: about 2.4 times the faces in all
+  // (measured 2.29; the map followed on this open sheet through its boundary values).
   const double ratio = static_cast<double>(b.num_faces()) / a.num_faces();
   EXPECT_GT(ratio, 2.0);
   EXPECT_LT(ratio, 3.0);
