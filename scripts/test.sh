@@ -79,7 +79,7 @@ if [ "${MESHQUILT_SKIP_SANITIZE:-0}" != 1 ]; then
   slow_under_asan+='|LeavesOrAll/SwatchAnimationSway.IvyOnAPlaneMovesWithItsSwatch/0$'
   slow_under_asan+='|CliAnimation.IvyFramesFollowTheSwatchAndFrameZeroIsTheStaticOutput'
   slow_under_asan+='|CliAnimation.ChainMailFollowsALiftedLayer'
-  slow_under_asan+='|GlobalQuilting.SizeMapVariesTheRingsSmoothly'
+  slow_under_asan+='|GlobalQuilting.SizeMapVariesTheRingsSmoothly|GlobalQuilting.SizeMapOnAnOpenSheet'
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j"$jobs" -E "$slow_under_asan"
   stage "sanitizer tests"
