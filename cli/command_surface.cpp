@@ -1,4 +1,5 @@
 // meshquilt surface: mesh quilting over a base mesh (paper section 3.1).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -661,11 +662,13 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
   SurfaceOutcome o;
   SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
-  // Elements that are copies of swatch elements know their sources (issue 25): the vines' and the
-  // global layout's lattice; cut and stitched ones (patches, a quilted plane) and welded thread
-  // pieces do not.
-  const bool lattice = o.global && o.global_stats.tiled && !o.global_stats.threads;
-  MQ_CHECK(r.frames.empty() || o.vines || lattice, InvalidInput,
+  // Only elements that are copies of swatch elements know their sources (issue 25; the layouts
+  // that keep them say so, SurfaceQuiltingOptions::keep_sources): refused before the embedding.
+  const bool sourced =
+      std::all_of(quilt.elements.begin(), quilt.elements.end(), [](const SurfaceElement& e) {
+        return e.source.rows() == static_cast<Eigen::Index>(e.face.size());
+      });
+  MQ_CHECK(r.frames.empty() || sourced, InvalidInput,
            "--swatch-frames: a swatch animation is followed by the vine method (ivy) and the "
            "global layout's lattice of separate elements (chain mail) only; this swatch took ",
            o.global ? (o.global_stats.threads ? "the global layout's threads"

@@ -1,9 +1,11 @@
 // Shared helpers for the test programs: data paths and small procedural fixtures.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "core/mesh/mesh.h"
 
@@ -15,6 +17,13 @@ inline double uniform01(std::mt19937_64& rng) {
 }
 inline double uniform(std::mt19937_64& rng, double lo, double hi) {
   return lo + (hi - lo) * uniform01(rng);
+}
+
+// The upper median of v (its element at index size / 2 once sorted; 0 when v is empty).
+inline double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
 }
 
 // Absolute path of a file in ../shared/data (e.g. "base/bunny_igl_7k.off").

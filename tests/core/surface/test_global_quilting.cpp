@@ -184,22 +184,18 @@ TEST(GlobalQuilting, SizeMapVariesTheRingsSmoothly) {
     const double w = wanted(e.centre.z() / e.centre.norm() * 3.0);
     (w < 0.55 ? small : w > 0.95 ? full : ramp).push_back(e.size_ratio / w);
   }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
   ASSERT_GT(small.size(), 100u);
   ASSERT_GT(full.size(), 30u);
   ASSERT_GT(ramp.size(), 50u);
   std::printf(
       "[ measure  ] size map on a sphere: %d rings (%.2f%% with 4 links); size against the "
       "wanted: top (0.5) %.3f, ramp %.3f, bottom (1) %.3f; scale energy %.3f -> %.3f\n",
-      s.rings, 100 * c.share_matching, median(small), median(ramp), median(full),
+      s.rings, 100 * c.share_matching, test::median(small), test::median(ramp), test::median(full),
       r.global.scale_energy_before, r.global.scale_energy);
   // The swatch is at the largest size: the top's rings are half of it, the bottom's whole.
-  EXPECT_NEAR(median(small), 1.0, 0.1);
-  EXPECT_NEAR(median(full), 1.0, 0.15);
-  EXPECT_NEAR(median(ramp), 1.0, 0.2);
+  EXPECT_NEAR(test::median(small), 1.0, 0.1);
+  EXPECT_NEAR(test::median(full), 1.0, 0.15);
+  EXPECT_NEAR(test::median(ramp), 1.0, 0.2);
   EXPECT_GE(c.share_matching, 0.9);
   EXPECT_TRUE(intersecting_face_pairs(r.output.V, r.output.F).empty());
   EXPECT_GE(r.embedding.coverage, 0.95);
@@ -226,17 +222,13 @@ TEST(GlobalQuilting, SizeMapOnAnOpenSheet) {
   }
   ASSERT_GT(full.size(), 50u);
   ASSERT_GT(half.size(), 200u);
-  const auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
   const StructureComparison& c = r.structure.comparison;
   std::printf(
       "[ measure  ] size map on an open sheet: %d rings (%.2f%% with 4 links); median size "
       "%.3f where 1 is asked, %.3f where 0.5\n",
-      r.structure.output.rings, 100 * c.share_matching, median(full), median(half));
-  EXPECT_NEAR(median(full), 1.0, 0.12);
-  EXPECT_NEAR(median(half), 0.5, 0.06);
+      r.structure.output.rings, 100 * c.share_matching, test::median(full), test::median(half));
+  EXPECT_NEAR(test::median(full), 1.0, 0.12);
+  EXPECT_NEAR(test::median(half), 0.5, 0.06);
   EXPECT_GE(c.share_matching, 0.95);
   EXPECT_GE(r.embedding.coverage, 0.95);
   EXPECT_TRUE(intersecting_face_pairs(r.output.V, r.output.F).empty());

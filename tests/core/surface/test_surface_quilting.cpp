@@ -101,12 +101,6 @@ CapSizes apples_on_caps(const Eigen::VectorXd& size_map) {
   return r;
 }
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 // A size map under the local patches (issue 25): each patch is flattened at its seed's size, so
 // the apples over the sphere's top are half the size of those over its bottom (without the map
 // the same), and four times as many there, whole and apart.
@@ -119,8 +113,8 @@ TEST(SurfaceQuilting, SizeMapSizesThePatchesElements) {
   const CapSizes plain = apples_on_caps(Eigen::VectorXd()), sized = apples_on_caps(map);
   ASSERT_GT(plain.top.size(), 10u);
   ASSERT_GT(sized.bottom.size(), 10u);
-  const double sized_ratio = median_of(sized.top) / median_of(sized.bottom);
-  const double plain_ratio = median_of(plain.top) / median_of(plain.bottom);
+  const double sized_ratio = test::median(sized.top) / test::median(sized.bottom);
+  const double plain_ratio = test::median(plain.top) / test::median(plain.bottom);
   const double per_area =
       static_cast<double>(sized.top.size()) / static_cast<double>(sized.bottom.size());
   std::printf(
