@@ -225,8 +225,8 @@ void declare_surface_options(CommandLine& cl) {
             "vertices lie); coverage is judged over the mask");
   cl.option("size-map", "FILE",
             "vary the element size: one factor per base vertex (1: the size --scale or "
-            "--element-size sets; the largest at most 8 times the smallest), followed by the "
-            "global layout and the local patches (not by vines)");
+            "--element-size sets; the largest at most 8 times the smallest), followed by every "
+            "method (a swatch animation moves each element at its size)");
   cl.option("field", "X Y Z", "guidance: a constant world direction projected on the surface", "",
             3);
   cl.option("field-file", "FILE", "guidance: one 'x y z' vector per base vertex");

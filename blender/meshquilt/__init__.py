@@ -103,8 +103,8 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     size_group: bpy.props.StringProperty(
         name="Size", default="",
         description="A vertex group of the base: elements at the full size where its weight is "
-        "1, at Smallest where it is 0 (or the vertex is not in it); every sample but the Ivy "
-        "(empty: one size)")
+        "1, at Smallest where it is 0 (or the vertex is not in it); every sample (empty: one "
+        "size)")
     smallest_size: bpy.props.FloatProperty(
         name="Smallest", default=0.5, min=0.125, max=1.0, subtype="FACTOR",
         description="The element size where the Size group's weight is 0, as a share of the "

@@ -430,9 +430,6 @@ def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch"
             cause = "the elements are too large for its parts"
         return ("meshquilt: %s only %.0f%% of %s would be covered (%.0f%% needed): %s; %s; "
                 "nothing was added" % (at, got, base, needed, cause, smaller))
-    if text.startswith("a size map is followed by the global layout and the local patches"):
-        return ("meshquilt: the Size group varies every swatch but vines (like the Ivy "
-                "sample), and %s grows as vines: clear Size in the panel" % swatch)
     if text.startswith("--swatch-frames: a swatch animation is followed by the vine method"):
         return ("meshquilt: Swatch motion follows a vine with leaves (like the Ivy sample) or "
                 "a lattice of separate elements (like Chain mail) only, and %s is laid out "

@@ -62,7 +62,7 @@ SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double s
 
 SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<int>& kept,
                                  const TriMesh& rest, const TriMesh& swatch, double scale)
-    : rest_(rest) {
+    : rest_(rest), sized_(quilt.sized) {
   const PreparedSwatch prepared = prepared_at(swatch, scale);
   for (const Element& e : prepared.elements) element_faces_.push_back(e.F);
   const MatrixX3d source = gather_sources(quilt, kept, prepared);
@@ -167,9 +167,14 @@ void SwatchAnimation::fit_frame(const MatrixX3d& source, const MatrixX3d& out, E
   const Vector3d p = source.middleRows(v0, n).colwise().mean().transpose();
   const Vector3d q = out.middleRows(v0, n).colwise().mean().transpose();
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (Eigen::Index v = v0; v < v0 + n; ++v)
-    cov += (out.row(v).transpose() - q) * (source.row(v).transpose() - p).transpose();
-  const Eigen::Matrix3f R = nearest_rotation(cov).cast<float>();
+  double spread_out = 0, spread_source = 0;
+  for (Eigen::Index v = v0; v < v0 + n; ++v) {
+    const Vector3d a = source.row(v).transpose() - p, b = out.row(v).transpose() - q;
+    cov += b * a.transpose();
+    spread_out += b.squaredNorm(), spread_source += a.squaredNorm();
+  }
+  const Eigen::Matrix3f R =
+      (nearest_rotation(cov) * size_ratio(spread_out, spread_source)).cast<float>();
   for (Eigen::Index v = v0; v < v0 + n; ++v) rotation_[static_cast<size_t>(v)] = R;
 }
 
@@ -193,6 +198,7 @@ void SwatchAnimation::fit_frames(const MatrixX3d& source, const MatrixX3d& out, 
     const Vector3d p = source.row(v).transpose(), q = out.row(v).transpose();
     const Cell c = cell_of(v);
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    double spread_out = 0, spread_source = 0;
     for (std::int64_t dx = -1; dx <= 1; ++dx)
       for (std::int64_t dy = -1; dy <= 1; ++dy)
         for (std::int64_t dz = -1; dz <= 1; ++dz) {
@@ -205,10 +211,13 @@ void SwatchAnimation::fit_frames(const MatrixX3d& source, const MatrixX3d& out, 
             if (d2 >= r2) continue;
             // Nearer points weigh more, fading to none at the reach.
             const double w = (1 - d2 / r2) * (1 - d2 / r2);
-            cov += w * (out.row(it->second).transpose() - q) * a.transpose();
+            const Vector3d b = out.row(it->second).transpose() - q;
+            cov += w * b * a.transpose();
+            spread_out += w * b.squaredNorm(), spread_source += w * d2;
           }
         }
-    rotation_[static_cast<size_t>(v)] = nearest_rotation(cov).cast<float>();
+    rotation_[static_cast<size_t>(v)] =
+        (nearest_rotation(cov) * size_ratio(spread_out, spread_source)).cast<float>();
   }
 }
 

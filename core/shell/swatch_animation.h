@@ -5,11 +5,13 @@
 // vertex; on a stem, the swatch vine's cross-section at the same place along one swatch vine
 // length, corrected to be continuous where lengths meet), turned from the swatch's frame
 // into the output's where the vertex lies: the rotation that best fits the points around it in the
-// swatch onto the same points in the output (Kabsch). A leaf takes one such turn for all of it (it
+// swatch onto the same points in the output (Kabsch); under a size map scaled by their spread's
+// ratio too. A leaf takes one such turn for all of it (it
 // moves as one, also where the surface bent it), a stem one per cross-section, so that it sways
 // about its own course over the surface.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -74,6 +76,11 @@ class SwatchAnimation {
   MatrixX3d cross_sections(const SwatchMotion& motion) const;
   Vector3d displacement(const SwatchMotion& motion, const MatrixX3d& sections, size_t v) const;
   MatrixX3d positions(const SwatchMotion& motion, const std::vector<double>& amplitude) const;
+  // The size of points in the output against theirs in the swatch from their weighted squared
+  // spreads: 1 unless the quilt was made under a size map.
+  double size_ratio(double spread_out, double spread_source) const {
+    return sized_ && spread_source > 0 ? std::sqrt(spread_out / spread_source) : 1.0;
+  }
 
   TriMesh rest_;
   std::vector<MatrixX3i> element_faces_;  // of the prepared swatch
@@ -85,9 +92,12 @@ class SwatchAnimation {
   std::vector<double> along_;
   int repeat_bins_ = 0;
   std::vector<int> repeat_bin_;
-  std::vector<Eigen::Matrix3f> rotation_;  // #V(rest): swatch frame -> output frame
-  std::vector<int> component_;             // #V(rest): its element in rest (connected component)
-  std::vector<double> amplitude_;          // per element of rest: its motion's share (settle)
+  // #V(rest): swatch frame -> output frame; under a size map (SurfaceQuilt::sized) times the
+  // element's size there against the swatch's, so that a smaller element moves less.
+  std::vector<Eigen::Matrix3f> rotation_;
+  bool sized_ = false;
+  std::vector<int> component_;     // #V(rest): its element in rest (connected component)
+  std::vector<double> amplitude_;  // per element of rest: its motion's share (settle)
 };
 
 }  // namespace mq

@@ -127,6 +127,7 @@ TriMesh without_fins(const TriMesh& mesh, std::vector<int>& input_face,
 }  // namespace
 
 void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt) {
+  quilt.sized = job.log_size.size() > 0;
   quilt.input_base = std::move(job.cleaned);
   quilt.refinement = std::move(job.refinement);
   quilt.input_vertex = std::move(job.input_vertex);

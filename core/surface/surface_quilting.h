@@ -68,6 +68,9 @@ struct SurfaceQuilt {
   Refinement refinement;           // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
   SwatchRepeat repeat;             // how SurfaceElement::source wraps (vines)
+  // Made under a size map: elements at other sizes than the swatch's (a swatch animation's
+  // motion is scaled with each element, core/shell/swatch_animation).
+  bool sized = false;
   // #V(input_base): the vertex of the base as given each input_base vertex is (empty for a
   // proxy, whose vertices are none of them): how a saved quilt follows the base moved.
   std::vector<int> input_vertex;
@@ -95,7 +98,7 @@ struct SurfaceQuiltingOptions {
   // element_size (issue 25, `--size-map`): each > 0, the largest at most kMaxSizeMapRange times
   // the smallest; interpolated over the faces. The global layout (lattices and threads) places its
   // cones for it as a log scale; the local patches take each patch at its seed's size; the vine
-  // method refuses it. Empty: one size.
+  // method takes every distance at the size where it is measured. Empty: one size.
   Eigen::VectorXd size_map;
   static constexpr double kMaxSizeMapRange = 8;
   // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch
@@ -240,7 +243,7 @@ struct SurfaceJob {
 };
 
 // Moves the job's bases into the quilt: cleaned (input_base), refinement, input_vertex and,
-// under a proxy, the welded base as given.
+// under a proxy, the welded base as given; sets SurfaceQuilt::sized.
 void take_input_bases(SurfaceJob& job, SurfaceQuilt& quilt);
 
 // The element size the size map asks for on face f of job.base, as a factor of job.swatch's

@@ -429,6 +429,29 @@ struct SurfacePoint {
   Vector3d bary = Vector3d::Constant(1.0 / 3);
 };
 
+// The element size a size map asks for at a point of the base, as a factor of the swatch's
+// (SurfaceJob::log_size, its log interpolated over the face so that a stem's tube and its
+// leaves change size smoothly along it); 1 without a map (issue 25).
+class SizeField {
+ public:
+  explicit SizeField(const SurfaceJob& job) : F_(job.base.F), log_size_(job.log_size) {}
+  bool varies() const { return log_size_.size() > 0; }
+  double operator()(const SurfacePoint& p) const {
+    if (!varies()) return 1.0;
+    double l = 0;
+    for (int k = 0; k < 3; ++k) l += p.bary(k) * log_size_(F_(p.face, k));
+    return std::exp(l);
+  }
+  // The smaller of the sizes at the base's vertices a and b.
+  double at_edge(int a, int b) const {
+    return varies() ? std::exp(std::min(log_size_(a), log_size_(b))) : 1.0;
+  }
+
+ private:
+  const MatrixX3i& F_;
+  const Eigen::VectorXd& log_size_;
+};
+
 // Straight lines on the surface: within a face a line, across an edge the direction carried over
 // by unfolding the two faces into one plane (so it keeps its angle to the edge: a geodesic).
 class SurfaceWalker {
@@ -644,13 +667,20 @@ class TriangleGrid {
 
 // --- evenly spaced streamlines -----------------------------------------------------------------
 
+// Under a size map (SizeField) a line is traced in steps of the step option times the size
+// where each step starts, so that its pattern coordinate t (arc length over the size: where the
+// swatch's pattern is along it, in full-size units) advances by the step option each step;
+// without a map t = s.
 struct Sample {
   SurfacePoint point;
   Vector3d position, direction, normal;  // direction: the stem's, forwards
   double s = 0;                          // arc length along its line
+  double t = 0;                          // pattern coordinate along its line
+  double size = 1;                       // the size asked here (SizeField)
   int line = -1;
 };
 
+// Distances at full size: under a size map each is taken times the size where it is measured.
 struct StreamlineOptions {
   double step = 0;            // between samples
   double separation = 0;      // d_sep: seeds this far from their line
@@ -675,9 +705,11 @@ struct Seed {
 // stems grow from the bottom as ivy does.
 class Streamlines {
  public:
-  Streamlines(const SurfaceWalker& walker, const MatrixX3d& guide, const MatrixX3d& fallback,
-              const std::vector<Vector3d>& obstacles, const StreamlineOptions& o)
+  Streamlines(const SurfaceWalker& walker, const SizeField& size, const MatrixX3d& guide,
+              const MatrixX3d& fallback, const std::vector<Vector3d>& obstacles,
+              const StreamlineOptions& o)
       : walker_(walker),
+        size_(size),
         guide_(guide),
         fallback_(fallback),
         o_(o),
@@ -708,18 +740,18 @@ class Streamlines {
     }
   }
 
-  // The kept lines, each its samples in order along it (s from 0), and its phase: the arc
-  // length its swatch pattern starts at. A line seeded beside a parallel one continues that
-  // one's phase at the seed, so that neighbours grown side by side carry their leaves at
+  // The kept lines, each its samples in order along it (s and t from 0), and its phase: the
+  // pattern coordinate its swatch pattern starts at. A line seeded beside a parallel one continues
+  // that one's phase at the seed, so that neighbours grown side by side carry their leaves at
   // matching places along them and the leaves of one interleave with the next's (as parallel
   // lines from one seed row do on a plane); another starts its pattern at the seed's height
   // along `up`, which is the same thing for lines that climb straight up.
   std::vector<std::pair<std::vector<Sample>, double>> lines() const {
     std::vector<double> start(lines_.size()), phase(lines_.size(), 0.0);
     for (size_t l = 0; l < lines_.size(); ++l) {
-      start[l] = samples_[static_cast<size_t>(lines_[l].front())].s;
+      start[l] = samples_[static_cast<size_t>(lines_[l].front())].t;
       const Origin& o = origin_[l];
-      phase[l] = o.parent >= 0 ? (o.parent_s - start[static_cast<size_t>(o.parent)]) +
+      phase[l] = o.parent >= 0 ? (o.parent_t - start[static_cast<size_t>(o.parent)]) +
                                      phase[static_cast<size_t>(o.parent)] + start[l]
                                : o.anchor + start[l];
     }
@@ -728,7 +760,8 @@ class Streamlines {
       if (!alive_[l]) continue;
       std::vector<Sample> line;
       for (const int id : lines_[l]) line.push_back(samples_[static_cast<size_t>(id)]);
-      for (Sample& q : line) q.s -= start[l];
+      const double s0 = line.front().s;
+      for (Sample& q : line) q.s -= s0, q.t -= start[l];
       out.emplace_back(std::move(line), phase[l]);
     }
     return out;
@@ -736,24 +769,31 @@ class Streamlines {
   int short_lines() const { return short_; }
 
  private:
-  bool near_line(const Vector3d& q, const Vector3d& n, double radius, int line, double s) const {
+  // Whether a sample of another line (or of `line` farther along it than the self gap) lies
+  // within `distance` (at full size) of q, taken at the mean of the sizes at q and at the sample:
+  // neighbours of different sizes each keep half of the room between them.
+  bool near_line(const Vector3d& q, const Vector3d& n, double distance, double size, int line,
+                 double t) const {
     return grid_.any(q, [&](int id) {
       const Sample& o = samples_[static_cast<size_t>(id)];
       if (!alive_[static_cast<size_t>(o.line)]) return false;
       // The other side of a thin wall is no neighbour: its texture grows away from this.
       if (o.normal.dot(n) < -0.5) return false;
-      if (o.line == line && std::abs(o.s - s) <= o_.self_gap) return false;
+      if (o.line == line && std::abs(o.t - t) <= o_.self_gap) return false;
+      const double radius = distance * (0.5 * (size + o.size));
       return (o.position - q).squaredNorm() < radius * radius;
     });
   }
-  bool near_obstacle(const Vector3d& q) const {
-    return obstacle_grid_.any(q, [&](int id) {
-      return (obstacles_[static_cast<size_t>(id)] - q).squaredNorm() < o_.obstacle * o_.obstacle;
-    });
+  bool near_obstacle(const Vector3d& q, double size) const {
+    const double r = o_.obstacle * size;
+    return obstacle_grid_.any(
+        q, [&](int id) { return (obstacles_[static_cast<size_t>(id)] - q).squaredNorm() < r * r; });
   }
   bool free_at(const SurfacePoint& p) const {
     const Vector3d q = walker_.position(p);
-    return !near_line(q, walker_.normal(p.face), o_.seed_clearance, -1, 0) && !near_obstacle(q);
+    const double size = size_(p);
+    return !near_line(q, walker_.normal(p.face), o_.seed_clearance, size, -1, 0) &&
+           !near_obstacle(q, size);
   }
 
   Vector3d start_direction(int f) const {
@@ -765,13 +805,16 @@ class Streamlines {
     return g.normalized();
   }
 
-  int add(const SurfacePoint& p, const Vector3d& direction, double s, int line) {
+  int add(const SurfacePoint& p, const Vector3d& direction, double s, double t, double size,
+          int line) {
     Sample q;
     q.point = p;
     q.position = walker_.position(p);
     q.normal = walker_.normal(p.face);
     q.direction = direction;
     q.s = s;
+    q.t = t;
+    q.size = size;
     q.line = line;
     samples_.push_back(q);
     const int id = static_cast<int>(samples_.size()) - 1;
@@ -782,9 +825,9 @@ class Streamlines {
   // One half of a line: from p along sign * field. Returns the sample ids in order of tracing.
   std::vector<int> trace(SurfacePoint p, Vector3d d, double sign, int line) {
     std::vector<int> ids;
-    double s = 0;
+    double s = 0, t = 0, size = size_(p);
     const double max_length = 1e6 * o_.step;  // a guard only: lines end near others first
-    while (s < max_length) {
+    while (t < max_length) {
       const int f = p.face;
       const Vector3d n = walker_.normal(f);
       const Vector3d g = sign * guide_.row(f).transpose();
@@ -794,17 +837,22 @@ class Streamlines {
         const double angle = std::atan2(n.dot(d.cross(gh)), d.dot(gh));
         // The field turns against the line (over the top of a wall, down its back): it ends.
         if (std::abs(angle) > 0.75 * M_PI && strength > 0.5) break;
+        // The turn radius scales with the size as the step does.
         const double limit = strength * o_.step / o_.turn_radius;
         const double turn = std::clamp(angle, -limit, limit);
         d = std::cos(turn) * d + std::sin(turn) * n.cross(d);
         d -= d.dot(n) * n;
         d.normalize();
       }
-      if (!walker_.walk(p, d, o_.step)) break;
-      s += o_.step;
+      if (!walker_.walk(p, d, o_.step * size)) break;
+      s += o_.step * size;
+      t += o_.step;
+      size = size_(p);
       const Vector3d q = walker_.position(p);
-      if (near_line(q, walker_.normal(p.face), o_.stop, line, sign * s) || near_obstacle(q)) break;
-      ids.push_back(add(p, sign > 0 ? d : Vector3d(-d), sign * s, line));
+      if (near_line(q, walker_.normal(p.face), o_.stop, size, line, sign * t) ||
+          near_obstacle(q, size))
+        break;
+      ids.push_back(add(p, sign > 0 ? d : Vector3d(-d), sign * s, sign * t, size, line));
     }
     return ids;
   }
@@ -835,19 +883,21 @@ class Streamlines {
     alive_.push_back(1);
     const Vector3d d = start_direction(seed.face);
     Origin origin;
-    origin.anchor = walker_.position(seed).dot(o_.up);
+    const double size = size_(seed);
+    origin.anchor = walker_.position(seed).dot(o_.up) / size;
     if (seed_in.parent_sample >= 0) {
       const Sample& p = samples_[static_cast<size_t>(seed_in.parent_sample)];
-      if (p.direction.dot(d) > kParallel) origin.parent = p.line, origin.parent_s = p.s;
+      if (p.direction.dot(d) > kParallel) origin.parent = p.line, origin.parent_t = p.t;
     }
     origin_.push_back(origin);
-    const int first = add(seed, d, 0, line);
+    const int first = add(seed, d, 0, 0, size, line);
     std::vector<int> back = trace(seed, -d, -1, line);
     const std::vector<int> ahead = trace(seed, d, 1, line);
     std::vector<int>& ids = lines_.back();
     ids.assign(back.rbegin(), back.rend());
     ids.push_back(first);
     ids.insert(ids.end(), ahead.begin(), ahead.end());
+    // In pattern units: a line is long enough for as many swatch vines whatever its size.
     const double length = o_.step * static_cast<double>(ids.size() - 1);
     if (length < o_.min_length) {
       alive_.back() = 0;  // its samples stay in the grid, ignored
@@ -857,7 +907,8 @@ class Streamlines {
     return true;
   }
 
-  // Seeds at the separation on both sides of a line, about every half separation along it.
+  // Seeds at the separation on both sides of a line, about every half separation along it
+  // (under a size map at the mean of the sizes at the line and at the seed).
   void beside(int line, std::deque<Seed>& queue) const {
     const std::vector<int>& ids = lines_[static_cast<size_t>(line)];
     const int every = std::max(1, static_cast<int>(0.5 * o_.separation / o_.step));
@@ -866,7 +917,13 @@ class Streamlines {
         const Sample& q = samples_[static_cast<size_t>(ids[i])];
         SurfacePoint p = q.point;
         Vector3d d = side * q.normal.cross(q.direction);
-        if (walker_.walk(p, d, o_.separation)) {
+        bool free = walker_.walk(p, d, o_.separation * q.size);
+        if (free && size_.varies()) {
+          const double there = size_(p);
+          p = q.point, d = side * q.normal.cross(q.direction);
+          free = walker_.walk(p, d, o_.separation * 0.5 * (q.size + there));
+        }
+        if (free) {
           Seed seed;
           seed.point = p;
           seed.parent_sample = ids[i];
@@ -876,6 +933,7 @@ class Streamlines {
   }
 
   const SurfaceWalker& walker_;
+  const SizeField& size_;
   const MatrixX3d& guide_;
   const MatrixX3d& fallback_;
   StreamlineOptions o_;
@@ -884,8 +942,8 @@ class Streamlines {
   std::vector<char> alive_;
   struct Origin {
     int parent = -1;      // the parallel line it was seeded beside, or -1
-    double parent_s = 0;  // where, along the parent, as traced
-    double anchor = 0;    // the seed's height along `up`
+    double parent_t = 0;  // where, along the parent, as traced (pattern coordinate)
+    double anchor = 0;    // the seed's height along `up`, over the size there
   };
   static constexpr double kParallel = 0.866;  // within 30 degrees
   std::vector<Origin> origin_;
@@ -896,12 +954,35 @@ class Streamlines {
 
 // --- elements along a stem ---------------------------------------------------------------------
 
-// A stem's frame: arc length X along its streamline, lateral Y to its left.
+// A stem's frame: arc length X along its streamline, lateral Y to its left; the swatch's
+// pattern is laid along it by the pattern coordinate t (Sample).
 class StemFrame {
  public:
-  StemFrame(const SurfaceWalker& walker, const std::vector<Sample>& line)
-      : walker_(walker), line_(line) {}
+  StemFrame(const SurfaceWalker& walker, const std::vector<Sample>& line, bool sized)
+      : walker_(walker), line_(line), sized_(sized) {}
   double length() const { return line_.back().s; }
+  double pattern_length() const { return line_.back().t; }
+
+  // The point at pattern coordinate t (clamped to the line), the line's direction there and the
+  // size asked there (*size; 1 without a size map).
+  SurfacePoint at_pattern(double t, Vector3d& direction, double* size) const {
+    if (!sized_) {
+      *size = 1;
+      return at(t, direction);
+    }
+    t = std::clamp(t, 0.0, pattern_length());
+    size_t i =
+        static_cast<size_t>(std::upper_bound(line_.begin(), line_.end(), t,
+                                             [](double v, const Sample& q) { return v < q.t; }) -
+                            line_.begin());
+    i = i == 0 ? 0 : i - 1;
+    SurfacePoint p = line_[i].point;
+    direction = line_[i].direction;
+    // The step from sample i was taken at its size (Streamlines::trace).
+    walker_.walk(p, direction, (t - line_[i].t) * line_[i].size);
+    *size = size_at(i, t);
+    return p;
+  }
 
   // The point at arc length x (clamped to the line) and the line's direction there.
   SurfacePoint at(double x, Vector3d& direction) const {
@@ -932,8 +1013,16 @@ class StemFrame {
   }
 
  private:
+  // The size at t, between samples i and i + 1: interpolated, so that the tube has no steps.
+  double size_at(size_t i, double t) const {
+    if (i + 1 >= line_.size() || !(line_[i + 1].t > line_[i].t)) return line_[i].size;
+    const double w = std::clamp((t - line_[i].t) / (line_[i + 1].t - line_[i].t), 0.0, 1.0);
+    return (1 - w) * line_[i].size + w * line_[i + 1].size;
+  }
+
   const SurfaceWalker& walker_;
   const std::vector<Sample>& line_;
+  bool sized_;
 };
 
 // An element placed on the base: local coordinates and its 3D positions by normal displacement
@@ -1065,12 +1154,13 @@ Vector3d stem_source(const VineModel& m, const Vector3d& q, double phase) {
 }
 
 // A stem laid along its line: each vertex reached from its cross-section's centre on the line
-// by its offset in the frame, along the surface. With `sources`, each vertex's place in the
-// swatch too (stem_source).
+// by its offset in the frame, along the surface, offsets and heights times the size asked there
+// (the tube is made along the pattern coordinate). With `sources`, each vertex's place in the
+// swatch too (stem_source). rings: each vertex's cross-section's pattern coordinate.
 Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
                  const Displacement& shell, std::vector<double>* rings, bool sources) {
   std::vector<double> ring;
-  const TriMesh t = stem_in_frame(m, frame.length(), phase, &ring);
+  const TriMesh t = stem_in_frame(m, frame.pattern_length(), phase, &ring);
   Placed out;
   SurfaceElement& e = out.element;
   e.kind = m.kind;
@@ -1080,13 +1170,14 @@ Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
   e.barycentric.resize(nv, 3);
   e.height.resize(nv);
   out.position.resize(nv, 3);
-  double at = -1;
+  double at = -1, size = 1;
   SurfacePoint c;
   Vector3d direction;
   for (int v = 0; v < nv; ++v) {
     const double s = ring[static_cast<size_t>(v)];
-    if (s != at) c = frame.at(s, direction), at = s;
-    set_vertex(out, v, frame.offset(c, direction, t.V(v, 0) - s, t.V(v, 1)), t.V(v, 2), shell);
+    if (s != at) c = frame.at_pattern(s, direction, &size), at = s;
+    set_vertex(out, v, frame.offset(c, direction, size * (t.V(v, 0) - s), size * t.V(v, 1)),
+               size * t.V(v, 2), shell);
   }
   if (sources) {
     e.source_element = m.element;
@@ -1098,9 +1189,10 @@ Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
   return out;
 }
 
-// A swatch leaf laid rigidly from its attachment at arc length x: each vertex reached by its
-// offset from there, along the surface. *whole is cleared when part of it would lie beyond the
-// base's boundary. `sources`: the swatch's leaf, vertex by vertex (SurfaceElement::source).
+// A swatch leaf laid rigidly from its attachment at pattern coordinate x, at the size asked
+// there: each vertex reached by its offset from there, along the surface. *whole is cleared when
+// part of it would lie beyond the base's boundary. `sources`: the swatch's leaf, vertex by vertex
+// (SurfaceElement::source).
 Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& frame, double x,
                  double phase, double push, const Displacement& shell, bool* whole,
                  const MatrixX3d* sources) {
@@ -1118,7 +1210,9 @@ Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& fr
   e.height.resize(nv);
   out.position.resize(nv, 3);
   Vector3d direction;
-  const SurfacePoint a = frame.at(x, direction);
+  double size = 1;
+  const SurfacePoint a = frame.at_pattern(x, direction, &size);
+  if (size != 1) e.flat *= size;
   for (int v = 0; v < nv; ++v)
     set_vertex(out, v, frame.offset(a, direction, e.flat(v, 0), e.flat(v, 1), whole), e.flat(v, 2),
                shell);
@@ -1257,11 +1351,18 @@ StreamlineOptions stem_streamline_options(const VineGrowthOptions& vo, const Vin
 // come within stop_fraction of another and leave gaps the seeds cannot fill, so their length is
 // less than area / spacing: 0.78 of it on David's head, 0.83 on the ivy wall, 0.88 on Spot
 // (sample ivy, 2026-12-04); at 0.83 the estimate is within 6% of the faces written on the three
-// (issue 28: 20% over).
-void estimate_vine_faces(const TriMesh& base, const VineModel& model, double separation,
+// (issue 28: 20% over). Under a size map a face's area counts over its size squared (stems
+// closer, rings and leaves closer along them).
+void estimate_vine_faces(const SurfaceJob& job, const VineModel& model, double separation,
                          const SurfaceQuiltingOptions& options, SurfaceQuiltingStats& stats) {
   constexpr double kStreamlineFill = 0.83;
-  const double area = surface_area(base.V, base.F);
+  double area = surface_area(job.base.V, job.base.F);
+  if (job.log_size.size()) {
+    const Eigen::VectorXd A = face_areas(job.base.V, job.base.F);
+    area = 0;
+    for (int f = 0; f < job.base.num_faces(); ++f)
+      area += A(f) / (nominal_size(job, f) * nominal_size(job, f));
+  }
   const double length = kStreamlineFill * area / separation;
   double leaf_faces = 0;
   for (const SwatchLeaf& l : model.leaves) leaf_faces += static_cast<double>(l.F.rows());
@@ -1284,9 +1385,9 @@ struct StemLine {
 // field, seeded from the lowest face along so.up first so that the stems grow from the bottom,
 // and kept off the base's boundary. *short_lines: those traced but too short to grow.
 std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& walker,
-                                  const std::vector<char>& region, const MatrixX3d& guide,
-                                  const StreamlineOptions& so, int* short_lines,
-                                  ProgressSink* progress) {
+                                  const SizeField& size, const std::vector<char>& region,
+                                  const MatrixX3d& guide, const StreamlineOptions& so,
+                                  int* short_lines, ProgressSink* progress) {
   const TriMesh& base = job.base;
   const int nf = base.num_faces();
   const auto inside = [&](int f) { return region.empty() || region[static_cast<size_t>(f)]; };
@@ -1296,7 +1397,8 @@ std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& wa
     const int* faces = job.topo.edge_faces.begin(e);
     if (job.topo.edge_faces.degree(e) == 2 && inside(faces[0]) == inside(faces[1])) continue;
     const Vector3d a = base.V.row(job.topo.E(e, 0)), b = base.V.row(job.topo.E(e, 1));
-    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * so.obstacle))));
+    const double gap = 0.5 * so.obstacle * size.at_edge(job.topo.E(e, 0), job.topo.E(e, 1));
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / gap)));
     for (int k = 0; k <= n; ++k) obstacles.push_back(a + (b - a) * (static_cast<double>(k) / n));
   }
   // Seeds lowest first (ties by face index: deterministic).
@@ -1306,7 +1408,7 @@ std::vector<StemLine> trace_stems(const SurfaceJob& job, const SurfaceWalker& wa
   std::vector<int> seeds;
   for (const auto& [height, f] : order)
     if (inside(f)) seeds.push_back(f);
-  Streamlines grower(walker, guide, job.field, obstacles, so);
+  Streamlines grower(walker, size, guide, job.field, obstacles, so);
   grower.grow(seeds, progress);
   std::vector<StemLine> stems;
   for (auto& [line, phase] : grower.lines()) stems.push_back({std::move(line), phase});
@@ -1379,9 +1481,9 @@ class VinePlacement {
   void place_leaves(VineGrowthStats& vs, ProgressSink* progress) {
     const double pitch = model_.period / std::max<size_t>(1, model_.leaves.size());
     for (size_t k = 0; k < kept_.size(); ++k) {
-      const StemFrame frame(walker_, kept_[k].line);
+      const StemFrame frame(walker_, kept_[k].line, sized());
       for (const auto& [x, i] :
-           leaf_slots(model_, frame.length(), kept_[k].phase, kLargestLeafShift * pitch)) {
+           leaf_slots(model_, frame.pattern_length(), kept_[k].phase, kLargestLeafShift * pitch)) {
         ++vs.leaf_slots;
         place_leaf(model_.leaves[static_cast<size_t>(i)], frame, x, kept_[k].phase, pitch, vs);
       }
@@ -1394,6 +1496,8 @@ class VinePlacement {
   SurfaceQuilt& quilt() { return quilt_; }
 
  private:
+  bool sized() const { return job_.log_size.size() > 0; }
+
   // Where a stem or a leaf dips under the base as given (into a pillar beside a wall, where
   // boxes meet), the embedding's check (core/shell/placement_check) would remove it whole: the
   // ivy wall lost 11 stems and 247 leaves so. Stems are cut there, leaves moved.
@@ -1403,7 +1507,7 @@ class VinePlacement {
   // (placed stems are checked later, in order).
   CheckedStem make_checked_stem(const StemLine& st) const {
     CheckedStem out;
-    const StemFrame frame(walker_, st.line);
+    const StemFrame frame(walker_, st.line, sized());
     out.placed = make_stem(model_, frame, st.phase, shell_, &out.rings, sources_ != nullptr);
     const Placed& p = out.placed;
     std::vector<char>& b = out.bad;
@@ -1420,8 +1524,9 @@ class VinePlacement {
     return out;
   }
 
-  // The pieces of st left once the arc lengths its bad faces span, widened by the spacing, are
-  // cut out: those at least so.min_length long go to `next`, in order along it.
+  // The pieces of st left once the stretches its bad faces span, widened by the spacing, are
+  // cut out: those at least so.min_length long go to `next`, in order along it (in pattern
+  // coordinates: c.rings are).
   void split_stem(const StemLine& st, const CheckedStem& c, std::vector<StemLine>& next) const {
     const Placed& p = c.placed;
     std::vector<std::pair<double, double>> cut;
@@ -1440,18 +1545,18 @@ class VinePlacement {
       if (b - a < so_.min_length) return;
       StemLine part;
       for (const Sample& q : st.line)
-        if (q.s >= a && q.s <= b) part.line.push_back(q);
+        if (q.t >= a && q.t <= b) part.line.push_back(q);
       if (part.line.size() < 2) return;
-      const double s0 = part.line.front().s;
-      for (Sample& q : part.line) q.s -= s0;
-      part.phase = st.phase + s0;
+      const double s0 = part.line.front().s, t0 = part.line.front().t;
+      for (Sample& q : part.line) q.s -= s0, q.t -= t0;
+      part.phase = st.phase + t0;
       next.push_back(std::move(part));
     };
     for (const auto& [a, b2] : cut) {
       piece(from, a);
       from = std::max(from, b2);
     }
-    piece(from, st.line.back().s);
+    piece(from, st.line.back().t);
   }
 
   // One leaf at arc length x of its stem: tried at its place, then a little along the stem
@@ -1460,7 +1565,7 @@ class VinePlacement {
   // is clear.
   void place_leaf(const SwatchLeaf& leaf, const StemFrame& frame, double x, double phase,
                   double pitch, VineGrowthStats& vs) {
-    const double S = frame.length();
+    const double S = frame.pattern_length();
     for (const auto& [shift, push] : kLeafMoves) {
       const double xs = x + shift * pitch;
       if (xs < 0 || xs > S) continue;
@@ -1514,8 +1619,12 @@ SurfaceQuilt finish_vine_quilt(SurfaceJob& job, const VineSwatch& vine, VinePlac
   vs.stems = static_cast<int>(kept.size());
   std::vector<double> lengths;
   lengths.reserve(kept.size());
-  for (const StemLine& st : kept) lengths.push_back(st.line.back().s);
-  for (const double l : lengths) vs.total_length += l;
+  for (const StemLine& st : kept) {
+    lengths.push_back(st.line.back().t);
+    vs.total_length += st.line.back().s;
+  }
+  for (const double l : lengths) vs.total_vines += l;
+  vs.total_vines /= vine.model.period;
   if (!lengths.empty()) {
     std::vector<double> sorted = lengths;
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
@@ -1581,9 +1690,6 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
                                   const VineGrowthOptions& vo, SurfaceQuiltingStats* stats_out,
                                   VineGrowthStats* vine_stats, ProgressSink* progress) {
   check_options(vo);
-  MQ_CHECK(job.log_size.size() == 0, InvalidInput,
-           "a size map is followed by the global layout and the local patches; vines grow at "
-           "one size");
   StageTimes& times = stats.times;
   VineGrowthStats vs;
   const VineSwatch vine = analyse_vine_swatch(job, times);
@@ -1598,7 +1704,7 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   const StreamlineOptions so = stem_streamline_options(vo, vine.model, vine.spacing, up);
   vs.vine_length = vine.model.period;
   vs.spacing = so.separation;
-  estimate_vine_faces(job.base, vine.model, so.separation, options, stats);
+  estimate_vine_faces(job, vine.model, so.separation, options, stats);
   if (options.global.count_only) {
     if (stats_out) *stats_out = std::move(stats);
     if (vine_stats) *vine_stats = vs;
@@ -1609,7 +1715,8 @@ SurfaceQuilt quilt_prepared_vines(SurfaceJob job, SurfaceQuiltingStats stats,
   std::vector<StemLine> stems;
   {
     ScopedStageTimer timer(times, Stage::Streamlines);
-    stems = trace_stems(job, walker, region, guide, so, &vs.streamlines_short, progress);
+    stems = trace_stems(job, walker, SizeField(job), region, guide, so, &vs.streamlines_short,
+                        progress);
   }
   VinePlacement placement(job, walker, vine.model, so, H,
                           options.keep_sources ? &vine.swatch : nullptr);

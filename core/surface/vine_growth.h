@@ -16,6 +16,9 @@
 //     repeated every swatch vine length, each laid rigidly from its attachment point by a
 //     geodesic polar map (bent only by the surface); a leaf that would intersect anything
 //     placed is tried a little along the stem, else left out.
+// Under a size map (SurfaceQuiltingOptions::size_map, issue 25) every distance of the three steps
+// is taken times the size asked where it is measured: stems closer where the map asks smaller
+// elements, their tubes thinner and their pattern shorter there, leaves smaller.
 // Every element is stored in local coordinates over the base (SurfaceElement), so the shell map
 // and the post-processing apply as to the other methods.
 #pragma once
@@ -55,10 +58,14 @@ struct VineGrowthStats {
   int leaf_slots = 0;         // places the swatch's ratio gives along the stems (and up to
                               // the largest move past their ends)
   int leaves_shifted = 0;     // of the placed, moved along the stem to clear a neighbour
-  double vine_length = 0;     // one swatch vine's length along its axis, base units
-  double spacing = 0;         // between stems, base units
+  double vine_length = 0;     // one swatch vine's length along its axis, base units (at full
+                              // size under a size map)
+  double spacing = 0;         // between stems, base units (at full size)
   double total_length = 0;    // of the stems, base units
-  double median_length = 0;   // of the stems, in swatch vine lengths
+  // Of the stems, in swatch vine lengths at the size asked along them (under a size map a
+  // stem at half size is twice as many swatch vines long as its length at full size).
+  double total_vines = 0;
+  double median_length = 0;  // of the stems, in swatch vine lengths at the size asked
 };
 
 // Whether the prepared swatch is a vine with attached elements: exactly one long element (its

@@ -133,12 +133,35 @@ TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
     EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
   }
   EXPECT_FALSE(fs::exists(dir + "/x.obj"));
-  // Vines grow at one size: refused in one line.
-  const CliRun vines = meshquilt(dir, job + " --size-map sizes.txt --method vines -o x.obj");
-  EXPECT_EQ(vines.status, 1);
-  EXPECT_EQ(vines.err_lines().size(), 1u) << vines.err;
-  EXPECT_NE(vines.err.find("vines grow at one size"), std::string::npos) << vines.err;
   EXPECT_FALSE(fs::exists(dir + "/x.obj"));
+}
+
+// Vines follow a size map too (stems closer, thinner, their leaves smaller where it asks less):
+// about 2.4 times the faces on the sheet above, as the rings; the estimate holds.
+TEST(CliSizeMap, VinesFollowTheMap) {
+  const std::string dir = test::temp_dir();
+  write_inputs(dir);
+  const TriMesh grid = read_mesh(dir + "/grid.obj");
+  std::string sizes;
+  for (int v = 0; v < grid.num_vertices(); ++v)
+    sizes += std::to_string(1.0 - 0.5 * std::clamp((grid.V(v, 0) - 4) / 2, 0.0, 1.0)) + "\n";
+  spit(dir + "/sizes.txt", sizes);
+  ASSERT_EQ(meshquilt(dir, "swatch ivy --count 2 --length 2 -o ivy.obj").status, 0);
+  const std::string job =
+      "surface --base grid.obj --swatch ivy.obj --method vines --scale 0.1 --quiet";
+  const CliRun plain = meshquilt(dir, job + " -o p.ply");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const CliRun m = meshquilt(dir, job + " --size-map sizes.txt -o m.ply --stats m.json");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const TriMesh a = read_mesh(dir + "/p.ply"), b = read_mesh(dir + "/m.ply");
+  const double ratio = static_cast<double>(b.num_faces()) / a.num_faces();
+  std::printf("[ measure  ] vines with a size map: %.2f times the faces\n", ratio);
+  EXPECT_GT(ratio, 2.0);
+  EXPECT_LT(ratio, 3.0);
+  const CliRun e = meshquilt(dir, job + " --size-map sizes.txt -o e.ply --estimate");
+  ASSERT_EQ(e.status, 0) << e.err;
+  const double estimated = std::stod(e.out.substr(e.out.find("faces ") + 6));
+  EXPECT_NEAR(estimated / b.num_faces(), 1.0, 0.2) << e.out << b.num_faces();
 }
 
 }  // namespace

@@ -88,10 +88,11 @@ struct Animated {
 };
 
 // Ivy grown over an upright plane with its sources kept, embedded as the tool does.
-Animated grow_ivy(const TriMesh& swatch) {
+Animated grow_ivy(const TriMesh& swatch, const Eigen::VectorXd& size_map = {}) {
   SurfaceQuiltingOptions o;
   o.scale = 0.1;  // the swatch's size as at 0.06 on a 2 x 1.5 plane (a third of the work)
   o.keep_sources = true;
+  o.size_map = size_map;
   Animated a;
   SurfaceQuiltingStats stats;
   a.quilt = quilt_surface_vines(test::plane_grid(1.2, 0.9, 12, 9), swatch, o, {}, &stats);
@@ -151,6 +152,40 @@ TEST_P(SwatchAnimationSway, IvyOnAPlaneMovesWithItsSwatch) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LeavesOrAll, SwatchAnimationSway, ::testing::Values(0.0, 0.5));
+
+// Under a size map (issue 25) an element moves at its own size: the swatch lifted as a whole
+// lifts the half-size ivy on the plane's right half as far as the full-size ivy on its left.
+TEST(SwatchAnimation, ElementsMoveAtTheSizeTheMapGaveThem) {
+  const TriMesh plane = test::plane_grid(1.2, 0.9, 12, 9);
+  Eigen::VectorXd map(plane.num_vertices());
+  for (int v = 0; v < plane.num_vertices(); ++v) map(v) = plane.V(v, 0) < 0.5 ? 1.0 : 0.5;
+  const TriMesh swatch = ivy_swatch();
+  const Animated a = grow_ivy(swatch, map);
+  TriMesh lifted = swatch;
+  lifted.V.col(2).array() += 0.2 * (swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff());
+  const SwatchMotion motion = swatch_motion(swatch, lifted, a.scale, "lifted");
+  const double lift = motion.displacement.front().row(0).norm();  // the swatch's, to scale
+  SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
+  const TriMesh f = animation.frame(motion);
+  std::vector<double> left, right;
+  for (const std::vector<int>& vertices : component_vertices(a.rest)) {
+    double x = 0, moved = 0;
+    for (const int v : vertices) {
+      x += a.rest.V(v, 0) / static_cast<double>(vertices.size());
+      moved += (f.V.row(v) - a.rest.V.row(v)).norm() / static_cast<double>(vertices.size());
+    }
+    if (x < 0.4) left.push_back(moved / lift);
+    if (x > 0.6) right.push_back(moved / lift);
+  }
+  ASSERT_GT(left.size(), 5u);
+  ASSERT_GT(right.size(), 5u);
+  std::printf(
+      "[ measure  ] lifted swatch under a size map: elements moved %.3f (left, size 1) and "
+      "%.3f (right, size 0.5) of the swatch's lift\n",
+      test::median(left), test::median(right));
+  EXPECT_NEAR(test::median(left), 1.0, 0.05);
+  EXPECT_NEAR(test::median(right), 0.5, 0.05);
+}
 
 TEST(SwatchAnimation, SameFramesWhateverTheThreadCount) {
   const TriMesh swatch = ivy_swatch();
