@@ -80,16 +80,21 @@ bool coplanar_triangles_intersect(const std::array<Vector2d, 3>& a,
          point_in_triangle_2d(b[0], a[0], a[1], a[2]);
 }
 
-// Closed segment pq against closed triangle abc.
+// (b - a) x (c - a): orient3d(a, b, c, d) is the sign of its dot product with d - a, computed
+// once per triangle instead of once per point (the same arithmetic, so the same signs).
+Vector3d plane_normal(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  return (b - a).cross(c - a);
+}
+
+// Closed segment pq against closed triangle abc, n its plane_normal.
 bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vector3d& a,
-                                const Vector3d& b, const Vector3d& c) {
-  const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+                                const Vector3d& b, const Vector3d& c, const Vector3d& n) {
+  const int op = sign(n.dot(p - a)), oq = sign(n.dot(q - a));
   if (op * oq > 0) return false;
   // The predicates are not exact: a segment in a tilted plane with the triangle (the fan that
   // caps a thread's end) gets signs from rounding, and the line test below then reports
   // sectors of the fan on opposite sides of its centre as overlapping. Within a relative 1e-9
   // of the plane the segment is taken to lie in it.
-  const Vector3d n = (b - a).cross(c - a);
   const double tolerance =
       1e-9 * n.norm() * std::max({(q - p).norm(), (b - a).norm(), (c - a).norm(), (c - b).norm()});
   const bool in_plane = (op == 0 && oq == 0) || (std::abs(n.dot(p - a)) <= tolerance &&
@@ -106,6 +111,11 @@ bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vect
   const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
   const bool has_neg = s1 < 0 || s2 < 0 || s3<0, has_pos = s1> 0 || s2 > 0 || s3 > 0;
   return !(has_neg && has_pos);
+}
+
+bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vector3d& a,
+                                const Vector3d& b, const Vector3d& c) {
+  return segment_triangle_intersect(p, q, a, b, c, plane_normal(a, b, c));
 }
 
 // Face pair test with combinatorial sharing taken into account (see IntersectionOptions).
@@ -404,11 +414,11 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
 bool triangles_intersect(const Vector3d& a0, const Vector3d& a1, const Vector3d& a2,
                          const Vector3d& b0, const Vector3d& b1, const Vector3d& b2) {
   // Separating planes: all of one triangle strictly on one side of the other's plane.
-  const int da0 = orient3d(b0, b1, b2, a0), da1 = orient3d(b0, b1, b2, a1),
-            da2 = orient3d(b0, b1, b2, a2);
+  const Vector3d nb = plane_normal(b0, b1, b2);
+  const int da0 = sign(nb.dot(a0 - b0)), da1 = sign(nb.dot(a1 - b0)), da2 = sign(nb.dot(a2 - b0));
   if ((da0 > 0 && da1 > 0 && da2 > 0) || (da0 < 0 && da1 < 0 && da2 < 0)) return false;
-  const int db0 = orient3d(a0, a1, a2, b0), db1 = orient3d(a0, a1, a2, b1),
-            db2 = orient3d(a0, a1, a2, b2);
+  const Vector3d na = plane_normal(a0, a1, a2);
+  const int db0 = sign(na.dot(b0 - a0)), db1 = sign(na.dot(b1 - a0)), db2 = sign(na.dot(b2 - a0));
   if ((db0 > 0 && db1 > 0 && db2 > 0) || (db0 < 0 && db1 < 0 && db2 < 0)) return false;
   if ((da0 == 0 && da1 == 0 && da2 == 0) || (db0 == 0 && db1 == 0 && db2 == 0)) {
     const int k = coplanar_axis(a0, a1, a2, b0, b1, b2);
@@ -417,12 +427,12 @@ bool triangles_intersect(const Vector3d& a0, const Vector3d& a1, const Vector3d&
   }
   // Non-coplanar: both meet the line of the two planes in an interval; the intervals overlap
   // iff an endpoint of one, which lies on an edge of its triangle, is inside the other.
-  return segment_triangle_intersect(a0, a1, b0, b1, b2) ||
-         segment_triangle_intersect(a1, a2, b0, b1, b2) ||
-         segment_triangle_intersect(a2, a0, b0, b1, b2) ||
-         segment_triangle_intersect(b0, b1, a0, a1, a2) ||
-         segment_triangle_intersect(b1, b2, a0, a1, a2) ||
-         segment_triangle_intersect(b2, b0, a0, a1, a2);
+  return segment_triangle_intersect(a0, a1, b0, b1, b2, nb) ||
+         segment_triangle_intersect(a1, a2, b0, b1, b2, nb) ||
+         segment_triangle_intersect(a2, a0, b0, b1, b2, nb) ||
+         segment_triangle_intersect(b0, b1, a0, a1, a2, na) ||
+         segment_triangle_intersect(b1, b2, a0, a1, a2, na) ||
+         segment_triangle_intersect(b2, b0, a0, a1, a2, na);
 }
 
 std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
