@@ -83,6 +83,75 @@ void move_cones(const TrivialConnection& solver, const Adjacency& adj,
   }
 }
 
+// The + cone and - cone (unit cones of one component) whose cancelling gives the lowest E, tried
+// for each + cone against its options.pair_candidates nearest - cones (breadth-first through
+// interior vertices, ties by index): false when there is none or the solve budget is spent.
+struct PairChoice {
+  int plus = -1, minus = -1;
+  double energy = kInf;
+  Eigen::VectorXd u;
+};
+
+bool best_cone_pair(const TrivialConnection& solver, const Adjacency& adj,
+                    const ConePlacementOptions& options, const std::vector<int>& index,
+                    std::vector<int>& stamp, int& mark, int& solves, PairChoice& best) {
+  const int nv = static_cast<int>(index.size());
+  const std::vector<char>& interior = solver.interior();
+  best = PairChoice();
+  for (int p = 0; p < nv; ++p) {
+    if (index[p] <= 0 || !interior[p]) continue;
+    // Breadth-first from p until enough - cones are found.
+    std::vector<int> found, ring{p};
+    stamp[p] = mark;
+    while (!ring.empty() && static_cast<int>(found.size()) < options.pair_candidates) {
+      std::vector<int> next;
+      for (const int v : ring)
+        for (const int* w = adj.begin(v); w != adj.end(v); ++w)
+          if (interior[*w] && stamp[*w] != mark) {
+            stamp[*w] = mark;
+            next.push_back(*w);
+          }
+      std::sort(next.begin(), next.end());
+      for (const int w : next)
+        if (index[w] < 0 && static_cast<int>(found.size()) < options.pair_candidates)
+          found.push_back(w);
+      ring = std::move(next);
+    }
+    ++mark;
+    for (const int n : found) {
+      if (solves >= options.max_pair_solves) return best.plus >= 0;
+      std::vector<int> trial = index;
+      trial[p] -= 1;
+      trial[n] += 1;
+      Eigen::VectorXd u = solver.log_scale(trial, options.target);
+      ++solves;
+      const double e = scale_energy(solver, u, options.target);
+      if (e < best.energy) best = {p, n, e, std::move(u)};
+    }
+  }
+  return best.plus >= 0;
+}
+
+// Cancels + and - cone pairs while the best raises E by at most options.pair_allowance (see
+// place_cones), moving the others again after each.
+void cancel_cone_pairs(const TrivialConnection& solver, const Adjacency& adj,
+                       const ConePlacementOptions& options, std::vector<int>& index,
+                       Eigen::VectorXd& u, double& energy, std::vector<int>& stamp, int& mark,
+                       ConePlacementReport& rep) {
+  int solves = 0;
+  PairChoice best;
+  while (best_cone_pair(solver, adj, options, index, stamp, mark, solves, best) &&
+         best.energy <= energy + options.pair_allowance) {
+    index[best.plus] -= 1;
+    index[best.minus] += 1;
+    u = std::move(best.u);
+    energy = best.energy;
+    ++rep.cancelled;
+    ++rep.pairs_cancelled;
+    move_cones(solver, adj, options, index, u, energy, stamp, mark, rep);
+  }
+}
+
 }  // namespace
 
 Eigen::VectorXd misfit(const TrivialConnection& solver, const Eigen::VectorXd& u,
@@ -121,6 +190,8 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
            "cone placement: ", nv, " indices for ", solver.interior().size(), " vertices");
   MQ_CHECK(options.max_rounds >= 0 && options.reach >= 1, InvalidInput,
            "cone placement: max_rounds must be >= 0 and reach >= 1");
+  MQ_CHECK(options.pair_candidates >= 1 && options.max_pair_solves >= 0, InvalidInput,
+           "cone placement: pair_candidates must be >= 1 and max_pair_solves >= 0");
   MQ_CHECK(options.target.size() == 0 || options.target.size() == nv, InvalidInput,
            "cone placement: ", options.target.size(), " target scales for ", nv, " vertices");
   ConePlacementReport rep;
@@ -149,6 +220,8 @@ std::vector<int> place_cones(const TrivialConnection& solver, std::vector<int> i
   double energy = scale_energy(solver, u, options.target);
   rep.energy_before = energy;
   move_cones(solver, adj, options, index, u, energy, stamp, mark, rep);
+  if (options.pair_allowance >= 0)
+    cancel_cone_pairs(solver, adj, options, index, u, energy, stamp, mark, rep);
   rep.energy_after = energy;
   if (report) *report = rep;
   return index;

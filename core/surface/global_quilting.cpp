@@ -1023,6 +1023,7 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
   if (connection.unbalanced_component(df.index) >= 0) return false;
   ConePlacementReport report;
   ConePlacementOptions placement;
+  placement.pair_allowance = options.cone_pair_allowance;
   // A size map: the layout's scale is the inverse of the element size.
   if (job.log_size.size()) placement.target = -job.log_size;
   const std::vector<int> cones = place_cones(

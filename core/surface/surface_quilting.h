@@ -161,6 +161,9 @@ struct SurfaceQuiltingOptions {
     bool seamless = true;
     // Cancel + and - cones at the two ends of one edge (cancel_singular_pairs).
     bool cancel_cone_pairs = true;
+    // After the cones are moved, cancel + and - cone pairs while that raises the mean squared
+    // log scale by at most this (ConePlacementOptions::pair_allowance); negative: none.
+    double cone_pair_allowance = 0.01;
     // Move the cones for the least change of scale (core/surface/cone_placement) and lay the
     // texture out conformally, by the field parallel in their flat metric scaled by e^u
     // (core/surface/trivial_connection); false: unit frames of the smooth line field.

@@ -92,7 +92,9 @@ TEST(SurfaceStructure, BunnyAndLink) {
 
 TEST(SurfaceStructure, ChainMailOnTheCup) {
   const TriMesh base = read_mesh(test::shared_data("base/cup_mug_11k.off"));
-  expect_chain_mail("cup, chain mail", quilt_by_default(base, mail(5, 6), 0.145), {0.92, 0.01});
+  // 95.5% linked since the cone pairs are cancelled (93.9% before); 39 of its 40 isolated rings
+  // are rings folded over the lip (a sharp crease), counted as misses (21 before).
+  expect_chain_mail("cup, chain mail", quilt_by_default(base, mail(5, 6), 0.145), {0.935, 0.0125});
 }
 
 // The armor job: at --scale 0.13 a ring (0.042 across) is as wide as the knight's arms are in
