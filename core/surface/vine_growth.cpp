@@ -971,11 +971,7 @@ class StemFrame {
       return at(t, direction);
     }
     t = std::clamp(t, 0.0, pattern_length());
-    size_t i =
-        static_cast<size_t>(std::upper_bound(line_.begin(), line_.end(), t,
-                                             [](double v, const Sample& q) { return v < q.t; }) -
-                            line_.begin());
-    i = i == 0 ? 0 : i - 1;
+    const size_t i = sample_before(t, &Sample::t);
     SurfacePoint p = line_[i].point;
     direction = line_[i].direction;
     // The step from sample i was taken at its size (Streamlines::trace).
@@ -987,11 +983,7 @@ class StemFrame {
   // The point at arc length x (clamped to the line) and the line's direction there.
   SurfacePoint at(double x, Vector3d& direction) const {
     x = std::clamp(x, 0.0, length());
-    size_t i =
-        static_cast<size_t>(std::upper_bound(line_.begin(), line_.end(), x,
-                                             [](double v, const Sample& q) { return v < q.s; }) -
-                            line_.begin());
-    i = i == 0 ? 0 : i - 1;
+    const size_t i = sample_before(x, &Sample::s);
     SurfacePoint p = line_[i].point;
     direction = line_[i].direction;
     walker_.walk(p, direction, x - line_[i].s);
@@ -1013,6 +1005,13 @@ class StemFrame {
   }
 
  private:
+  // The last sample whose `key` (s or t) is at most `value` (the first when none is).
+  size_t sample_before(double value, double Sample::*key) const {
+    const auto after = std::upper_bound(line_.begin(), line_.end(), value,
+                                        [key](double v, const Sample& q) { return v < q.*key; });
+    const size_t i = static_cast<size_t>(after - line_.begin());
+    return i == 0 ? 0 : i - 1;
+  }
   // The size at t, between samples i and i + 1: interpolated, so that the tube has no steps.
   double size_at(size_t i, double t) const {
     if (i + 1 >= line_.size() || !(line_[i + 1].t > line_[i].t)) return line_[i].size;

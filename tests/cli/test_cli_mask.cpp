@@ -95,15 +95,21 @@ TEST(CliMask, MaskedRunAndBadMaskFiles) {
   EXPECT_FALSE(fs::exists(dir + "/x.json"));
 }
 
-TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
-  const std::string dir = test::temp_dir();
+// The inputs and dir/sizes.txt, a size map over the grid: full size over x < 4, half size over
+// x > 6, a ramp between. Returns the grid.
+TriMesh write_inputs_and_ramp_sizes(const std::string& dir) {
   write_inputs(dir);
   const TriMesh grid = read_mesh(dir + "/grid.obj");
-  // Full size over x < 4, half size over x > 6, a ramp between.
   std::string sizes = "# element size per vertex\n";
   for (int v = 0; v < grid.num_vertices(); ++v)
     sizes += std::to_string(1.0 - 0.5 * std::clamp((grid.V(v, 0) - 4) / 2, 0.0, 1.0)) + "\n";
   spit(dir + "/sizes.txt", sizes);
+  return grid;
+}
+
+TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
+  const std::string dir = test::temp_dir();
+  const TriMesh grid = write_inputs_and_ramp_sizes(dir);
   const std::string job =
       "surface --base grid.obj --swatch sw.obj --field 1 0 0 --scale 0.1 --quiet";
   const CliRun plain = meshquilt(dir, job + " -o p.obj");
@@ -140,12 +146,7 @@ TEST(CliSizeMap, SmallerRingsWhereTheMapAsksAndBadMaps) {
 // about 2.4 times the faces on the sheet above, as the rings; the estimate holds.
 TEST(CliSizeMap, VinesFollowTheMap) {
   const std::string dir = test::temp_dir();
-  write_inputs(dir);
-  const TriMesh grid = read_mesh(dir + "/grid.obj");
-  std::string sizes;
-  for (int v = 0; v < grid.num_vertices(); ++v)
-    sizes += std::to_string(1.0 - 0.5 * std::clamp((grid.V(v, 0) - 4) / 2, 0.0, 1.0)) + "\n";
-  spit(dir + "/sizes.txt", sizes);
+  write_inputs_and_ramp_sizes(dir);
   ASSERT_EQ(meshquilt(dir, "swatch ivy --count 2 --length 2 -o ivy.obj").status, 0);
   const std::string job =
       "surface --base grid.obj --swatch ivy.obj --method vines --scale 0.1 --quiet";
