@@ -87,6 +87,7 @@ void write_element_figures(JsonWriter& j, const SurfaceQuiltingStats& s,
       .value("removed_self_intersecting", em.removed_self_intersecting)
       .value("rigid_repairs", em.rigid_repairs)
       .value("shrunk_to_fit", em.shrunk_to_fit)
+      .value("linked_versions", em.linked_versions)
       .value("layout_versions", em.layout_versions)
       .value("separated_rings", em.separated_rings)
       .value("separation_reverted", em.separation_reverted)

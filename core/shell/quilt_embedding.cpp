@@ -17,6 +17,7 @@
 #include "core/shell/element_grid.h"
 #include "core/shell/element_removal.h"
 #include "core/shell/element_unfolding.h"
+#include "core/shell/linked_versions.h"
 #include "core/shell/offset_surface.h"
 #include "core/shell/placement_check.h"
 #include "core/shell/quilt_intersections.h"
@@ -94,6 +95,7 @@ class QuiltEmbedder {
   void build_shell_map();
   void embed(TetStretchEvaluator& stretch);
   void embed_layout_versions();
+  void choose_linked_versions();
   void check_placement();
   void repair_folds();
   void separate_touching_rings();
@@ -132,6 +134,7 @@ class QuiltEmbedder {
   // The layout's versions of elements placed as even copies (SurfaceElement::through_layout).
   std::vector<Eigen::Index> alternative_first_;
   MatrixX3d alternative_V_;
+  std::vector<char> alternative_by_normal_;  // per element: its layout version so placed
   PlacementCheckOptions check_;
   std::optional<SignedHeight> base_height_;
   std::vector<ElementHeights> heights_;
@@ -324,7 +327,8 @@ void QuiltEmbedder::embed_layout_versions() {
   alt.face.resize(na);
   alt.bary.resize(na, 3);
   alt.height.resize(na);
-  std::vector<char> alt_normal(ne_, map_ ? 0 : 1);
+  std::vector<char>& alt_normal = alternative_by_normal_;
+  alt_normal.assign(ne_, map_ ? 0 : 1);
   for (size_t k = 0; k < ne_; ++k) {
     const SurfaceElement::Alternative& a = quilt_.elements[k].through_layout;
     for (size_t v = 0; v < a.face.size(); ++v) {
@@ -348,6 +352,28 @@ void QuiltEmbedder::embed_layout_versions() {
                                 alternative_first_[k + 1] - alternative_first_[k]) =
           mapped_alt.middleRows(alternative_first_[k],
                                 alternative_first_[k + 1] - alternative_first_[k]);
+}
+
+// Rings whose layout version threads more of their neighbours than their even copy does take
+// it (core/shell/linked_versions); the copy becomes the other version.
+void QuiltEmbedder::choose_linked_versions() {
+  if (alternative_V_.rows() == 0) return;
+  // Timed as part of the embedding (it chooses between two embedded versions), without a
+  // second progress line for it.
+  ScopedStageTimer timer(stats_.times, Stage::Embedding);
+  LinkedVersionStats linked;
+  const std::vector<char> swapped =
+      mq::choose_linked_versions(quilt_, first_, all_.V, alternative_V_, alternative_first_,
+                                 std::vector<char>(ne_, 0), {}, &linked);
+  // A swapped ring's intersecting pairs are found again (the pairs found after the embedding
+  // are of its copy).
+  for (size_t k = 0; k < ne_; ++k)
+    if (swapped[k]) {
+      std::swap(by_normal_[k], alternative_by_normal_[k]);
+      stale_[k] = 1;
+      known_disjoint_ = false;
+    }
+  stats_.linked_versions = linked.chosen;
 }
 
 // The check (issue 23): every vertex's signed height over the base as given. An element under
@@ -649,7 +675,10 @@ TriMesh embed_quilt(const SurfaceQuilt& quilt, const QuiltEmbeddingOptions& opti
   QuiltEmbedder embedding(quilt, options, stats, progress);
   if (options.shell_map && !embedding.empty()) embedding.build_shell_map();
   embedding.embed(stretch);
-  if (options.remove_intersecting) embedding.embed_layout_versions();
+  if (options.remove_intersecting) {
+    embedding.embed_layout_versions();
+    if (options.choose_linked_versions) embedding.choose_linked_versions();
+  }
   embedding.check_placement();
   if (options.remove_intersecting) {
     embedding.repair_folds();

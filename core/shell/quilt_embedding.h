@@ -21,6 +21,9 @@ struct QuiltEmbeddingOptions {
   // Before removing rings that touch each other, move them apart whole
   // (core/shell/ring_separation).
   bool separate_rings = true;
+  // Rings placed as even copies take the layout's version where it keeps more links
+  // (core/shell/linked_versions).
+  bool choose_linked_versions = true;
   std::uint64_t seed = 1;
   // Per face of quilt.base, where coverage is measured (a mask, core/surface/surface_mask);
   // empty: the whole base.
@@ -37,6 +40,7 @@ struct QuiltEmbeddingStats {
   int removed_self_intersecting = 0;  // folded through itself, and no repair possible
   int rigid_repairs = 0;              // folded elements replaced by their flat shape moved rigidly
   int shrunk_to_fit = 0;              // elements kept at 85-95% of their size instead of removed
+  int linked_versions = 0;  // even copies replaced by the layout's version, which links more
   int layout_versions = 0;  // even copies that touched a neighbour, kept as the layout placed them
   int separated_rings = 0;  // rings moved apart from those they touched
   int separation_reverted = 0;    // moved, then put back: a link would have changed
