@@ -139,6 +139,7 @@ void write_global_layout(JsonWriter& j, const GlobalQuiltingStats& g) {
       .value("cancelled_cone_pairs", g.cancelled_cone_pairs)
       .value("split_poles", g.split_poles)
       .value("cone_moves", g.cone_moves)
+      .value("placement_pairs_cancelled", g.placement_pairs_cancelled)
       .value("scale_energy_before", g.scale_energy_before)
       .value("scale_energy", g.scale_energy)
       .value("scale_exponent", g.scale_exponent)

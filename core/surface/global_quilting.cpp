@@ -1030,6 +1030,7 @@ bool conformal_layout_field(const SurfaceJob& job, const SurfaceQuiltingOptions:
       connection, df.index, vertex_adjacency(base.F, base.num_vertices()), placement, &report);
   gstats.split_poles = report.split_poles;
   gstats.cone_moves = report.moves;
+  gstats.placement_pairs_cancelled = report.pairs_cancelled;
   gstats.scale_energy_before = report.energy_before;
   gstats.scale_energy = report.energy_after;
   // On a boundary the metric's scale is free: held to the size map's there (0 without one).

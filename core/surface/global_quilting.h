@@ -18,15 +18,16 @@ namespace mq {
 struct VineGrowthStats;
 
 struct GlobalQuiltingStats {
-  bool periodic = false;      // the swatch's lattice was found (core/planar/swatch_symmetry)
-  bool seamless = false;      // cones pinned and transitions fixed at the texture's symmetries
-  bool tiled = false;         // the plane texture is the lattice tiling (else a planar quilt)
-  int orbits = 0;             // elements per lattice cell, when tiled
-  int singular_vertices = 0;  // of the line field, after cancelling adjacent pairs
-  int cancelled_cone_pairs = 0;
-  // Cone placement (core/surface/cone_placement): poles split, moves, and the mean squared log
-  // scale of the flat cone metric before and after.
-  int split_poles = 0, cone_moves = 0;
+  bool periodic = false;         // the swatch's lattice was found (core/planar/swatch_symmetry)
+  bool seamless = false;         // cones pinned and transitions fixed at the texture's symmetries
+  bool tiled = false;            // the plane texture is the lattice tiling (else a planar quilt)
+  int orbits = 0;                // elements per lattice cell, when tiled
+  int singular_vertices = 0;     // of the line field, after cancelling adjacent pairs
+  int cancelled_cone_pairs = 0;  // adjacent + and - singularities of the field
+  // Cone placement (core/surface/cone_placement): poles split, moves, + and - cone pairs
+  // cancelled within its allowance of scale, and the mean squared log scale of the flat cone
+  // metric before and after.
+  int split_poles = 0, cone_moves = 0, placement_pairs_cancelled = 0;
   // How far the layout followed the cone metric's scale e^u: e^(a u), a in [0, 1]
   // (SurfaceQuiltingOptions::Global::max_overfill); 0 when the layout is not conformal.
   double scale_exponent = 0;
