@@ -46,14 +46,24 @@ BoundingBox box_of_rows(const MatrixX3d& P) {
   return b;
 }
 
-// How many of the rings near k (within `box`, by the grid) `loop` links.
+BoundingBox box_of_loop(const Loop& loop) {
+  BoundingBox b;
+  for (const Vector3d& p : loop) b.extend(p);
+  return b;
+}
+
+// How many of the rings near k (within `box`, by the grid) `loop` links. Two loops whose boxes
+// are apart cannot link (a plane parts them): only loops whose boxes meet are tested.
 int links_of(const Loop& loop, size_t k, const BoundingBox& box, const ElementGrid& grid,
              const std::vector<std::optional<Loop>>& loops) {
+  const BoundingBox own = box_of_loop(loop);
   int links = 0;
-  for (const int j : grid.near(box))
-    if (static_cast<size_t>(j) != k && loops[static_cast<size_t>(j)] &&
-        linking_number(loop, *loops[static_cast<size_t>(j)]) != 0)
+  for (const int j : grid.near(box)) {
+    const std::optional<Loop>& other = loops[static_cast<size_t>(j)];
+    if (static_cast<size_t>(j) != k && other && ElementGrid::overlap(own, box_of_loop(*other)) &&
+        linking_number(loop, *other) != 0)
       ++links;
+  }
   return links;
 }
 
@@ -157,9 +167,13 @@ std::vector<char> choose_linked_versions(
       if (candidate[k] && !swapped[k] && loops[k])
         gain[k] = judge(x, k, reach[k], grid, loops, options, taken[k]);
     });
+    // The next pass judges again only the candidates whose reach meets a swapped ring's (the
+    // others' neighbours stand as they were judged).
+    ElementGrid moved(V, first, std::vector<char>(ne, 1));
     int changed = 0;
     for (size_t k = 0; k < ne; ++k) {
       if (!taken[k]) continue;
+      moved.insert(static_cast<int>(k), reach[k]);
       const Eigen::Index n = first[k + 1] - first[k];
       V.middleRows(first[k], n).swap(A.middleRows(alternative_first[k], n));
       loops[k] = std::move(taken[k]);
@@ -169,6 +183,8 @@ std::vector<char> choose_linked_versions(
       ++changed;
     }
     if (changed == 0) break;
+    for (size_t k = 0; k < ne; ++k)
+      candidate[k] = candidate[k] && !swapped[k] && !moved.near(reach[k]).empty();
   }
   if (stats) *stats = st;
   return swapped;
