@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/common/errors.h"
+#include "core/mesh/geometry_measures.h"
 #include "core/mesh/linking_number.h"
 #include "core/shell/element_grid.h"
 
@@ -38,12 +39,6 @@ bool sound_ring(const MatrixX3d& P, const SurfaceElement& e, const Loop& loop, d
     if (const std::optional<Loop> flat = ring_centre_loop(e.flat, e.F))
       reference = ring_shape(e.flat, e.F, *flat).fold;
   return shape.fold - reference <= max_fold;
-}
-
-BoundingBox box_of_rows(const MatrixX3d& P) {
-  BoundingBox b;
-  for (Eigen::Index v = 0; v < P.rows(); ++v) b.extend(P.row(v).transpose());
-  return b;
 }
 
 BoundingBox box_of_loop(const Loop& loop) {
@@ -92,8 +87,8 @@ void reach_and_loops(const Versions& x, const std::vector<char>& candidate,
   const ElementGrid grid(x.V, x.first, std::vector<char>(ne, 0));
   tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
     if (!candidate[k]) return;
-    reach[k] = box_of_rows(x.placed(k));
-    const BoundingBox other = box_of_rows(x.other(k));
+    reach[k] = bounding_box(x.placed(k));
+    const BoundingBox other = bounding_box(x.other(k));
     reach[k].extend(other.min);
     reach[k].extend(other.max);
   });
