@@ -896,11 +896,21 @@ std::vector<char> intersecting_thread_pieces(const SurfaceJob& job, const Matrix
     F.middleRows(first_face[k], e.F.rows()) = e.F.array() + static_cast<int>(first[k]);
     std::copy(face_piece[k].begin(), face_piece[k].end(), piece_of.begin() + first_face[k]);
   });
-  IntersectionOptions io;
-  io.between_components_only = false;
+  // Pairs within a piece matter only when its folds do: else only pieces meeting each other are
+  // tested (most face pairs whose boxes meet are neighbours in one piece; the cup's weave job:
+  // placement 0.71-1.05 -> 0.39-0.43 s, the same pieces dropped).
+  std::vector<std::pair<int, int>> pairs;
+  if (drop_folded) {
+    IntersectionOptions io;
+    io.between_components_only = false;
+    pairs = intersecting_face_pairs(V, F, io);
+  } else {
+    pairs = intersecting_face_pairs_touching(V, F, std::vector<char>(piece_of.size(), 1),
+                                             piece_of, false);
+  }
   std::vector<char> drop(num_pieces, 0);
   std::vector<std::pair<int, int>> touching;
-  for (const auto& [f, g] : intersecting_face_pairs(V, F, io)) {
+  for (const auto& [f, g] : pairs) {
     const int a = piece_of[static_cast<size_t>(f)], b = piece_of[static_cast<size_t>(g)];
     if (a != b)
       touching.emplace_back(a, b);
