@@ -13,9 +13,11 @@ namespace mq {
 // Area-weighted fraction of the base (#V by 3 V, #F by 3 F, faces counter-clockwise seen from
 // outside) whose face centroids c have a point q of `output` with |q - c| <= radius and
 // (q - c) . n >= -below, n the face's unit normal; in [0, 1]. The nearest such point of each
-// output triangle is exact (the triangle clipped by that half-space); Embree prunes the
-// triangles, parallel over base faces, deterministic. An empty output covers nothing; a
-// degenerate base face (no normal) counts as covered by any point within the radius.
+// output triangle is exact (the triangle clipped by that half-space); an output vertex (of a
+// face) within the radius decides first, from a grid of the vertices, and Embree prunes the
+// triangles only for the centroids no vertex covers; parallel over base faces, deterministic.
+// An empty output covers nothing; a degenerate base face (no normal) counts as covered by any
+// point within the radius.
 // `faces` (#F(base), or empty: all) limits the measure to the faces set (a mask, issue 25): the
 // fraction of their area covered; 0 when none is set.
 // Throws InvalidInput for a base without faces, non-finite vertices, radius or below < 0 / NaN,

@@ -49,6 +49,29 @@ TEST(SurfaceCoverage, ATriangleReachingOverTheBaseFromBelowCountsByItsPartAbove)
   EXPECT_DOUBLE_EQ(surface_coverage(base, wall, 0.2), 0.0);
 }
 
+TEST(SurfaceCoverage, ByTheOutputsVerticesOrItsTrianglesAlike) {
+  // The vertices decide first, the triangles where none is near. One large triangle over a
+  // 1 x 1 sheet, its corners far beyond the radius of every centroid: covered through its
+  // interior. A vertex no face uses, just over the sheet, covers nothing.
+  const TriMesh base = test::plane_grid(1, 1, 10, 10);
+  TriMesh big;
+  big.V.resize(4, 3);
+  big.V << -5, -5, 0.02, 10, -5, 0.02, -5, 10, 0.02, 0.5, 0.5, 0.01;
+  big.F.resize(1, 3);
+  big.F << 0, 1, 2;
+  EXPECT_DOUBLE_EQ(surface_coverage(base, big, 0.05), 1.0);
+  TriMesh far_face = big;
+  far_face.V.topRows(3).col(2).setConstant(3.0);  // the face far above; vertex 3 unused
+  EXPECT_DOUBLE_EQ(surface_coverage(base, far_face, 0.05), 0.0);
+  // Dense vertices over the left half, the big triangle over all of it under the plane by more
+  // than `below`: the left half (its next centroids lie 1/30 beyond the sheet's edge).
+  TriMesh both = moved(test::plane_grid(0.5, 1, 20, 40), Vector3d(0, 0, 0.01));
+  TriMesh under = big;
+  under.V.col(2).setConstant(-0.05);
+  append_mesh(both, under);
+  EXPECT_NEAR(surface_coverage(base, both, 0.02, 0.01), 0.5, 1e-9);
+}
+
 TEST(SurfaceCoverage, ClosedBaseIndependentOfThreads) {
   const TriMesh cube = test::unit_cube();
   // Texture over the top face only (outside), and a copy of the cube shrunk inside.
