@@ -148,17 +148,18 @@ class VertexGrid {
     if (points_.empty()) return false;
     const Eigen::Array3i m = cell_of(c);
     if ((m < 1).any() || (m > kCells - 2).any()) return false;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const std::uint64_t k = key(m + Eigen::Array3i(dx, dy, dz));
-          auto it = std::lower_bound(points_.begin(), points_.end(), k,
-                                     [](const Point& p, std::uint64_t x) { return p.key < x; });
-          for (; it != points_.end() && it->key == k; ++it) {
-            const Vector3d d = it->p - c;
-            if (d.squaredNorm() <= radius * radius && d.dot(n) >= -below) return true;
-          }
-        }
+    // Three cells along x are consecutive keys: one search per row of them, c's own row first
+    // (where a covering vertex most often is).
+    for (int row = 0; row < 9; ++row) {
+      const int dy = (row + 1) % 3 - 1, dz = (row / 3 + 1) % 3 - 1;
+      const std::uint64_t from = key(m + Eigen::Array3i(-1, dy, dz)), to = from + 2;
+      auto it = std::lower_bound(points_.begin(), points_.end(), from,
+                                 [](const Point& p, std::uint64_t x) { return p.key < x; });
+      for (; it != points_.end() && it->key <= to; ++it) {
+        const Vector3d d = it->p - c;
+        if (d.squaredNorm() <= radius * radius && d.dot(n) >= -below) return true;
+      }
+    }
     return false;
   }
 
