@@ -57,6 +57,7 @@ double clipped_distance(const Vector3d& c, const Vector3d& n, double below, cons
 
 struct Query {
   const TriMesh* output;
+  const std::vector<int>* faces;  // the scene's triangles: output faces
   Vector3d c, n;
   double below, radius;
   bool found = false;
@@ -65,7 +66,7 @@ struct Query {
 bool visit(RTCPointQueryFunctionArguments* args) {
   Query& q = *static_cast<Query*>(args->userPtr);
   if (q.found) return false;
-  const int f = static_cast<int>(args->primID);
+  const int f = (*q.faces)[args->primID];
   const MatrixX3d& V = q.output->V;
   const MatrixX3i& F = q.output->F;
   const double d = clipped_distance(q.c, q.n, q.below, V.row(F(f, 0)).transpose(),
@@ -76,10 +77,11 @@ bool visit(RTCPointQueryFunctionArguments* args) {
   return true;
 }
 
-// The output's triangles in an Embree scene (float copies; released with the object).
+// Some of the output's triangles (`faces`) in an Embree scene (float copies; released with the
+// object).
 class OutputScene {
  public:
-  OutputScene(const EmbreeDevice& device, const TriMesh& output) {
+  OutputScene(const EmbreeDevice& device, const TriMesh& output, const std::vector<int>& faces) {
     scene_ = rtcNewScene(device.get());
     device.check("coverage: rtcNewScene");
     MQ_CHECK(scene_, Error, "coverage: Embree returned no scene");
@@ -90,7 +92,7 @@ class OutputScene {
       auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
           geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), output.V.rows()));
       auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), output.F.rows()));
+          geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), faces.size()));
       if (!vb || !ib) {
         rtcReleaseGeometry(geom);
         device.check("coverage: rtcSetNewGeometryBuffer");
@@ -98,8 +100,8 @@ class OutputScene {
       }
       for (Eigen::Index i = 0; i < output.V.rows(); ++i)
         for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(output.V(i, k));
-      for (Eigen::Index f = 0; f < output.F.rows(); ++f)
-        for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(output.F(f, k));
+      for (size_t i = 0; i < faces.size(); ++i)
+        for (int k = 0; k < 3; ++k) ib[3 * i + k] = static_cast<unsigned>(output.F(faces[i], k));
       rtcCommitGeometry(geom);
       rtcAttachGeometry(scene_, geom);
       rtcReleaseGeometry(geom);
@@ -182,6 +184,60 @@ class VertexGrid {
   std::vector<Point> points_;
 };
 
+// The output's triangles whose box, grown by the radius, holds one of `points`: the only ones
+// that can cover them (cup job: the triangle pass for the few centroids no vertex covers then
+// builds its BVH over them instead of the whole output). Ascending; a triangle whose grown box
+// spans more than 64 cells of the points' grid is taken unchecked.
+std::vector<int> triangles_near(const TriMesh& output, const std::vector<Vector3d>& points,
+                                double radius) {
+  constexpr int kCells = 1 << 20;
+  BoundingBox box;
+  for (const Vector3d& p : points) box.extend(p);
+  const double grow = radius * (1 + 1e-9) + 1e-300;
+  const double cell = std::max(grow, box.extent().maxCoeff() / (kCells / 2.0));
+  const Eigen::Array3d origin = box.min.array() - cell;
+  const auto cell_of = [&](const Eigen::Array3d& x) {
+    return ((x - origin) / cell).floor().max(0.0).min(kCells - 1.0).cast<std::int64_t>().eval();
+  };
+  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return static_cast<std::uint64_t>((z << 40) | (y << 20) | x);
+  };
+  std::vector<std::uint64_t> keys;
+  for (const Vector3d& p : points) {
+    const auto c = cell_of(p.array());
+    keys.push_back(key(c.x(), c.y(), c.z()));
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<char> near(static_cast<size_t>(output.F.rows()), 0);
+  tbb::parallel_for(Eigen::Index(0), output.F.rows(), [&](Eigen::Index f) {
+    Eigen::Array3d lo = output.V.row(output.F(f, 0)).transpose().array(), hi = lo;
+    for (int k = 1; k < 3; ++k) {
+      lo = lo.min(output.V.row(output.F(f, k)).transpose().array());
+      hi = hi.max(output.V.row(output.F(f, k)).transpose().array());
+    }
+    lo -= grow;
+    hi += grow;
+    if ((hi < box.min.array()).any() || (lo > box.max.array()).any()) return;
+    const auto a = cell_of(lo), b = cell_of(hi);
+    if ((b - a + 1).prod() > 64) {
+      near[static_cast<size_t>(f)] = 1;
+      return;
+    }
+    for (std::int64_t z = a.z(); z <= b.z(); ++z)
+      for (std::int64_t y = a.y(); y <= b.y(); ++y) {
+        const auto it = std::lower_bound(keys.begin(), keys.end(), key(a.x(), y, z));
+        if (it != keys.end() && *it <= key(b.x(), y, z)) {
+          near[static_cast<size_t>(f)] = 1;
+          return;
+        }
+      }
+  });
+  std::vector<int> faces;
+  for (Eigen::Index f = 0; f < output.F.rows(); ++f)
+    if (near[static_cast<size_t>(f)]) faces.push_back(static_cast<int>(f));
+  return faces;
+}
+
 // Whether base face f is measured: all are without a mask (`faces` empty).
 bool counted(const std::vector<char>& faces, Eigen::Index f) {
   return faces.empty() || faces[static_cast<size_t>(f)] != 0;
@@ -189,7 +245,8 @@ bool counted(const std::vector<char>& faces, Eigen::Index f) {
 
 // Per base face (those counted): whether output geometry lies within the radius of its
 // centroid on its outer side (visit: the first triangle found ends the query).
-std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& output, RTCScene scene,
+std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& output,
+                                         const std::vector<int>& scene_faces, RTCScene scene,
                                          double radius, double below,
                                          const std::vector<char>& faces) {
   std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
@@ -204,6 +261,7 @@ std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& out
     if (!counted(faces, f)) return;
     Query q;
     q.output = &output;
+    q.faces = &scene_faces;
     q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
               .transpose() /
           3.0;
@@ -256,11 +314,20 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
       left[static_cast<size_t>(f)] = !covered[static_cast<size_t>(f)];
     });
   }
-  if (std::find(left.begin(), left.end(), 1) != left.end()) {
+  std::vector<Vector3d> points;  // the centroids left
+  for (Eigen::Index f = 0; f < base.F.rows(); ++f)
+    if (left[static_cast<size_t>(f)])
+      points.emplace_back(
+          (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
+              .transpose() /
+          3.0);
+  const std::vector<int> near =
+      points.empty() ? std::vector<int>() : triangles_near(output, points, radius);
+  if (!near.empty()) {
     const EmbreeDevice device;
-    const OutputScene scene(device, output);
+    const OutputScene scene(device, output, near);
     const std::vector<unsigned char> by_triangles =
-        covered_faces(base, output, scene.get(), radius, below, left);
+        covered_faces(base, output, near, scene.get(), radius, below, left);
     for (size_t f = 0; f < covered.size(); ++f) covered[f] = covered[f] || by_triangles[f];
   }
   const Eigen::VectorXd A = face_areas(base.V, base.F);
