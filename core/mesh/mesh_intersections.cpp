@@ -445,6 +445,14 @@ std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, con
   return find_pairs(V, F, &component, false);
 }
 
+std::vector<std::pair<int, int>> intersecting_face_pairs_between(const MatrixX3d& V,
+                                                                 const MatrixX3i& F,
+                                                                 const std::vector<int>& label) {
+  MQ_CHECK(static_cast<Eigen::Index>(label.size()) == F.rows(), InvalidInput,
+           "intersection test: ", label.size(), " labels for ", F.rows(), " faces");
+  return find_pairs(V, F, &label, false);
+}
+
 std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3d& V,
                                                                   const MatrixX3i& F,
                                                                   const std::vector<char>& active) {

@@ -32,6 +32,13 @@ struct IntersectionOptions {
 std::vector<std::pair<int, int>> intersecting_face_pairs(const MatrixX3d& V, const MatrixX3i& F,
                                                          const IntersectionOptions& options = {});
 
+// The intersecting pairs of faces with different labels (#F labels, >= 0: the piece of each
+// face, say), each pair (f, g), f < g, sorted; faces of one label are not tested against each
+// other. Throws like intersecting_face_pairs, and InvalidInput for #labels != #F.
+std::vector<std::pair<int, int>> intersecting_face_pairs_between(const MatrixX3d& V,
+                                                                 const MatrixX3i& F,
+                                                                 const std::vector<int>& label);
+
 // The pairs of intersecting_face_pairs with between_components_only = false that hold at least
 // one face with active[f] != 0 (#F flags), at a cost in proportion to the active faces' share
 // of the narrow phase: for re-testing after a few faces moved. Same order and throws.

@@ -121,7 +121,24 @@ class OutputScene {
   RTCScene scene_ = nullptr;
 };
 
-// The output's vertices that faces use, sorted by the cell of a grid `cell` wide they lie in: a
+// Cells of a uniform grid keyed by 20 bits per axis (x lowest: three cells along x are
+// consecutive keys), clamped to the grid: what the vertex pass and the triangle filter below
+// look points up by.
+struct CellKeys {
+  static constexpr int kCells = 1 << 20;
+  Eigen::Array3d origin = Eigen::Array3d::Zero();
+  double cell = 1;
+
+  Eigen::Array3i cell_of(const Eigen::Array3d& p) const {
+    return ((p - origin) / cell).floor().max(0.0).min(kCells - 1.0).cast<int>();
+  }
+  static std::uint64_t key(const Eigen::Array3i& c) {
+    return (static_cast<std::uint64_t>(c.z()) << 40) | (static_cast<std::uint64_t>(c.y()) << 20) |
+           static_cast<std::uint64_t>(c.x());
+  }
+};
+
+// The output's vertices that faces use, sorted by the cell (one radius wide) they lie in: a
 // base point with one of them within the radius on its outer side is covered (a vertex is a
 // point of its triangles, and the triangle query would find that one or a nearer point), and
 // where every point is, the triangles' BVH is never built (armor job: 2.7M output faces, 3,344
@@ -129,17 +146,20 @@ class OutputScene {
 // cells along an axis.
 class VertexGrid {
  public:
-  VertexGrid(const TriMesh& output, double cell) : cell_(cell) {
+  VertexGrid(const TriMesh& output, double radius) {
     const Eigen::Index nv = output.V.rows();
     std::vector<char> used(static_cast<size_t>(nv), 0);
     for (Eigen::Index f = 0; f < output.F.rows(); ++f)
       for (int k = 0; k < 3; ++k) used[static_cast<size_t>(output.F(f, k))] = 1;
     const BoundingBox box = bounding_box(output.V);
-    if (!(cell > 0) || !((box.extent() / cell).maxCoeff() < kCells - 2)) return;
-    origin_ = box.min.array() - cell;
+    if (!(radius > 0) || !((box.extent() / radius).maxCoeff() < CellKeys::kCells - 2)) return;
+    grid_.origin = box.min.array() - radius;
+    grid_.cell = radius;
     for (Eigen::Index v = 0; v < nv; ++v)
-      if (used[static_cast<size_t>(v)])
-        points_.push_back({key(cell_of(output.V.row(v).transpose())), output.V.row(v)});
+      if (used[static_cast<size_t>(v)]) {
+        const Vector3d p = output.V.row(v).transpose();
+        points_.push_back({CellKeys::key(grid_.cell_of(p.array())), p});
+      }
     // Whether a vertex covers a point does not depend on the order within a cell.
     tbb::parallel_sort(points_.begin(), points_.end(),
                        [](const Point& a, const Point& b) { return a.key < b.key; });
@@ -148,13 +168,13 @@ class VertexGrid {
   // Is a vertex within `radius` (at most the cell) of c with (v - c) . n >= -below?
   bool covers(const Vector3d& c, const Vector3d& n, double radius, double below) const {
     if (points_.empty()) return false;
-    const Eigen::Array3i m = cell_of(c);
-    if ((m < 1).any() || (m > kCells - 2).any()) return false;
-    // Three cells along x are consecutive keys: one search per row of them, c's own row first
-    // (where a covering vertex most often is).
+    const Eigen::Array3i m = grid_.cell_of(c.array());
+    if ((m < 1).any() || (m > CellKeys::kCells - 2).any()) return false;
+    // One search per row of three cells along x, c's own row first (where a covering vertex
+    // most often is).
     for (int row = 0; row < 9; ++row) {
       const int dy = (row + 1) % 3 - 1, dz = (row / 3 + 1) % 3 - 1;
-      const std::uint64_t from = key(m + Eigen::Array3i(-1, dy, dz)), to = from + 2;
+      const std::uint64_t from = CellKeys::key(m + Eigen::Array3i(-1, dy, dz)), to = from + 2;
       auto it = std::lower_bound(points_.begin(), points_.end(), from,
                                  [](const Point& p, std::uint64_t x) { return p.key < x; });
       for (; it != points_.end() && it->key <= to; ++it) {
@@ -166,47 +186,27 @@ class VertexGrid {
   }
 
  private:
-  static constexpr int kCells = 1 << 20;
   struct Point {
     std::uint64_t key;
     Vector3d p;
   };
-  Eigen::Array3i cell_of(const Vector3d& p) const {
-    const Eigen::Array3d x = ((p.array() - origin_) / cell_).floor();
-    return x.max(0.0).min(static_cast<double>(kCells - 1)).cast<int>();
-  }
-  static std::uint64_t key(const Eigen::Array3i& c) {
-    return (static_cast<std::uint64_t>(c.z()) << 40) | (static_cast<std::uint64_t>(c.y()) << 20) |
-           static_cast<std::uint64_t>(c.x());
-  }
-  double cell_;
-  Eigen::Array3d origin_ = Eigen::Array3d::Zero();
+  CellKeys grid_;
   std::vector<Point> points_;
 };
 
-// The output's triangles whose box, grown by the radius, holds one of `points`: the only ones
-// that can cover them (cup job: the triangle pass for the few centroids no vertex covers then
-// builds its BVH over them instead of the whole output). Ascending; a triangle whose grown box
-// spans more than 64 cells of the points' grid is taken unchecked.
-std::vector<int> triangles_near(const TriMesh& output, const std::vector<Vector3d>& points,
-                                double radius) {
-  constexpr int kCells = 1 << 20;
-  BoundingBox box;
-  for (const Vector3d& p : points) box.extend(p);
+// The output's triangles whose box, grown by the radius, holds one of the rows of `points`: the
+// only ones that can cover them (cup job: the triangle pass for the few centroids no vertex
+// covers then builds its BVH over them instead of the whole output). Ascending; a triangle
+// whose grown box spans more than 64 cells of the points' grid is taken unchecked.
+std::vector<int> triangles_near(const TriMesh& output, const MatrixX3d& points, double radius) {
+  const BoundingBox box = bounding_box(points);
   const double grow = radius * (1 + 1e-9) + 1e-300;
-  const double cell = std::max(grow, box.extent().maxCoeff() / (kCells / 2.0));
-  const Eigen::Array3d origin = box.min.array() - cell;
-  const auto cell_of = [&](const Eigen::Array3d& x) {
-    return ((x - origin) / cell).floor().max(0.0).min(kCells - 1.0).cast<std::int64_t>().eval();
-  };
-  const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return static_cast<std::uint64_t>((z << 40) | (y << 20) | x);
-  };
+  CellKeys grid;
+  grid.cell = std::max(grow, box.extent().maxCoeff() / (CellKeys::kCells / 2.0));
+  grid.origin = box.min.array() - grid.cell;
   std::vector<std::uint64_t> keys;
-  for (const Vector3d& p : points) {
-    const auto c = cell_of(p.array());
-    keys.push_back(key(c.x(), c.y(), c.z()));
-  }
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+    keys.push_back(CellKeys::key(grid.cell_of(points.row(i).transpose().array())));
   std::sort(keys.begin(), keys.end());
   std::vector<char> near(static_cast<size_t>(output.F.rows()), 0);
   tbb::parallel_for(Eigen::Index(0), output.F.rows(), [&](Eigen::Index f) {
@@ -218,15 +218,15 @@ std::vector<int> triangles_near(const TriMesh& output, const std::vector<Vector3
     lo -= grow;
     hi += grow;
     if ((hi < box.min.array()).any() || (lo > box.max.array()).any()) return;
-    const auto a = cell_of(lo), b = cell_of(hi);
-    if ((b - a + 1).prod() > 64) {
+    const Eigen::Array3i a = grid.cell_of(lo), b = grid.cell_of(hi);
+    if ((b - a + 1).cast<std::int64_t>().prod() > 64) {
       near[static_cast<size_t>(f)] = 1;
       return;
     }
-    for (std::int64_t z = a.z(); z <= b.z(); ++z)
-      for (std::int64_t y = a.y(); y <= b.y(); ++y) {
-        const auto it = std::lower_bound(keys.begin(), keys.end(), key(a.x(), y, z));
-        if (it != keys.end() && *it <= key(b.x(), y, z)) {
+    for (int z = a.z(); z <= b.z(); ++z)
+      for (int y = a.y(); y <= b.y(); ++y) {
+        const auto it = std::lower_bound(keys.begin(), keys.end(), CellKeys::key({a.x(), y, z}));
+        if (it != keys.end() && *it <= CellKeys::key({b.x(), y, z})) {
           near[static_cast<size_t>(f)] = 1;
           return;
         }
@@ -245,26 +245,24 @@ bool counted(const std::vector<char>& faces, Eigen::Index f) {
 
 // Per base face (those counted): whether output geometry lies within the radius of its
 // centroid on its outer side (visit: the first triangle found ends the query).
-std::vector<unsigned char> covered_faces(const TriMesh& base, const TriMesh& output,
-                                         const std::vector<int>& scene_faces, RTCScene scene,
-                                         double radius, double below,
+//   C, N  #F(base) by 3 face centroids and unit normals
+std::vector<unsigned char> covered_faces(const MatrixX3d& C, const MatrixX3d& N,
+                                         const TriMesh& output, const std::vector<int>& scene_faces,
+                                         RTCScene scene, double radius, double below,
                                          const std::vector<char>& faces) {
-  std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
+  std::vector<unsigned char> covered(static_cast<size_t>(C.rows()), 0);
   const BoundingBox box = bounding_box(output.V);
   // Float bounds and a float query point: the radius handed to Embree is enlarged far above
   // their rounding; every triangle is then measured exactly in double.
   const double slack = 1e-6 * (box.extent().norm() + std::max(box.min.cwiseAbs().maxCoeff(),
                                                               box.max.cwiseAbs().maxCoeff())) +
                        1e-30;
-  const MatrixX3d N = face_normals(base.V, base.F);
-  tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
+  tbb::parallel_for(Eigen::Index(0), C.rows(), [&](Eigen::Index f) {
     if (!counted(faces, f)) return;
     Query q;
     q.output = &output;
     q.faces = &scene_faces;
-    q.c = (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
-              .transpose() /
-          3.0;
+    q.c = C.row(f).transpose();
     q.n = N.row(f).transpose();
     q.below = below;
     q.radius = radius;
@@ -299,35 +297,35 @@ double surface_coverage(const TriMesh& base, const TriMesh& output, double radiu
   MQ_CHECK(output.F.minCoeff() >= 0 && output.F.maxCoeff() < output.V.rows(), InvalidInput,
            "coverage: an output face index is out of range");
   // First by the output's vertices, then the faces left by the output's triangles.
+  MatrixX3d C(base.F.rows(), 3);
+  for (Eigen::Index f = 0; f < base.F.rows(); ++f)
+    C.row(f) =
+        (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2))) / 3.0;
+  const MatrixX3d N = face_normals(base.V, base.F);
   std::vector<unsigned char> covered(static_cast<size_t>(base.F.rows()), 0);
-  std::vector<char> left(static_cast<size_t>(base.F.rows()), 0);
   {
     const VertexGrid grid(output, radius);
-    const MatrixX3d N = face_normals(base.V, base.F);
     tbb::parallel_for(Eigen::Index(0), base.F.rows(), [&](Eigen::Index f) {
-      if (!counted(faces, f)) return;
-      const Vector3d c =
-          (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
-              .transpose() /
-          3.0;
-      covered[static_cast<size_t>(f)] = grid.covers(c, N.row(f).transpose(), radius, below);
-      left[static_cast<size_t>(f)] = !covered[static_cast<size_t>(f)];
+      if (counted(faces, f))
+        covered[static_cast<size_t>(f)] =
+            grid.covers(C.row(f).transpose(), N.row(f).transpose(), radius, below);
     });
   }
-  std::vector<Vector3d> points;  // the centroids left
+  std::vector<char> left(static_cast<size_t>(base.F.rows()), 0);
+  std::vector<Eigen::Index> left_rows;
   for (Eigen::Index f = 0; f < base.F.rows(); ++f)
-    if (left[static_cast<size_t>(f)])
-      points.emplace_back(
-          (base.V.row(base.F(f, 0)) + base.V.row(base.F(f, 1)) + base.V.row(base.F(f, 2)))
-              .transpose() /
-          3.0);
-  const std::vector<int> near =
-      points.empty() ? std::vector<int>() : triangles_near(output, points, radius);
+    if (counted(faces, f) && !covered[static_cast<size_t>(f)]) {
+      left[static_cast<size_t>(f)] = 1;
+      left_rows.push_back(f);
+    }
+  const std::vector<int> near = left_rows.empty()
+                                    ? std::vector<int>()
+                                    : triangles_near(output, C(left_rows, Eigen::all), radius);
   if (!near.empty()) {
     const EmbreeDevice device;
     const OutputScene scene(device, output, near);
     const std::vector<unsigned char> by_triangles =
-        covered_faces(base, output, near, scene.get(), radius, below, left);
+        covered_faces(C, N, output, near, scene.get(), radius, below, left);
     for (size_t f = 0; f < covered.size(); ++f) covered[f] = covered[f] || by_triangles[f];
   }
   const Eigen::VectorXd A = face_areas(base.V, base.F);

@@ -905,8 +905,7 @@ std::vector<char> intersecting_thread_pieces(const SurfaceJob& job, const Matrix
     io.between_components_only = false;
     pairs = intersecting_face_pairs(V, F, io);
   } else {
-    pairs = intersecting_face_pairs_touching(V, F, std::vector<char>(piece_of.size(), 1), piece_of,
-                                             false);
+    pairs = intersecting_face_pairs_between(V, F, piece_of);
   }
   std::vector<char> drop(num_pieces, 0);
   std::vector<std::pair<int, int>> touching;
