@@ -277,9 +277,9 @@ void declare_surface_options(CommandLine& cl) {
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "
             "again on the base moved (posed, animated) without a new synthesis");
   cl.option("swatch-frames", "PATTERN",
-            "animate the result with the swatch (vines: ivy; lattices: chain mail): frames of the "
-            "swatch, the same mesh "
-            "with its vertices moved, named by a pattern with one frame number (%d or %0Nd; "
+            "animate the result with the swatch (any method: ivy, chain mail, weave, apples): "
+            "frames of the swatch, the same mesh with its vertices moved, named by a pattern with "
+            "one frame number (%d or %0Nd; "
             "'meshquilt swatch ivy --frames N' makes some). Each output vertex moves as the point "
             "of the swatch it came from, in its own frame on the base; with --frames A-B, -o is a "
             "pattern too and one output is written per frame (same faces and element order)");
@@ -664,18 +664,14 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
   SurfaceOutcome o;
   SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
-  // Only elements that are copies of swatch elements know their sources (issue 25; the layouts
-  // that keep them say so, SurfaceQuiltingOptions::keep_sources): refused before the embedding.
+  // Every method keeps the sources when asked (SurfaceQuiltingOptions::keep_sources, issue 25):
+  // an element without them is a fault of ours, found before the embedding.
   const bool sourced =
       std::all_of(quilt.elements.begin(), quilt.elements.end(), [](const SurfaceElement& e) {
         return e.source.rows() == static_cast<Eigen::Index>(e.face.size());
       });
-  MQ_CHECK(r.frames.empty() || sourced, InvalidInput,
-           "--swatch-frames: a swatch animation is followed by the vine method (ivy) and the "
-           "global layout's lattice of separate elements (chain mail) only; this swatch took ",
-           o.global ? (o.global_stats.threads ? "the global layout's threads"
-                                              : "the global layout's plane quilt")
-                    : "the local patches");
+  MQ_CHECK(r.frames.empty() || sourced, InternalError,
+           "--swatch-frames: the result's elements do not say where in the swatch they come from");
   if (cl.has("mask")) {
     r.embedding.coverage_faces = mask_quilt_faces(in.mask, in.base, quilt);
     drop_unmasked_elements(quilt, r.embedding.coverage_faces);

@@ -124,8 +124,8 @@ class MeshquiltSettings(bpy.types.PropertyGroup):
     swatch_motion: bpy.props.BoolProperty(
         name="Swatch motion", default=False,
         description="The swatch object's own animation (shape keys, armature, modifiers) over "
-        "the scene's frame range, followed by the result: one shape key a frame. A vine with "
-        "leaves (like the Ivy sample) only, at Detail 100%")
+        "the scene's frame range, followed by the result: one shape key a frame. Any swatch, "
+        "at Detail 100%")
     # The engine's last estimate (meshquilt.estimate) and the settings it was made for.
     estimate_key: bpy.props.StringProperty(options={"SKIP_SAVE"})
     estimate_faces: bpy.props.IntProperty(name="Estimated faces", options={"SKIP_SAVE"})

@@ -430,10 +430,6 @@ def artist_message(error, scale, limit_gib, base="the base", swatch="the swatch"
             cause = "the elements are too large for its parts"
         return ("meshquilt: %s only %.0f%% of %s would be covered (%.0f%% needed): %s; %s; "
                 "nothing was added" % (at, got, base, needed, cause, smaller))
-    if text.startswith("--swatch-frames: a swatch animation is followed by the vine method"):
-        return ("meshquilt: Swatch motion follows a vine with leaves (like the Ivy sample) or "
-                "a lattice of separate elements (like Chain mail) only, and %s is laid out "
-                "otherwise: clear Swatch motion" % swatch)
     if text.startswith("the size map's largest value"):
         return "meshquilt: the Size group's sizes are too far apart: raise Smallest in the panel"
     if text.startswith("no element of the swatch could be placed"):

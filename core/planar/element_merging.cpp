@@ -128,11 +128,12 @@ std::vector<CutLabel> swatch_labels(const Element& in, const Element& out,
   return hard;
 }
 
-TriMesh kept_part(const Element& e, const std::vector<bool>& keep) {
+// The faces of e that `keep` marks; `vertices`: e's vertex each of the part's is.
+TriMesh kept_part(const Element& e, const std::vector<bool>& keep, std::vector<int>& vertices) {
   std::vector<int> faces;
   for (size_t f = 0; f < keep.size(); ++f)
     if (keep[f]) faces.push_back(static_cast<int>(f));
-  return extract_faces(e.mesh(), faces);
+  return extract_faces(e.mesh(), faces, &vertices);
 }
 
 }  // namespace
@@ -252,7 +253,8 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
       out_V, out.F, dist_out / unit, output_labels(out, query_in, region, cover));
   const std::vector<bool> keep_in = graph_cut_keep_faces(
       in_V, in.F, dist_in / unit, swatch_labels(in, out, keep_out, query_out, region, cover));
-  const TriMesh a = kept_part(out, keep_out), b = kept_part(in, keep_in);
+  std::vector<int> from_out, from_in;
+  const TriMesh a = kept_part(out, keep_out, from_out), b = kept_part(in, keep_in, from_in);
   if (a.F.rows() == 0 || b.F.rows() == 0) return fail(StitchFailure::EmptyCut);
   if (a.F.rows() == out.F.rows() || b.F.rows() == in.F.rows())
     return fail(StitchFailure::NothingCut);
@@ -279,6 +281,13 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   result.V = deform_element(stitched->mesh.V, stitched->mesh.F, constraints, deformation);
   result.F = stitched->mesh.F;
   result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
+  // The stitched vertices are the kept parts' (section 2.7 adds none), some of B's welded.
+  std::vector<int> parts_vertex = from_out;
+  for (const int v : from_in) parts_vertex.push_back(v);
+  std::vector<int> from_out_kept, from_in_kept;
+  for (const int v : stitched->origin)
+    (v < a.num_vertices() ? from_out_kept : from_in_kept).push_back(parts_vertex[v]);
+  carry_sources({{&out, &from_out_kept}, {&in, &from_in_kept}}, result);
   result.update();
   if (const StitchFailure why = merged_failure(result, out, in, mean_edge_length);
       why != StitchFailure::None)

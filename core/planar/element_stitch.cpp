@@ -200,7 +200,10 @@ std::optional<StitchResult> stitch_cut_elements(const TriMesh& A, const TriMesh&
   std::vector<int> index(V.rows(), -1);
   int count = 0;
   for (int v = 0; v < V.rows(); ++v)
-    if (replace[v] == v) index[v] = count++;
+    if (replace[v] == v) {
+      index[v] = count++;
+      result.origin.push_back(v);
+    }
   if (count < V.rows()) {
     MatrixX3d W(count, 3);
     for (int v = 0; v < V.rows(); ++v)

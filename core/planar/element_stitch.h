@@ -19,10 +19,12 @@ struct StitchOptions {
 };
 
 struct StitchResult {
-  // A's vertices, then B's (indices shifted by A.num_vertices()), then no new vertex; A's
-  // faces, then B's, then the bridge triangles. One connected component; the bridged loops
-  // leave no boundary edge. N is kept only when both A and B have normals.
+  // A's vertices, then B's (indices shifted by A.num_vertices()) but those welded onto A's, then
+  // no new vertex; A's faces, then B's, then the bridge triangles. One connected component; the
+  // bridged loops leave no boundary edge. N is kept only when both A and B have normals.
   TriMesh mesh;
+  // #V(mesh): the vertex of A, or of B shifted by A.num_vertices(), each of mesh's is.
+  std::vector<int> origin;
   // One point constraint per seam vertex (mesh numbering): the average of the vertex and its
   // closest point on the opposite loop, ready for the Eq. (5) deformation of the merged part.
   std::vector<LinearConstraint> constraints;

@@ -163,6 +163,8 @@ void deform_related(Patch& patch, const PreparedSwatch& swatch, const SwatchQuer
     if (is_out) {
       e.F = patch.frame[k].F;
       e.kind = patch.frame[k].kind;
+      e.source = patch.frame[k].source;
+      e.source_element = patch.frame[k].source_element;
     }
     e.V = std::move(solved[j]);
     e.update();

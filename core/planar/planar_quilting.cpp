@@ -270,13 +270,7 @@ class PlaneQuilter {
           c.y() <= domain_hi_.y())
         faces.push_back(f);
     }
-    const TriMesh part = extract_faces(e.mesh(), faces);
-    Element t;
-    t.V = part.V;
-    t.F = part.F;
-    t.kind = e.kind;
-    t.update();
-    return t;
+    return element_part(e, faces);
   }
 
   const PreparedSwatch& swatch_;
@@ -322,12 +316,13 @@ double matching_cell_size(const PreparedSwatch& s) {
 
 TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& options,
                     TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats_out,
-                    ProgressSink* progress) {
+                    ProgressSink* progress, PlaneSources* sources) {
   PlanarQuiltingStats stats;
   PreparedSwatch swatch;
   {
     ScopedStageTimer timer(stats.times, Stage::Prepare);
     swatch = prepare_swatch(swatch_mesh);
+    if (sources) track_sources(swatch);
     // After the swatch, so that a bad swatch is what a job with both wrong is refused for.
     options.validate();
     check_against_swatch(swatch, options);
@@ -346,6 +341,20 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   const std::vector<const Element*> kept = quilter.keep_in_domain(trimmed);
   TriMesh result = merge_elements(kept);
   result.kinds = swatch.kinds;
+  if (sources) {
+    sources->point.resize(result.num_vertices(), 3);
+    sources->element.clear();
+    Eigen::Index row = 0;
+    for (const Element* e : kept) {
+      MQ_CHECK(e->source.rows() == e->V.rows() &&
+                   e->source_element.size() == static_cast<size_t>(e->V.rows()),
+               InternalError, "planar quilting: an element lost its sources");
+      sources->point.middleRows(row, e->V.rows()) = e->source;
+      sources->element.insert(sources->element.end(), e->source_element.begin(),
+                              e->source_element.end());
+      row += e->V.rows();
+    }
+  }
   // Back to the swatch's own axes (the thickness axis returns to where it was).
   const Eigen::Matrix3d back = swatch.rotation.transpose();
   result.V = (result.V * back.transpose()).eval();

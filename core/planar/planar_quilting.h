@@ -57,6 +57,12 @@ struct PlanarQuiltingStats {
   StageTimes times;
 };
 
+// Where each vertex of a planar quilt comes from (Element::source), in the quilt's vertex order.
+struct PlaneSources {
+  MatrixX3d point;           // #V by 3: a point of the prepared swatch, in its synthesis frame
+  std::vector<int> element;  // #V: the prepared swatch's element it lies on
+};
+
 // The default grid cell of the matching (section 2.3's grid): half an element across, and at
 // least 8 cells along the swatch's shorter side.
 double matching_cell_size(const PreparedSwatch& swatch);
@@ -67,8 +73,10 @@ double matching_cell_size(const PreparedSwatch& swatch);
 // Throws InvalidInput for impossible parameters (options.validate(), a domain smaller than
 // every element of the swatch, a cell larger than the swatch or making too many cells, an
 // output too large to hold in memory) and for a swatch prepare_swatch rejects.
+// sources (optional): where each output vertex comes from in the swatch (issue 25, swatch
+// animation; Element::source), the elements being copies of the swatch's, cut and stitched.
 TriMesh quilt_plane(const TriMesh& swatch, const PlanarQuiltingOptions& options,
                     TranslationCostEvaluator& evaluator, PlanarQuiltingStats* stats = nullptr,
-                    ProgressSink* progress = nullptr);
+                    ProgressSink* progress = nullptr, PlaneSources* sources = nullptr);
 
 }  // namespace mq

@@ -42,6 +42,38 @@ std::vector<Element> split_elements(const TriMesh& mesh) {
   return elements;
 }
 
+Element element_part(const Element& e, const std::vector<int>& faces) {
+  std::vector<int> vertices;
+  const TriMesh part = extract_faces(e.mesh(), faces, &vertices);
+  Element out;
+  out.V = part.V;
+  out.F = part.F;
+  out.kind = e.kind;
+  carry_sources({{&e, &vertices}}, out);
+  out.update();
+  return out;
+}
+
+void carry_sources(const std::vector<SourcePart>& parts, Element& to) {
+  to.source.resize(0, 3);
+  to.source_element.clear();
+  size_t n = 0;
+  for (const SourcePart& p : parts) {
+    if (p.from->source.rows() != p.from->V.rows() ||
+        p.from->source_element.size() != static_cast<size_t>(p.from->V.rows()))
+      return;
+    n += p.vertices->size();
+  }
+  to.source.resize(static_cast<Eigen::Index>(n), 3);
+  to.source_element.reserve(n);
+  Eigen::Index row = 0;
+  for (const SourcePart& p : parts)
+    for (const int v : *p.vertices) {
+      to.source.row(row++) = p.from->source.row(v);
+      to.source_element.push_back(p.from->source_element[static_cast<size_t>(v)]);
+    }
+}
+
 TriMesh merge_elements(const std::vector<const Element*>& elements) {
   Eigen::Index nv = 0, nf = 0;
   for (const Element* e : elements) {
@@ -120,6 +152,14 @@ PreparedSwatch prepare_swatch(const TriMesh& swatch) {
     v0 += static_cast<int>(s.elements[e].V.rows());
   }
   return s;
+}
+
+void track_sources(PreparedSwatch& swatch) {
+  for (size_t i = 0; i < swatch.elements.size(); ++i) {
+    Element& e = swatch.elements[i];
+    e.source = e.V;
+    e.source_element.assign(static_cast<size_t>(e.V.rows()), static_cast<int>(i));
+  }
 }
 
 }  // namespace mq

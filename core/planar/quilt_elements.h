@@ -17,6 +17,12 @@ struct Element {
   Vector2d lo = Vector2d::Zero(), hi = Vector2d::Zero();  // xy footprint bounding box
   double z_lo = 0, z_hi = 0;
   int kind = 0;  // index into the swatch's kinds (PreparedSwatch::kinds); copies keep it
+  // Optional (issue 25, swatch animation): where each vertex comes from, a point of the prepared
+  // swatch's element source_element[v] in its synthesis frame (#V by 3 and #V, or both empty:
+  // not tracked). track_sources sets them on the swatch; copies keep them, element_part and the
+  // stitch (section 2.7) carry them vertex for vertex, and deformations leave them as they are.
+  MatrixX3d source;
+  std::vector<int> source_element;
 
   // Recomputes normals and bounds after V changed.
   void update();
@@ -35,6 +41,20 @@ struct Element {
 // Splits a mesh into elements, in order of each component's first face. An element's kind is
 // the one most of its faces have in mesh (component_kinds), 0 when mesh has no kinds.
 std::vector<Element> split_elements(const TriMesh& mesh);
+
+// The faces `faces` of e (indices into e.F) as an element of its own, vertices numbered by first
+// use, sources carried (Element::source), normals and bounds updated.
+Element element_part(const Element& e, const std::vector<int>& faces);
+
+// One part of an element made of others: the vertices of `from` it takes, in its order.
+struct SourcePart {
+  const Element* from = nullptr;
+  const std::vector<int>* vertices = nullptr;
+};
+
+// Sets to's sources (Element::source) to those of the parts' vertices, part after part; none
+// when some part has none.
+void carry_sources(const std::vector<SourcePart>& parts, Element& to);
 
 // Concatenates elements into one mesh (in order). face_kind holds each face's element kind;
 // kinds is left empty for the caller to name (PreparedSwatch::kinds).
@@ -59,5 +79,9 @@ struct PreparedSwatch {
 // Validates and prepares a swatch. Throws InvalidInput for an empty mesh, non-finite
 // coordinates, out-of-range indices, or a swatch whose footprint has zero area.
 PreparedSwatch prepare_swatch(const TriMesh& swatch);
+
+// Makes every swatch element its own source (Element::source: its vertices, element i), so that
+// the copies a quilt is made of say where each of their vertices comes from.
+void track_sources(PreparedSwatch& swatch);
 
 }  // namespace mq

@@ -2,13 +2,16 @@
 
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
 
 #include "core/common/errors.h"
+#include "core/common/union_find.h"
 #include "core/mesh/closest_point_query.h"
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_topology.h"
@@ -67,22 +70,38 @@ SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<in
   for (const Element& e : prepared.elements) element_faces_.push_back(e.F);
   const MatrixX3d source = gather_sources(quilt, kept, prepared);
   locate_sources(quilt.repeat, prepared, source);
+  part_ = element_;
   // Each vertex's frame: on the repeated element (a stem), the points within the shell height of
   // it in the swatch (sources unwrapped) fitted onto theirs in the output; that reach spans the
-  // stem's cross-section, which so turns as one. A compact element takes one frame.
+  // stem's cross-section, which so turns as one. Any other element takes one frame per part
+  // (find_parts; a frame per vertex turned a stitched thread's deformed stretches by up to 10
+  // degrees on a plane, enough to push it through the threads crossing it), which a long one
+  // bends with the surface (bend_with_surface).
   const double reach = prepared.size.z();
   rotation_.resize(static_cast<size_t>(rest.num_vertices()));
   std::vector<Eigen::Index> first{0};
   for (const int k : kept)
     first.push_back(first.back() +
                     static_cast<Eigen::Index>(quilt.elements[static_cast<size_t>(k)].face.size()));
+  if (quilt.stitched) find_parts(quilt, kept, source, first);
+  // Long swatch elements: footprints at least 4 times longer than wide (thread_tiling's measure).
+  std::vector<char> long_element;
+  for (const Element& e : prepared.elements)
+    long_element.push_back((e.hi - e.lo).maxCoeff() >= 4 * (e.hi - e.lo).minCoeff());
+  const bool any_long =
+      std::find(long_element.begin(), long_element.end(), 1) != long_element.end();
+  const MatrixX3d normals = any_long ? vertex_normals(quilt.base.V, quilt.base.F) : MatrixX3d();
   tbb::parallel_for(size_t{0}, kept.size(), [&](size_t i) {
     const Eigen::Index v0 = first[i], n = first[i + 1] - first[i];
-    if (along_[static_cast<size_t>(v0)] >= 0)
+    if (along_[static_cast<size_t>(v0)] >= 0) {
       fit_frames(source, rest.V, v0, n, reach);
-    else
-      fit_frame(source, rest.V, v0, n);
+      return;
+    }
+    fit_frame(source, rest.V, v0, n);
+    if (long_element[static_cast<size_t>(element_[static_cast<size_t>(v0)])])
+      bend_with_surface(quilt.elements[static_cast<size_t>(kept[i])], quilt.base, normals, v0);
   });
+  find_seams();
   std::vector<int> face_component;
   const int nv = rest.num_vertices();
   amplitude_.assign(static_cast<size_t>(connected_components(rest.F, nv, face_component)), 1.0);
@@ -103,16 +122,19 @@ MatrixX3d SwatchAnimation::gather_sources(const SurfaceQuilt& quilt, const std::
   for (const int k : kept) {
     const SurfaceElement& e = quilt.elements[static_cast<size_t>(k)];
     const Eigen::Index n = static_cast<Eigen::Index>(e.face.size());
-    MQ_CHECK(e.source.rows() == n && e.source_element >= 0 &&
-                 e.source_element < static_cast<int>(prepared.elements.size()),
+    const auto known = [&](int s) {
+      return s >= 0 && s < static_cast<int>(prepared.elements.size());
+    };
+    MQ_CHECK(e.source.rows() == n && e.source_element.size() == static_cast<size_t>(n) &&
+                 std::all_of(e.source_element.begin(), e.source_element.end(), known),
              InvalidInput,
-             "a swatch animation is followed by the vine method (ivy) and the global layout's "
-             "lattice (chain mail) only: this result's elements do not say where in the swatch "
-             "they come from");
+             "a swatch animation is followed by the vine method (ivy), the global layout's "
+             "lattice (chain mail) and the local patches only: this result's elements do not say "
+             "where in the swatch they come from");
     MQ_CHECK(v0 + n <= nv, InternalError,
              "swatch animation: the output is smaller than its elements");
     source.middleRows(v0, n) = e.source;
-    for (Eigen::Index i = 0; i < n; ++i) element_[static_cast<size_t>(v0 + i)] = e.source_element;
+    std::copy(e.source_element.begin(), e.source_element.end(), element_.begin() + v0);
     v0 += n;
   }
   MQ_CHECK(v0 == nv, InternalError, "swatch animation: the output is larger than its elements");
@@ -164,6 +186,11 @@ void SwatchAnimation::locate_sources(const SwatchRepeat& repeat, const PreparedS
 // wall's edge its two halves would part, or close through each other, with a frame each).
 void SwatchAnimation::fit_frame(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0,
                                 Eigen::Index n) {
+  const auto from = part_.begin() + v0, to = from + n;
+  if (std::any_of(from, to, [&](int e) { return e != *from; })) {
+    fit_parts(source, out, v0, n);
+    return;
+  }
   const Vector3d p = source.middleRows(v0, n).colwise().mean().transpose();
   const Vector3d q = out.middleRows(v0, n).colwise().mean().transpose();
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
@@ -176,6 +203,99 @@ void SwatchAnimation::fit_frame(const MatrixX3d& source, const MatrixX3d& out, E
   const Eigen::Matrix3f R =
       (nearest_rotation(cov) * size_ratio(spread_out, spread_source)).cast<float>();
   for (Eigen::Index v = v0; v < v0 + n; ++v) rotation_[static_cast<size_t>(v)] = R;
+}
+
+// A long element (a thread) follows the surface along its course: each vertex's frame is turned
+// by the least rotation that takes its swatch normal (the thickness axis, z) to the base's normal
+// under the vertex (normals: per vertex of the quilt's base). One frame for a thread's part laid
+// round a sphere moved its ends sideways into the threads beside it, and the part's best fit
+// rolled with the bend (lifts up to 62 degrees off the normal); on a plane nothing turns.
+void SwatchAnimation::bend_with_surface(const SurfaceElement& e, const TriMesh& base,
+                                        const MatrixX3d& normals, Eigen::Index v0) {
+  for (size_t u = 0; u < e.face.size(); ++u) {
+    Vector3d under = Vector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+      under += e.barycentric(static_cast<Eigen::Index>(u), k) *
+               normals.row(base.F(e.face[u], k)).transpose();
+    Eigen::Matrix3f& R = rotation_[static_cast<size_t>(v0) + u];
+    const Vector3d z = R.col(2).cast<double>();
+    if (!(under.squaredNorm() > 0) || !(z.squaredNorm() > 0)) continue;
+    R = Eigen::Quaterniond::FromTwoVectors(z, under).toRotationMatrix().cast<float>() * R;
+  }
+}
+
+// Each vertex's part (part_): of an element stitched of parts of several swatch copies
+// (SurfaceQuilt::stitched), the vertices joined by edges between two vertices of one swatch
+// element whose length there is the element's usual ratio to the output's (within 2x): an edge
+// across a seam joins two copies, whose sources lie apart (other elements, or one element's
+// points from two places). Numbered by their first vertex.
+void SwatchAnimation::find_parts(const SurfaceQuilt& quilt, const std::vector<int>& kept,
+                                 const MatrixX3d& source, const std::vector<Eigen::Index>& first) {
+  std::vector<Eigen::Index> first_face{0};
+  for (const int k : kept)
+    first_face.push_back(first_face.back() + quilt.elements[static_cast<size_t>(k)].F.rows());
+  MQ_CHECK(first_face.back() == rest_.num_faces(), InternalError,
+           "swatch animation: the output's faces are not its elements'");
+  tbb::parallel_for(size_t{0}, kept.size(), [&](size_t i) {
+    const Eigen::Index v0 = first[i], f0 = first_face[i], f1 = first_face[i + 1];
+    const auto ratio = [&](int a, int b) {
+      const double out = (rest_.V.row(a) - rest_.V.row(b)).norm();
+      return out > 0 ? (source.row(a) - source.row(b)).norm() / out : 0.0;
+    };
+    std::vector<double> ratios;
+    for (Eigen::Index f = f0; f < f1; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = rest_.F(f, k), b = rest_.F(f, (k + 1) % 3);
+        if (element_[static_cast<size_t>(a)] == element_[static_cast<size_t>(b)])
+          ratios.push_back(ratio(a, b));
+      }
+    if (ratios.empty()) return;
+    std::nth_element(ratios.begin(),
+                     ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+    const double usual = ratios[ratios.size() / 2];
+    UnionFind parts(static_cast<int>(first[i + 1] - v0));
+    for (Eigen::Index f = f0; f < f1; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = rest_.F(f, k), b = rest_.F(f, (k + 1) % 3);
+        const double r = ratio(a, b);
+        if (element_[static_cast<size_t>(a)] == element_[static_cast<size_t>(b)] &&
+            r <= 2 * usual && 2 * r >= usual)
+          parts.unite(static_cast<int>(a - v0), static_cast<int>(b - v0));
+      }
+    for (Eigen::Index v = v0; v < first[i + 1]; ++v)
+      part_[static_cast<size_t>(v)] = static_cast<int>(v0) + parts.find(static_cast<int>(v - v0));
+  });
+}
+
+// The frames of the n vertices from v0, an element stitched of parts of several swatch copies
+// (the local patches, section 2.7): one per part (find_parts), fitted alone (each part moves as
+// its own copy, and the parts' sources lie apart in the swatch).
+void SwatchAnimation::fit_parts(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0,
+                                Eigen::Index n) {
+  std::vector<std::pair<int, Eigen::Index>> part;  // (part, vertex), sorted
+  for (Eigen::Index v = v0; v < v0 + n; ++v) part.emplace_back(part_[static_cast<size_t>(v)], v);
+  std::sort(part.begin(), part.end());
+  for (size_t a = 0, b = 0; a < part.size(); a = b) {
+    while (b < part.size() && part[b].first == part[a].first) ++b;
+    Vector3d p = Vector3d::Zero(), q = Vector3d::Zero();
+    for (size_t i = a; i < b; ++i) {
+      p += source.row(part[i].second).transpose();
+      q += out.row(part[i].second).transpose();
+    }
+    p /= static_cast<double>(b - a);
+    q /= static_cast<double>(b - a);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    double spread_out = 0, spread_source = 0;
+    for (size_t i = a; i < b; ++i) {
+      const Vector3d s = source.row(part[i].second).transpose() - p,
+                     o = out.row(part[i].second).transpose() - q;
+      cov += o * s.transpose();
+      spread_out += o.squaredNorm(), spread_source += s.squaredNorm();
+    }
+    const Eigen::Matrix3f R =
+        (nearest_rotation(cov) * size_ratio(spread_out, spread_source)).cast<float>();
+    for (size_t i = a; i < b; ++i) rotation_[static_cast<size_t>(part[i].second)] = R;
+  }
 }
 
 // The frames of the n vertices from v0 (one element): for each, the rotation that best fits its
@@ -218,6 +338,65 @@ void SwatchAnimation::fit_frames(const MatrixX3d& source, const MatrixX3d& out, 
         }
     rotation_[static_cast<size_t>(v)] =
         (nearest_rotation(cov) * size_ratio(spread_out, spread_source)).cast<float>();
+  }
+}
+
+// The vertices within kSeamRings edges of a seam, where an element stitched of parts of several
+// swatch elements joins two of them (an edge between vertices of different sources), and each
+// one's neighbours.
+void SwatchAnimation::find_seams() {
+  const int nv = rest_.num_vertices();
+  const auto differs = [&](int v, int u) {
+    return part_[static_cast<size_t>(u)] != part_[static_cast<size_t>(v)];
+  };
+  std::vector<int> seam;
+  for (int f = 0; f < rest_.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (differs(rest_.F(f, k), rest_.F(f, (k + 1) % 3))) seam.push_back(rest_.F(f, k));
+  if (seam.empty()) return;  // no element of two sources: nothing to blend
+  const Adjacency adjacency = vertex_adjacency(rest_.F, nv);
+  std::vector<int> ring(static_cast<size_t>(nv), -1);
+  for (const int v : seam) ring[static_cast<size_t>(v)] = 0;
+  std::vector<int> band;
+  for (int v = 0; v < nv; ++v)
+    if (ring[static_cast<size_t>(v)] == 0) band.push_back(v);
+  for (size_t i = 0; i < band.size(); ++i) {
+    const int v = band[i];
+    if (ring[static_cast<size_t>(v)] == kSeamRings) continue;
+    for (const int* u = adjacency.begin(v); u != adjacency.end(v); ++u)
+      if (ring[static_cast<size_t>(*u)] < 0) {
+        ring[static_cast<size_t>(*u)] = ring[static_cast<size_t>(v)] + 1;
+        band.push_back(*u);
+      }
+  }
+  std::sort(band.begin(), band.end());
+  seams_.vertices = band;
+  seams_.neighbours.offsets.push_back(0);
+  for (const int v : band) {
+    seams_.neighbours.indices.insert(seams_.neighbours.indices.end(), adjacency.begin(v),
+                                     adjacency.end(v));
+    seams_.neighbours.offsets.push_back(static_cast<int>(seams_.neighbours.indices.size()));
+  }
+}
+
+// The displacements D (#V(rest) by 3) blended across the seams: each seam vertex's taken as the
+// mean of its neighbours' (Jacobi steps, the vertices beyond the band held), so that the parts'
+// motions meet without a step (issue 25: displacements blend where stitching merged elements).
+void SwatchAnimation::blend_seams(MatrixX3d& D) const {
+  const std::vector<int>& band = seams_.vertices;
+  if (band.empty()) return;
+  MatrixX3d next(static_cast<Eigen::Index>(band.size()), 3);
+  for (int step = 0; step < kSeamSteps; ++step) {
+    tbb::parallel_for(size_t{0}, band.size(), [&](size_t i) {
+      const int* from = seams_.neighbours.begin(static_cast<int>(i));
+      const int* to = seams_.neighbours.end(static_cast<int>(i));
+      Vector3d sum = Vector3d::Zero();
+      for (const int* u = from; u != to; ++u) sum += D.row(*u).transpose();
+      next.row(static_cast<Eigen::Index>(i)) =
+          (from == to ? D.row(band[i]).transpose() : Vector3d(sum / (to - from))).transpose();
+    });
+    for (size_t i = 0; i < band.size(); ++i)
+      D.row(band[i]) = next.row(static_cast<Eigen::Index>(i));
   }
 }
 
@@ -283,12 +462,18 @@ MatrixX3d SwatchAnimation::positions(const SwatchMotion& motion,
            " elements for a swatch of ", element_faces_.size());
   MatrixX3d V = rest_.V;
   const MatrixX3d sections = cross_sections(motion);
+  MatrixX3d D = MatrixX3d::Zero(rest_.num_vertices(), 3);
   tbb::parallel_for(0, rest_.num_vertices(), [&](int v) {
     const double a = amplitude[static_cast<size_t>(component_[static_cast<size_t>(v)])];
     if (a == 0) return;
     const Vector3d d = displacement(motion, sections, static_cast<size_t>(v));
     if (d.isZero(0)) return;
-    V.row(v) += (a * (rotation_[static_cast<size_t>(v)].cast<double>() * d)).transpose();
+    D.row(v) = (a * (rotation_[static_cast<size_t>(v)].cast<double>() * d)).transpose();
+  });
+  blend_seams(D);
+  // A vertex that does not move keeps its rest position bit for bit.
+  tbb::parallel_for(0, rest_.num_vertices(), [&](int v) {
+    if (!D.row(v).isZero(0)) V.row(v) += D.row(v);
   });
   return V;
 }

@@ -8,13 +8,16 @@
 // swatch onto the same points in the output (Kabsch); under a size map scaled by their spread's
 // ratio too. A leaf takes one such turn for all of it (it
 // moves as one, also where the surface bent it), a stem one per cross-section, so that it sways
-// about its own course over the surface.
+// about its own course over the surface. An element the local patches stitched of parts of several
+// swatch copies (section 2.7) takes a turn per part, and the parts' displacements are blended
+// over a few edges either side of the seam.
 #pragma once
 
 #include <cmath>
 #include <vector>
 
 #include "core/mesh/mesh.h"
+#include "core/mesh/mesh_topology.h"
 #include "core/mesh/settled_motion.h"
 #include "core/planar/quilt_elements.h"
 #include "core/surface/surface_quilting.h"
@@ -71,6 +74,13 @@ class SwatchAnimation {
   void locate_sources(const SwatchRepeat& repeat, const PreparedSwatch& prepared,
                       const MatrixX3d& source);
   void fit_frame(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0, Eigen::Index n);
+  void bend_with_surface(const SurfaceElement& e, const TriMesh& base, const MatrixX3d& normals,
+                         Eigen::Index v0);
+  void find_parts(const SurfaceQuilt& quilt, const std::vector<int>& kept, const MatrixX3d& source,
+                  const std::vector<Eigen::Index>& first);
+  void fit_parts(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0, Eigen::Index n);
+  void find_seams();
+  void blend_seams(MatrixX3d& D) const;
   void fit_frames(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0, Eigen::Index n,
                   double reach);
   MatrixX3d cross_sections(const SwatchMotion& motion) const;
@@ -85,7 +95,8 @@ class SwatchAnimation {
   TriMesh rest_;
   std::vector<MatrixX3i> element_faces_;  // of the prepared swatch
   std::vector<int> element_;              // #V(rest): source element
-  std::vector<Location> location_;        // #V(rest): where, off the repeated element
+  std::vector<int> part_;  // #V(rest): its part, moved as one copy (find_parts; else element_)
+  std::vector<Location> location_;  // #V(rest): where, off the repeated element
   // The repeated element (the vine): #V(rest) places along one repeat in [0, 1) (-1 off it), and
   // its cross-sections: how many, and each swatch vine vertex's.
   SwatchRepeat repeat_;
@@ -96,7 +107,14 @@ class SwatchAnimation {
   // element's size there against the swatch's, so that a smaller element moves less.
   std::vector<Eigen::Matrix3f> rotation_;
   bool sized_ = false;
-  std::vector<int> component_;     // #V(rest): its element in rest (connected component)
+  std::vector<int> component_;  // #V(rest): its element in rest (connected component)
+  // Where stitched parts of different swatch elements meet (find_seams): the vertices within
+  // kSeamRings edges of a seam (ascending) and each one's neighbours, blended over kSeamSteps.
+  static constexpr int kSeamRings = 3, kSeamSteps = 32;
+  struct Seams {
+    std::vector<int> vertices;
+    Adjacency neighbours;
+  } seams_;
   std::vector<double> amplitude_;  // per element of rest: its motion's share (settle)
 };
 

@@ -638,7 +638,7 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
       // A copy of the swatch element vertex for vertex: each vertex's source is its own place
       // there (issue 25, swatch animation).
       if (options.keep_sources) {
-        s.source_element = tiling.reps[c.rep];
+        s.source_element.assign(static_cast<size_t>(e.V.rows()), tiling.reps[c.rep]);
         s.source = e.V;
       }
     });
@@ -656,11 +656,12 @@ std::vector<SurfaceElement> place_lattice(const GlobalParameterization& gp, cons
 }
 
 // A quilted plane texture (a swatch that is not a lattice of separate elements) carried onto
-// the base: every element from each face whose chart contains its centre.
+// the base: every element from each face whose chart contains its centre. sources (optional):
+// the plane's (quilt_plane), kept per element (SurfaceElement::source).
 std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const SurfaceJob& job,
-                                        const TriMesh& plane, double shell_height,
-                                        GlobalQuiltingStats& gstats, StageTimes& times,
-                                        ProgressSink* progress) {
+                                        const TriMesh& plane, const PlaneSources* sources,
+                                        double shell_height, GlobalQuiltingStats& gstats,
+                                        StageTimes& times, ProgressSink* progress) {
   ScopedStage stage(times, progress, Stage::Placement);
   const ChartGrid grid(gp, job.base.num_faces());
   std::vector<int> fc;
@@ -672,7 +673,8 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
   for (int first = 0; first < n; first += block) {
     report_progress(progress, Stage::Placement, first, n);
     tbb::parallel_for(first, std::min(n, first + block), [&](int c) {
-      const TriMesh part = extract_faces(plane, groups[c]);
+      std::vector<int> vertices;
+      const TriMesh part = extract_faces(plane, groups[c], &vertices);
       const Vector2d centre = part.V.leftCols<2>().colwise().mean().transpose();
       // One placement per place on the surface: faces of one chart around the centre (it lies
       // on their common edge or vertex) are the same place.
@@ -686,6 +688,13 @@ std::vector<SurfaceElement> place_plane(const GlobalParameterization& gp, const 
         SurfaceElement s;
         s.F = part.F;
         s.kind = has_kinds(plane) ? plane.face_kind[static_cast<size_t>(groups[c][0])] : 0;
+        if (sources) {
+          s.source.resize(part.num_vertices(), 3);
+          for (size_t v = 0; v < vertices.size(); ++v) {
+            s.source.row(static_cast<Eigen::Index>(v)) = sources->point.row(vertices[v]);
+            s.source_element.push_back(sources->element[static_cast<size_t>(vertices[v])]);
+          }
+        }
         if (place_from(gp, job, part.V, f0, shell_height, s, nullptr, nominal_size(job, f0)))
           per[c].push_back(std::move(s));
         else
@@ -967,9 +976,16 @@ std::vector<SurfaceElement> place_threads(const GlobalParameterization& gp, cons
   ScopedStage stage(times, progress, Stage::Placement);
   const MatrixX3d N = vertex_normals(job.base.V, job.base.F);
   std::vector<MatrixX3d> positions;
-  const std::vector<PlacedPiece> placed = place_thread_copies(
+  std::vector<PlacedPiece> placed = place_thread_copies(
       ThreadPiecePlacer(gp, job, tiling, sym, lo, shell_height, options.global, N), copies,
       &positions, gstats, progress);
+  // A piece is a part of its swatch thread, vertex for vertex (issue 25, swatch animation).
+  if (options.keep_sources)
+    for (PlacedPiece& p : placed) {
+      const ThreadPiece& piece = tiling.pieces[static_cast<size_t>(p.piece)];
+      p.element.source = piece.V;
+      p.element.source_element.assign(static_cast<size_t>(piece.V.rows()), piece.source);
+    }
   // Decided on the pieces' outcomes alone, before they are welded and tested for
   // intersections (the wicker chair: 1.2 s of the 2.1 s its placement took).
   if (unfit && !layout_carries_threads(gstats)) {
@@ -1154,7 +1170,9 @@ std::vector<SurfaceElement> place_quilted_plane(
   po.max_faces = options.max_faces;
   gstats.parameter_area = po.length * po.width;
   PlanarQuiltingStats ps;
-  TriMesh plane = quilt_plane(job.swatch, po, evaluator, &ps, progress);
+  PlaneSources sources;
+  TriMesh plane = quilt_plane(job.swatch, po, evaluator, &ps, progress,
+                              options.keep_sources ? &sources : nullptr);
   stats.iterations = ps.iterations;
   stats.cell_size = ps.cell_size;
   stats.matched_point_offsets = ps.matched_point_offsets;
@@ -1164,7 +1182,8 @@ std::vector<SurfaceElement> place_quilted_plane(
   plane.V = (plane.V * swatch.rotation.transpose()).eval();
   plane.V.col(0).array() += lo.x();
   plane.V.col(1).array() += lo.y();
-  return place_plane(gp, job, plane, swatch.size.z(), gstats, stats.times, progress);
+  return place_plane(gp, job, plane, options.keep_sources ? &sources : nullptr, swatch.size.z(),
+                     gstats, stats.times, progress);
 }
 
 // The quilt of the elements placed over the base, and its counts.
@@ -1235,6 +1254,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   }
   gstats.placed = static_cast<int>(placed.size());
   SurfaceQuilt quilt = global_surface_quilt(job, swatch, std::move(placed), stats);
+  quilt.stitched = !gstats.tiled;  // the plane quilt's elements, the threads welded of pieces
   report_progress(progress, Stage::Quilting, 1, 1);
   if (stats_out) *stats_out = std::move(stats);
   if (global_out) *global_out = gstats;

@@ -476,6 +476,7 @@ LocalPatchSynthesis::LocalPatchSynthesis(SurfaceJob& job, const SurfaceQuiltingO
   {
     ScopedStageTimer timer(times_, Stage::Prepare);
     swatch_ = prepare_swatch(job.swatch);
+    if (options.keep_sources) track_sources(swatch_);
     swatch_tree_ = std::make_unique<SwatchFaceTree>(swatch_.mesh.V, swatch_.mesh.F);
     laplacians_ = swatch_topologies(swatch_);
   }
@@ -587,6 +588,8 @@ std::map<int, Element> LocalPatchSynthesis::flatten_output(const PatchFrame& fra
     Element e;
     e.F = s.F;
     e.kind = s.kind;
+    e.source = s.source;
+    e.source_element = s.source_element;
     e.V.resize(static_cast<Eigen::Index>(s.face.size()), 3);
     for (size_t v = 0; v < s.face.size(); ++v) {
       const Vector2d q = frame.to_frame(s.face[v], s.barycentric.row(v).transpose());
@@ -637,6 +640,8 @@ void LocalPatchSynthesis::store_changed(const PatchFrame& frame, const FramedOut
     SurfaceElement s;
     s.F = e.F;
     s.kind = e.kind;
+    s.source = e.source;
+    s.source_element = e.source_element;
     s.face.resize(e.V.rows());
     s.barycentric.resize(e.V.rows(), 3);
     s.height.resize(e.V.rows());
@@ -715,6 +720,7 @@ SurfaceQuilt LocalPatchSynthesis::take_quilt(SurfaceJob& job) {
   SurfaceQuilt quilt;
   quilt.kinds = swatch_.kinds;
   quilt.shell_height = H_;
+  quilt.stitched = true;
   quilt.base = job.base;
   take_input_bases(job, quilt);
   ScopedStageTimer timer(times_, Stage::PostProcessing);

@@ -41,14 +41,15 @@ struct SurfaceElement {
     MatrixX3d barycentric;   // #V by 3
     Eigen::VectorXd height;  // #V
   } through_layout;
-  // Optional (#V by 3, or empty): where each vertex comes from in the swatch (issue 25, swatch
-  // animation; core/shell/swatch_animation): a point on the prepared swatch's element
-  // `source_element` (the swatch scaled to the output, in its synthesis frame), or beyond it
+  // Optional (#V by 3 and #V, or empty): where each vertex comes from in the swatch (issue 25,
+  // swatch animation; core/shell/swatch_animation): a point on the prepared swatch's element
+  // source_element[v] (the swatch scaled to the output, in its synthesis frame), or beyond it
   // along SurfaceQuilt::repeat for the element repeated so. Kept with
-  // SurfaceQuiltingOptions::keep_sources, by the vine method and the global layout's lattice
-  // (each copy's vertices are its swatch element's).
-  int source_element = -1;
+  // SurfaceQuiltingOptions::keep_sources by the vine method, the global layout's lattice (each
+  // copy's vertices are its swatch element's) and the local patches (an element stitched of two
+  // has the sources of both parts: Element::source).
   MatrixX3d source;
+  std::vector<int> source_element;
 };
 
 // A swatch element repeated end to end along an axis in the quilt (the vine method's stems):
@@ -68,6 +69,9 @@ struct SurfaceQuilt {
   Refinement refinement;           // base faces in input_base faces (empty: base is input_base)
   std::vector<std::string> kinds;  // names of SurfaceElement::kind (the swatch's)
   SwatchRepeat repeat;             // how SurfaceElement::source wraps (vines)
+  // Elements may be stitched of parts of several swatch copies (the local patches, section 2.7),
+  // whose sources then lie apart in the swatch, or overlap for two copies of one element.
+  bool stitched = false;
   // Made under a size map: elements at other sizes than the swatch's (a swatch animation's
   // motion is scaled with each element, core/shell/swatch_animation).
   bool sized = false;
@@ -102,8 +106,8 @@ struct SurfaceQuiltingOptions {
   Eigen::VectorXd size_map;
   static constexpr double kMaxSizeMapRange = 8;
   // Keep where each output vertex comes from in the swatch (SurfaceElement::source), for a swatch
-  // animation (issue 25); followed by the vine method and the global layout's lattice (not by
-  // its threads or plane quilt, nor by the local patches, whose elements are cut and stitched).
+  // animation (issue 25); followed by the vine method, the global layout's lattice and the local
+  // patches (not by the global layout's threads or plane quilt).
   bool keep_sources = false;
   // Where long elements may lie (issue 25, `--mask`): per face of the refined base it is
   // handed, whether that face is in; empty: everywhere. The vine method's stems stop at the

@@ -761,12 +761,21 @@ class ThreadAssembly {
     e.face.resize(static_cast<size_t>(nv));
     e.barycentric.resize(nv, 3);
     e.height.resize(nv);
+    const bool sourced = source_.size() == face_.size();
+    if (sourced) {
+      e.source.resize(nv, 3);
+      e.source_element.resize(static_cast<size_t>(nv));
+    }
     for (size_t v = 0; v < face_.size(); ++v) {
       const int u = used[v];
       if (u < 0) continue;
       e.face[static_cast<size_t>(u)] = face_[v];
       e.barycentric.row(u) = bary_[v].transpose();
       e.height(u) = height_[v];
+      if (sourced) {
+        e.source.row(u) = source_[v].transpose();
+        e.source_element[static_cast<size_t>(u)] = source_element_[v];
+      }
     }
     return e;
   }
@@ -781,6 +790,10 @@ class ThreadAssembly {
     face_.push_back(s.face[static_cast<size_t>(v)]);
     bary_.push_back(s.barycentric.row(v).transpose());
     height_.push_back(s.height(v));
+    if (s.source.rows() > v) {  // the piece's sources (SurfaceElement::source), when kept
+      source_.push_back(s.source.row(v).transpose());
+      source_element_.push_back(s.source_element[static_cast<size_t>(v)]);
+    }
     return static_cast<int>(face_.size()) - 1;
   }
 
@@ -794,6 +807,8 @@ class ThreadAssembly {
   std::vector<int> face_;
   std::vector<Vector3d> bary_;
   std::vector<double> height_;
+  std::vector<Vector3d> source_;
+  std::vector<int> source_element_;
 };
 
 }  // namespace

@@ -1179,7 +1179,7 @@ Placed make_stem(const VineModel& m, const StemFrame& frame, double phase,
                size * t.V(v, 2), shell);
   }
   if (sources) {
-    e.source_element = m.element;
+    e.source_element.assign(static_cast<size_t>(nv), m.element);
     e.source.resize(nv, 3);
     for (int v = 0; v < nv; ++v)
       e.source.row(v) = stem_source(m, t.V.row(v).transpose(), phase).transpose();
@@ -1216,8 +1216,8 @@ Placed make_leaf(const VineModel& m, const SwatchLeaf& leaf, const StemFrame& fr
     set_vertex(out, v, frame.offset(a, direction, e.flat(v, 0), e.flat(v, 1), whole), e.flat(v, 2),
                shell);
   if (sources) {
-    e.source_element = leaf.element;
     e.source = *sources;
+    e.source_element.assign(static_cast<size_t>(e.source.rows()), leaf.element);
   }
   return out;
 }

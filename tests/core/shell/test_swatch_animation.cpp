@@ -205,6 +205,141 @@ TEST(SwatchAnimation, SameFramesWhateverTheThreadCount) {
   for (size_t k = 0; k < frames.size(); ++k) EXPECT_TRUE(out[0][k].V == out[1][k].V);
 }
 
+// The weave by the local patches, whose threads are cut and stitched at patch seams (section
+// 2.7), some of parts of different swatch threads: each swatch thread k lifted by (k + 1) / 50 of
+// the layer's thickness. A vertex away from a seam moves by its own thread's lift, along the
+// plane's normal (a thread's frames are bent to the base's normal); a stitched thread's parts
+// meet without a step: along every edge the motion changes
+// by well under one step (by one or more across a seam between two threads, unblended).
+TEST(SwatchAnimation, StitchedThreadsBlendTheirPartsMotions) {
+  WeaveOptions w;
+  w.threads_x = w.threads_y = 4;
+  w.tube_segments = 8;
+  const TriMesh swatch = plain_weave(w);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.2;
+  o.keep_sources = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt quilt =
+      quilt_surface(test::plane_grid(2, 1.5, 20, 15), swatch, o, cpu, &stats);
+  int of_two_threads = 0;
+  for (const SurfaceElement& s : quilt.elements)
+    of_two_threads += std::any_of(s.source_element.begin(), s.source_element.end(),
+                                  [&](int e) { return e != s.source_element[0]; });
+  ASSERT_GT(of_two_threads, 0);
+  QuiltEmbeddingStats e;
+  TetStretchCpu stretch;
+  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
+  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
+  // The frame equal to the swatch moves nothing, bit for bit.
+  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, stats.swatch_scale, "f")).V == rest.V);
+  std::vector<int> fc;
+  connected_components(swatch.F, swatch.num_vertices(), fc);
+  TriMesh lifted = swatch;
+  const double H = swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff();
+  for (int f = 0; f < swatch.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      lifted.V(swatch.F(f, k), 2) = swatch.V(swatch.F(f, k), 2) + H * (fc[f] + 1) / 50.0;
+  const MatrixX3d d =
+      animation.frame(swatch_motion(swatch, lifted, stats.swatch_scale, "f")).V - rest.V;
+  const double unit = H * stats.swatch_scale / 50;  // one step of lift in the output
+  int whole = 0;
+  for (int v = 0; v < rest.num_vertices(); ++v) {
+    const double steps = d.row(v).norm() / unit;
+    ASSERT_LT(d.row(v).head<2>().norm(), 1e-3 * d.row(v).norm()) << v;
+    ASSERT_GE(steps, 0.99) << v;  // a blend of turned lifts is a little shorter
+    whole += std::abs(steps - std::round(steps)) < 1e-6;
+  }
+  const int blended = rest.num_vertices() - whole;
+  EXPECT_GT(blended, 0);
+  EXPECT_LT(blended, rest.num_vertices() / 10);
+  double step = 0;
+  for (int f = 0; f < rest.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      step = std::max(step, (d.row(rest.F(f, k)) - d.row(rest.F(f, (k + 1) % 3))).norm());
+  std::printf(
+      "[ measure  ] stitched weave: %d elements of two threads, %d of %d vertices blended; the "
+      "motion changes along an edge by at most %.3f lift steps\n",
+      of_two_threads, blended, rest.num_vertices(), step / unit);
+  EXPECT_LT(step, 0.5 * unit);
+}
+
+// The weave by the global layout, its threads welded of one-period pieces: a swatch frame that
+// lifts every vertex by a tenth of the layer's thickness per swatch unit along x (a ramp, so not
+// periodic) would step where two pieces along x are welded, by the ramp over one period (two
+// thread spacings); blended, the motion changes along any edge by a fraction of that.
+TEST(SwatchAnimation, WeldedThreadPiecesBlendAtTheirWelds) {
+  WeaveOptions w;
+  w.threads_x = w.threads_y = 4;
+  w.tube_segments = 8;
+  const TriMesh swatch = plain_weave(w);
+  SurfaceQuiltingOptions o;
+  o.scale = 0.2;
+  o.keep_sources = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats stats;
+  GlobalQuiltingStats g;
+  const SurfaceQuilt quilt =
+      quilt_surface_global(test::plane_grid(2, 1.5, 20, 15), swatch, o, cpu, &stats, &g);
+  ASSERT_TRUE(g.threads);
+  ASSERT_GT(g.thread_welds, 0);
+  QuiltEmbeddingStats e;
+  TetStretchCpu stretch;
+  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
+  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
+  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, stats.swatch_scale, "f")).V == rest.V);
+  TriMesh ramp = swatch;
+  const double H = swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff();
+  ramp.V.col(2) += 0.1 * H * swatch.V.col(0);
+  const MatrixX3d d =
+      animation.frame(swatch_motion(swatch, ramp, stats.swatch_scale, "f")).V - rest.V;
+  const double weld_step = 0.1 * H * 2 * w.spacing * stats.swatch_scale;
+  double step = 0;
+  for (int f = 0; f < rest.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      step = std::max(step, (d.row(rest.F(f, k)) - d.row(rest.F(f, (k + 1) % 3))).norm());
+  std::printf(
+      "[ measure  ] welded weave: %d welds; the motion changes along an edge by at most %.3f of "
+      "the step at a weld\n",
+      g.thread_welds, step / weld_step);
+  EXPECT_LT(step, 0.3 * weld_step);
+}
+
+// The 6 x 6 weave on a sphere at 0.2, quilted over the global layout's plane (30 threads, each
+// round a good part of the sphere), lifted by a fifth of its thickness: every vertex moves along
+// the sphere's normal under it and nothing meets, so nothing is damped. With one frame per part
+// (before bend_with_surface; the command line on a 48 x 24 sphere) the lifts were up to 62
+// degrees off the normal and all 30 threads were damped.
+TEST(SwatchAnimation, ThreadsRoundASphereLiftAlongItsNormal) {
+  const TriMesh swatch = plain_weave();
+  SurfaceQuiltingOptions o;
+  o.scale = 0.2;
+  o.keep_sources = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats stats;
+  const SurfaceQuilt quilt =
+      quilt_surface_global(test::uv_sphere(1, 48, 24), swatch, o, cpu, &stats);
+  QuiltEmbeddingStats e;
+  TetStretchCpu stretch;
+  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
+  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
+  TriMesh lifted = swatch;
+  lifted.V.col(2).array() += 0.2 * (swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff());
+  const std::vector<SwatchMotion> motions{swatch_motion(swatch, lifted, stats.swatch_scale, "f")};
+  SettledMotionStats settled;
+  animation.settle(motions, &settled);
+  EXPECT_EQ(settled.damped + settled.stilled, 0);
+  const MatrixX3d d = animation.frame(motions[0]).V - rest.V;
+  double worst = 1;
+  for (int v = 0; v < rest.num_vertices(); ++v)
+    worst = std::min(worst, d.row(v).normalized().dot(rest.V.row(v).normalized()));
+  std::printf(
+      "[ measure  ] weave round a sphere: %zu threads, lifts at least %.4f along the normal\n",
+      quilt.elements.size(), worst);
+  EXPECT_GT(worst, 0.99);
+}
+
 TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
   const TriMesh swatch = ivy_swatch();
   TriMesh other = swatch;
@@ -216,8 +351,8 @@ TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
   TriMesh nan = swatch;
   nan.V(3, 1) = std::nan("");
   EXPECT_THROW(swatch_motion(swatch, nan, 1.0, "f"), InvalidInput);
-  // Chain mail by the local patches keeps no sources (its elements are cut and stitched); by
-  // the global layout's lattice it does (each ring a copy of its swatch ring).
+  // Chain mail by the local patches and by the global layout's lattice keeps its sources; a result
+  // made without keep_sources does not.
   ChainMailOptions mail;
   mail.rows = mail.cols = 4;
   const TriMesh rings = chainmail_4in1(mail);
@@ -227,14 +362,19 @@ TEST(SwatchAnimation, OtherConnectivityAndResultsWithoutSourcesAreRefused) {
   TranslationCostCpu cpu;
   SurfaceQuiltingStats stats, global_stats;
   const TriMesh plane = test::plane_grid(2, 1.5, 20, 15);
-  const SurfaceQuilt q = quilt_surface(plane, rings, o, cpu, &stats);
+  SurfaceQuilt q = quilt_surface(plane, rings, o, cpu, &stats);
   const SurfaceQuilt g = quilt_surface_global(plane, rings, o, cpu, &global_stats);
   QuiltEmbeddingStats e, ge;
   TetStretchCpu stretch;
   const TriMesh rest = embed_quilt(q, {}, stretch, &e);
   const TriMesh global_rest = embed_quilt(g, {}, stretch, &ge);
   EXPECT_NO_THROW(SwatchAnimation(g, ge.kept, global_rest, rings, global_stats.swatch_scale));
-  EXPECT_THROW(SwatchAnimation(q, e.kept, rest, rings, stats.swatch_scale), InvalidInput);
+  EXPECT_NO_THROW(SwatchAnimation(q, e.kept, rest, rings, stats.swatch_scale));
+  o.keep_sources = false;
+  const SurfaceQuilt none = quilt_surface(plane, rings, o, cpu, &stats);
+  QuiltEmbeddingStats ne;
+  const TriMesh none_rest = embed_quilt(none, {}, stretch, &ne);
+  EXPECT_THROW(SwatchAnimation(none, ne.kept, none_rest, rings, stats.swatch_scale), InvalidInput);
 }
 
 }  // namespace
