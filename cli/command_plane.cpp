@@ -1,6 +1,8 @@
 // meshquilt plane: planar mesh quilting (paper section 2).
 #include <chrono>
 #include <cstdio>
+#include <numeric>
+#include <optional>
 
 #include "cli/command_line.h"
 #include "cli/commands.h"
@@ -11,6 +13,7 @@
 #include "core/mesh/atomic_file.h"
 #include "core/mesh/mesh_io.h"
 #include "core/planar/planar_quilting.h"
+#include "core/shell/swatch_animation.h"
 #include "core/structure/texture_structure.h"
 #include "host/translation_cost_evaluator.h"
 
@@ -66,6 +69,12 @@ void declare_plane_options(CommandLine& cl) {
             "where large translation-cost evaluations run (small ones stay on the CPU)", "auto");
   cl.flag("no-deform", "skip element deformation (section 2.6)");
   cl.flag("trim", "cut elements crossing the domain border open (default: keep them whole)");
+  cl.option("swatch-frames", "PATTERN",
+            "animate the layer with the swatch: frames of the swatch, the same mesh with its "
+            "vertices moved, named by a pattern with one frame number (%d or %0Nd). Each output "
+            "vertex moves as the point of the swatch it came from; with --frames A-B, -o is a "
+            "pattern too and one output is written per frame (same faces and element order)");
+  cl.option("frames", "A-B", "the frames of --swatch-frames to follow, one output each");
   add_detail_option(cl);
   add_output_options(cl);
   add_run_options(cl);
@@ -84,6 +93,24 @@ PlanarQuiltingOptions plane_options(const CommandLine& cl) {
   options.trim_border = cl.has("trim");
   options.max_faces = face_limit(cl);
   return options;
+}
+
+// --swatch-frames (issue 25): the layer's vertices located in the swatch and the frames' motions,
+// settled so that no element meets another in any frame. frames: the swatch frames as read.
+SwatchAnimation animate_layer(const TriMesh& layer, const PlaneSources& sources,
+                              const TriMesh& swatch, const std::vector<SwatchFrame>& requested,
+                              const std::vector<TriMesh>& frames,
+                              std::vector<SwatchMotion>& motions, SettledMotionStats& settled) {
+  // The layer's normal: the swatch's thickness axis, in its own axes (prepare_swatch's z).
+  const Vector3d normal = prepare_swatch(swatch).rotation.row(2).transpose();
+  const SurfaceQuilt quilt = layer_quilt(layer, sources, normal);
+  std::vector<int> kept(quilt.elements.size());
+  std::iota(kept.begin(), kept.end(), 0);
+  SwatchAnimation animation(quilt, kept, layer, swatch, 1.0);
+  for (size_t k = 0; k < frames.size(); ++k)
+    motions.push_back(swatch_motion(swatch, frames[k], 1.0, requested[k].swatch));
+  animation.settle(motions, &settled);
+  return animation;
 }
 
 // The two lines a run prints unless --quiet (the structure follows with --stats).
@@ -111,12 +138,22 @@ int run_plane(int argc, char** argv, int first) {
   if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
   if (!cl.has("size")) throw UsageError("--size L W is required");
   if (!cl.has("output")) throw UsageError("-o OUT is required");
-  const std::string out_path = cl.get("output");
-  mesh_format_from_path(out_path);  // fail on an unknown extension before any work
+  const std::vector<SwatchFrame> requested = requested_swatch_frames(cl);
+  const std::string out_path = requested.empty() ? cl.get("output") : requested.front().output;
   const WriteOptions write_options = output_options(cl);
-  std::vector<std::string> outputs = output_files(out_path, write_options);
+  std::vector<std::string> outputs, inputs{cl.get("swatch")};
+  for (const SwatchFrame& f : requested) inputs.push_back(f.swatch);
+  for (const std::string& out :
+       requested.empty() ? std::vector<std::string>{out_path} : std::vector<std::string>{}) {
+    mesh_format_from_path(out);  // fail on an unknown extension before any work
+    for (const std::string& file : output_files(out, write_options)) outputs.push_back(file);
+  }
+  for (const SwatchFrame& f : requested) {
+    mesh_format_from_path(f.output);
+    for (const std::string& file : output_files(f.output, write_options)) outputs.push_back(file);
+  }
   outputs.push_back(cl.get("stats"));
-  check_paths(outputs, {cl.get("swatch")});
+  check_paths(outputs, inputs);
 
   const PlanarQuiltingOptions options = plane_options(cl);
   const double detail = detail_share(cl);
@@ -126,9 +163,16 @@ int run_plane(int argc, char** argv, int first) {
   const auto start = std::chrono::steady_clock::now();
   const ElementDetail swatch_detail = read_swatch(cl.get("swatch"), detail);
   const TriMesh& swatch = swatch_detail.mesh;
+  std::vector<TriMesh> frames;  // with --swatch-frames: each as read, checked before any work
+  for (const SwatchFrame& f : requested) {
+    frames.push_back(read_mesh(f.swatch));
+    check_swatch_frame(swatch, frames.back(), f.swatch);
+  }
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(device);
   PlanarQuiltingStats stats;
-  const TriMesh result = quilt_plane(swatch, options, *evaluator, &stats, run.progress());
+  PlaneSources sources;
+  const TriMesh result = quilt_plane(swatch, options, *evaluator, &stats, run.progress(),
+                                     requested.empty() ? nullptr : &sources);
   // A run that makes no geometry is an error, not an empty file (issue 14).
   MQ_CHECK(result.num_faces() > 0, InvalidInput,
            "the layer is empty: no element of the swatch fits the ", options.length, " x ",
@@ -143,15 +187,35 @@ int run_plane(int argc, char** argv, int first) {
     structure = summarize_structure(result, swatch, nullptr, 1.0);
     measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  // The mesh and the --stats file are one commit (issue 28); with --swatch-frames the mesh is
+  // the first frame's, and the others follow.
+  std::optional<SwatchAnimation> animation;
+  std::vector<SwatchMotion> motions;
+  SettledMotionStats settled;
+  if (!requested.empty()) {
+    ScopedStageTimer timer(stats.times, Stage::Animation);
+    animation = animate_layer(result, sources, swatch, requested, frames, motions, settled);
+  }
+  const auto frame = [&](size_t k) { return animation->frame(motions[k]); };
   const double wall = write_output_and_stats(
-      run, out_path, result, write_options, stats.times, start, measuring, [&](double w) {
+      run, out_path, animation ? frame(0) : result, write_options, stats.times, start, measuring,
+      [&](double w) {
         return stats_json(stats, evaluator->name(), run.threads(), w, cl.get("swatch"),
                           options.length, options.width, structure, swatch_detail, detail);
       });
+  for (size_t k = 1; k < requested.size(); ++k) {
+    ScopedStageProgress shown(run.progress(), Stage::Writing);
+    write_output(requested[k].output, frame(k), write_options);
+  }
   run.progress()->finish();
   if (!run.quiet()) {
     print_detail(swatch_detail, detail);
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
+    if (!requested.empty())
+      std::printf(
+          "swatch animation: %zu frames (to %s); %d elements move at half their motion and %d "
+          "stay still, where they would meet another element\n",
+          requested.size(), requested.back().output.c_str(), settled.damped, settled.stilled);
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);
   }

@@ -301,28 +301,8 @@ struct SurfaceRequest {
   double min_coverage = 0;
   double detail = 1;
   Device device = Device::Auto;
-  // With --swatch-frames: per frame, its number, the swatch frame's file and the output's.
-  struct Frame {
-    int number = 0;
-    std::string swatch, output;
-  };
-  std::vector<Frame> frames;
+  std::vector<SwatchFrame> frames;  // with --swatch-frames
 };
-
-// --swatch-frames and --frames: the frames' files, or none.
-std::vector<SurfaceRequest::Frame> requested_swatch_frames(const CommandLine& cl) {
-  if (cl.has("swatch-frames") != cl.has("frames"))
-    throw UsageError("--swatch-frames and --frames A-B go together");
-  std::vector<SurfaceRequest::Frame> frames;
-  if (!cl.has("frames")) return frames;
-  if (cl.has("detail") && cl.get_double("detail", 0) != 1)
-    throw UsageError("--swatch-frames animates the swatch as given: not with --detail");
-  const auto [a, b] = frame_range(cl.get("frames"));
-  const FramePattern swatch(cl.get("swatch-frames"), "--swatch-frames"),
-      output(cl.get("output"), "-o");
-  for (int f = a; f <= b; ++f) frames.push_back({f, swatch(f), output(f)});
-  return frames;
-}
 
 SurfaceRequest parse_surface_request(const CommandLine& cl) {
   if (!cl.has("base")) throw UsageError("--base FILE is required");
@@ -336,13 +316,13 @@ SurfaceRequest parse_surface_request(const CommandLine& cl) {
   r.write_options = output_options(cl);
   std::vector<std::string> outputs, inputs{cl.get("base"), cl.get("swatch"), cl.get("field-file"),
                                            cl.get("keys"), cl.get("mask")};
-  for (const SurfaceRequest::Frame& f : r.frames) inputs.push_back(f.swatch);
+  for (const SwatchFrame& f : r.frames) inputs.push_back(f.swatch);
   for (const std::string& out :
        r.frames.empty() ? std::vector<std::string>{r.out_path} : std::vector<std::string>{}) {
     mesh_format_from_path(out);
     for (const std::string& file : output_files(out, r.write_options)) outputs.push_back(file);
   }
-  for (const SurfaceRequest::Frame& f : r.frames) {
+  for (const SwatchFrame& f : r.frames) {
     mesh_format_from_path(f.output);
     for (const std::string& file : output_files(f.output, r.write_options)) outputs.push_back(file);
   }
@@ -427,7 +407,7 @@ void read_surface_inputs(const CommandLine& cl, SurfaceRequest& r, SurfaceInputs
                      std::to_string(diagonal));
   // Every swatch frame read and checked before any work: a missing frame, or one that is not the
   // swatch moved, fails the run before anything is written.
-  for (const SurfaceRequest::Frame& f : r.frames) {
+  for (const SwatchFrame& f : r.frames) {
     in.swatch_frames.push_back(read_mesh(f.swatch));
     check_swatch_frame(swatch, in.swatch_frames.back(), f.swatch);
   }

@@ -13,6 +13,20 @@
 
 namespace mq::cli {
 
+std::vector<SwatchFrame> requested_swatch_frames(const CommandLine& cl) {
+  if (cl.has("swatch-frames") != cl.has("frames"))
+    throw UsageError("--swatch-frames and --frames A-B go together");
+  std::vector<SwatchFrame> frames;
+  if (!cl.has("frames")) return frames;
+  if (cl.has("detail") && cl.get_double("detail", 0) != 1)
+    throw UsageError("--swatch-frames animates the swatch as given: not with --detail");
+  const auto [a, b] = frame_range(cl.get("frames"));
+  const FramePattern swatch(cl.get("swatch-frames"), "--swatch-frames"),
+      output(cl.get("output"), "-o");
+  for (int f = a; f <= b; ++f) frames.push_back({f, swatch(f), output(f)});
+  return frames;
+}
+
 Device parse_device(const std::string& name) {
   if (name == "auto") return Device::Auto;
   if (name == "cpu") return Device::Cpu;

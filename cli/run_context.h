@@ -83,6 +83,17 @@ ElementDetail read_swatch(const std::string& path, double share, TriMesh* full =
 void print_detail(const ElementDetail& detail, double share);
 void write_detail(JsonWriter& j, const ElementDetail& detail, double share);
 
+// With --swatch-frames PATTERN and --frames A-B (issue 25, swatch animation): per frame, its
+// number, the swatch frame's file and the output's (-o a pattern too).
+struct SwatchFrame {
+  int number = 0;
+  std::string swatch, output;
+};
+
+// The frames --swatch-frames and --frames ask for, or none. Throws UsageError when one comes
+// without the other, with --detail below 1, or for a pattern without one frame number.
+std::vector<SwatchFrame> requested_swatch_frames(const CommandLine& cl);
+
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {
  public:

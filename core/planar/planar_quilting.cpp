@@ -344,6 +344,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
   if (sources) {
     sources->point.resize(result.num_vertices(), 3);
     sources->element.clear();
+    sources->element_vertices.clear();
+    sources->element_faces.clear();
     Eigen::Index row = 0;
     for (const Element* e : kept) {
       MQ_CHECK(e->source.rows() == e->V.rows() &&
@@ -352,6 +354,8 @@ TriMesh quilt_plane(const TriMesh& swatch_mesh, const PlanarQuiltingOptions& opt
       sources->point.middleRows(row, e->V.rows()) = e->source;
       sources->element.insert(sources->element.end(), e->source_element.begin(),
                               e->source_element.end());
+      sources->element_vertices.push_back(static_cast<int>(e->V.rows()));
+      sources->element_faces.push_back(static_cast<int>(e->F.rows()));
       row += e->V.rows();
     }
   }

@@ -61,6 +61,9 @@ struct PlanarQuiltingStats {
 struct PlaneSources {
   MatrixX3d point;           // #V by 3: a point of the prepared swatch, in its synthesis frame
   std::vector<int> element;  // #V: the prepared swatch's element it lies on
+  // Per element of the quilt, in order (each holds a run of its vertices and of its faces): how
+  // many vertices and faces.
+  std::vector<int> element_vertices, element_faces;
 };
 
 // The default grid cell of the matching (section 2.3's grid): half an element across, and at

@@ -63,6 +63,42 @@ SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double s
   return out;
 }
 
+SurfaceQuilt layer_quilt(const TriMesh& layer, const PlaneSources& sources,
+                         const Vector3d& normal) {
+  MQ_CHECK(sources.point.rows() == layer.num_vertices() &&
+               sources.element.size() == static_cast<size_t>(layer.num_vertices()),
+           InternalError, "swatch animation: the layer's sources do not match it");
+  SurfaceQuilt quilt;
+  // The base: any two triangles with the layer's normal (the frames need only that).
+  const Eigen::Matrix3d frame =
+      Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), normal).toRotationMatrix();
+  quilt.base.V.resize(4, 3);
+  quilt.base.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  quilt.base.V = (quilt.base.V * frame.transpose()).eval();
+  quilt.base.F.resize(2, 3);
+  quilt.base.F << 0, 1, 2, 0, 2, 3;
+  quilt.stitched = true;
+  Eigen::Index v0 = 0, f0 = 0;
+  for (size_t i = 0; i < sources.element_vertices.size(); ++i) {
+    const Eigen::Index nv = sources.element_vertices[i], nf = sources.element_faces[i];
+    MQ_CHECK(v0 + nv <= layer.num_vertices() && f0 + nf <= layer.num_faces(), InternalError,
+             "swatch animation: the layer's elements do not match it");
+    SurfaceElement e;
+    e.F = layer.F.middleRows(f0, nf).array() - static_cast<int>(v0);
+    e.face.assign(static_cast<size_t>(nv), 0);
+    e.barycentric = MatrixX3d::Constant(nv, 3, 1.0 / 3);
+    e.height = Eigen::VectorXd::Zero(nv);
+    e.source = sources.point.middleRows(v0, nv);
+    e.source_element.assign(sources.element.begin() + v0, sources.element.begin() + v0 + nv);
+    quilt.elements.push_back(std::move(e));
+    v0 += nv;
+    f0 += nf;
+  }
+  MQ_CHECK(v0 == layer.num_vertices() && f0 == layer.num_faces(), InternalError,
+           "swatch animation: the layer's elements do not match it");
+  return quilt;
+}
+
 SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<int>& kept,
                                  const TriMesh& rest, const TriMesh& swatch, double scale)
     : rest_(rest), sized_(quilt.sized) {

@@ -19,6 +19,7 @@
 #include "core/mesh/mesh.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/mesh/settled_motion.h"
+#include "core/planar/planar_quilting.h"
 #include "core/planar/quilt_elements.h"
 #include "core/surface/surface_quilting.h"
 
@@ -41,6 +42,11 @@ SwatchMotion swatch_motion(const TriMesh& swatch, const TriMesh& frame, double s
 // The check swatch_motion makes first, alone (before a synthesis: nothing prepared). Throws as
 // swatch_motion.
 void check_swatch_frame(const TriMesh& swatch, const TriMesh& frame, const std::string& name);
+
+// A planar quilt (quilt_plane's `layer`, in the swatch's own axes, and its sources) as a quilt
+// over its own plane, for SwatchAnimation with `layer` as the rest: its elements in order, every
+// vertex over a base of two triangles whose normal is `normal` (the layer's thickness axis).
+SurfaceQuilt layer_quilt(const TriMesh& layer, const PlaneSources& sources, const Vector3d& normal);
 
 // The output's vertices with their sources located on the swatch and their frames, made once;
 // frame() is then a pass over the vertices per swatch frame.

@@ -1,7 +1,8 @@
 // Swatch animation from the command line (issue 25 item 5): `swatch ivy --frames N` writes a
 // looping wind, `surface --swatch-frames P --frames A-B` one output per frame, frame 0 the static
-// output byte for byte; chain mail (the global layout's lattice) and the weave by the local
-// patches (threads cut and stitched) follow their swatch's frames too; missing or mismatched
+// output byte for byte; chain mail (the global layout's lattice), the weave by the local patches
+// (threads cut and stitched) and by the global layout, and `plane`'s layer follow their swatch's
+// frames too; missing or mismatched
 // frames fail in one line before anything is written.
 #include <gtest/gtest.h>
 
@@ -141,6 +142,38 @@ TEST_P(CliWeaveAnimation, ThreadsFollowALiftedLayer) {
 
 INSTANTIATE_TEST_SUITE_P(PatchesAndGlobal, CliWeaveAnimation,
                          ::testing::Values("patches", "global"));
+
+// `plane` follows swatch frames too: the weave's layer, its threads stitched where patches meet,
+// lifted by a fifth of the swatch's thickness moves every vertex by that lift, frame 0 being the
+// static layer byte for byte; a frame range without frames is a usage error.
+TEST(CliAnimation, PlaneLayerFollowsALiftedSwatch) {
+  const std::string dir = test::temp_dir();
+  ASSERT_EQ(meshquilt(dir, "swatch weave --rows 4 --cols 4 --detail 8 -o w.obj --quiet").status, 0);
+  TriMesh lifted = read_mesh(dir + "/w.obj");
+  const double lift = 0.2 * (lifted.V.col(2).maxCoeff() - lifted.V.col(2).minCoeff());
+  lifted.V.col(2).array() += lift;
+  write_mesh(dir + "/w_1.obj", lifted);
+  fs::copy_file(dir + "/w.obj", dir + "/w_0.obj");
+  const std::string job = "plane --swatch w.obj --size 8 6 --quiet --stats s.json";
+  ASSERT_EQ(meshquilt(dir, job + " -o static.ply").status, 0);
+  const CliRun run =
+      meshquilt(dir, job + " --swatch-frames 'w_%d.obj' --frames 0-1 -o 'out_%d.ply'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(slurp(dir + "/out_0.ply") == slurp(dir + "/static.ply"));
+  const std::string stats = slurp(dir + "/s.json");
+  const size_t at = stats.find("\"stitched\": ");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_GT(std::stoi(stats.substr(at + 12)), 0);
+  const TriMesh rest = read_mesh(dir + "/out_0.ply"), moved = read_mesh(dir + "/out_1.ply");
+  ASSERT_TRUE(moved.F == rest.F);
+  for (int v = 0; v < rest.num_vertices(); ++v)
+    ASSERT_LT((moved.V.row(v) - rest.V.row(v) - Vector3d(0, 0, lift).transpose()).norm(),
+              1e-5 * lift)
+        << v;
+  const CliRun lone = meshquilt(dir, job + " --frames 0-1 -o 'x_%d.ply'");
+  EXPECT_EQ(lone.status, 2) << lone.err;
+  EXPECT_EQ(lone.err_lines().size(), 1u) << lone.err;
+}
 
 TEST(CliAnimation, BadFramesAreRefusedBeforeAnyWork) {
   const std::string dir = test::temp_dir();
