@@ -693,10 +693,14 @@ def material_for(kind, look):
         r, g, b, metallic, roughness = look
         material.diffuse_color = (r, g, b, 1.0)
         material.metallic, material.roughness = metallic, roughness
+        # Inputs by name: these three kept their names in Blender 4.0's Principled BSDF (others,
+        # such as Specular and Emission, were renamed); a missing one is skipped, not a
+        # KeyError (the viewport colour above is set either way).
         if bsdf is not None:
-            bsdf.inputs["Base Color"].default_value = (r, g, b, 1.0)
-            bsdf.inputs["Metallic"].default_value = metallic
-            bsdf.inputs["Roughness"].default_value = roughness
+            for socket, value in (("Base Color", (r, g, b, 1.0)), ("Metallic", metallic),
+                                  ("Roughness", roughness)):
+                if socket in bsdf.inputs:
+                    bsdf.inputs[socket].default_value = value
     return material
 
 

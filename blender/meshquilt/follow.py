@@ -296,13 +296,15 @@ def remove_elements(context, obj, ids):
         bake(context, obj)
 
 
-@bpy.app.handlers.persistent
 def set_stepping(on):
     """While on, frame changes do not re-place following results (a bake, or a swatch's motion
     exported frame by frame, steps through the frames itself)."""
     _state["baking"] = on
 
 
+# Persistent: File > Open keeps the add-on enabled without registering it again, and a handler
+# that is not persistent goes with the file it was added in (Follow base then stopped).
+@bpy.app.handlers.persistent
 def on_frame_change(scene, depsgraph=None):
     """frame_change_post: every result following its base placed on it; one that cannot be
     (its base changed connectivity, the engine failed) stops following with the reason."""

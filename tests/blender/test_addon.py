@@ -1432,6 +1432,26 @@ def test_a_mesh_goes_to_the_engine_the_same_whatever_its_face_order():
     check(len(T0) == 18 and set(M0.tolist()) == {0, 1}, "%d triangles, materials %s"
           % (len(T0), sorted(set(M0.tolist()))))
 
+@test
+def test_follow_base_goes_on_after_the_file_is_opened_again():
+    # File > Open keeps the add-on enabled without registering it again: the frame handler must
+    # be persistent to outlive the file it was added in (a later edit had moved its decorator).
+    scene, base, obj = twisting_grid_quilt()
+    obj.meshquilt.follow = True
+    name = obj.name
+    path = os.path.join(WORK, "follow_reopened.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    import meshquilt.follow
+    check(bpy.app.handlers.frame_change_post.count(meshquilt.follow.on_frame_change) == 1,
+          "the frame handler went with the file")
+    scene, obj = bpy.context.scene, bpy.data.objects[name]
+    scene.frame_set(6)
+    before = positions(obj)
+    scene.frame_set(18)
+    check(np.abs(positions(obj) - before).max() > 1e-3, "the result no longer follows its base")
+
+
 print("[blender] %d failed: %s" % (len(failures), ", ".join(failures) or "none"), flush=True)
 if failures:
     sys.exit(1)
