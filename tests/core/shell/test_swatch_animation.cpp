@@ -205,35 +205,58 @@ TEST(SwatchAnimation, SameFramesWhateverTheThreadCount) {
   for (size_t k = 0; k < frames.size(); ++k) EXPECT_TRUE(out[0][k].V == out[1][k].V);
 }
 
+// `swatch` quilted over `base` at `scale` with its sources kept, by the global layout or the local
+// patches, embedded as the tool does; *global_stats (optional) the layout's figures.
+Animated quilt_with_sources(const TriMesh& base, const TriMesh& swatch, double scale, bool global,
+                            GlobalQuiltingStats* global_stats = nullptr) {
+  SurfaceQuiltingOptions o;
+  o.scale = scale;
+  o.keep_sources = true;
+  TranslationCostCpu cpu;
+  SurfaceQuiltingStats stats;
+  Animated a;
+  a.quilt = global ? quilt_surface_global(base, swatch, o, cpu, &stats, global_stats)
+                   : quilt_surface(base, swatch, o, cpu, &stats);
+  a.scale = stats.swatch_scale;
+  TetStretchCpu stretch;
+  a.rest = embed_quilt(a.quilt, {}, stretch, &a.embedding);
+  return a;
+}
+
+// The 4 x 4 weave at 8 segments round a thread: small enough for many seams on a small plane.
+TriMesh small_weave() {
+  WeaveOptions w;
+  w.threads_x = w.threads_y = 4;
+  w.tube_segments = 8;
+  return plain_weave(w);
+}
+
+// The largest change of the displacement d (#V by 3) along an edge of F.
+double largest_edge_change(const MatrixX3d& d, const MatrixX3i& F) {
+  double step = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      step = std::max(step, (d.row(F(f, k)) - d.row(F(f, (k + 1) % 3))).norm());
+  return step;
+}
+
 // The weave by the local patches, whose threads are cut and stitched at patch seams (section
 // 2.7), some of parts of different swatch threads: each swatch thread k lifted by (k + 1) / 50 of
 // the layer's thickness. A vertex away from a seam moves by its own thread's lift, along the
 // plane's normal (a thread's frames are bent to the base's normal); a stitched thread's parts
-// meet without a step: along every edge the motion changes
-// by well under one step (by one or more across a seam between two threads, unblended).
+// meet without a step: along every edge the motion changes by well under one step (by one or
+// more across a seam between two threads, unblended).
 TEST(SwatchAnimation, StitchedThreadsBlendTheirPartsMotions) {
-  WeaveOptions w;
-  w.threads_x = w.threads_y = 4;
-  w.tube_segments = 8;
-  const TriMesh swatch = plain_weave(w);
-  SurfaceQuiltingOptions o;
-  o.scale = 0.2;
-  o.keep_sources = true;
-  TranslationCostCpu cpu;
-  SurfaceQuiltingStats stats;
-  const SurfaceQuilt quilt =
-      quilt_surface(test::plane_grid(2, 1.5, 20, 15), swatch, o, cpu, &stats);
+  const TriMesh swatch = small_weave();
+  const Animated a = quilt_with_sources(test::plane_grid(2, 1.5, 20, 15), swatch, 0.2, false);
   int of_two_threads = 0;
-  for (const SurfaceElement& s : quilt.elements)
+  for (const SurfaceElement& s : a.quilt.elements)
     of_two_threads += std::any_of(s.source_element.begin(), s.source_element.end(),
                                   [&](int e) { return e != s.source_element[0]; });
   ASSERT_GT(of_two_threads, 0);
-  QuiltEmbeddingStats e;
-  TetStretchCpu stretch;
-  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
-  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
+  SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
   // The frame equal to the swatch moves nothing, bit for bit.
-  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, stats.swatch_scale, "f")).V == rest.V);
+  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, a.scale, "f")).V == a.rest.V);
   std::vector<int> fc;
   connected_components(swatch.F, swatch.num_vertices(), fc);
   TriMesh lifted = swatch;
@@ -241,27 +264,23 @@ TEST(SwatchAnimation, StitchedThreadsBlendTheirPartsMotions) {
   for (int f = 0; f < swatch.num_faces(); ++f)
     for (int k = 0; k < 3; ++k)
       lifted.V(swatch.F(f, k), 2) = swatch.V(swatch.F(f, k), 2) + H * (fc[f] + 1) / 50.0;
-  const MatrixX3d d =
-      animation.frame(swatch_motion(swatch, lifted, stats.swatch_scale, "f")).V - rest.V;
-  const double unit = H * stats.swatch_scale / 50;  // one step of lift in the output
+  const MatrixX3d d = animation.frame(swatch_motion(swatch, lifted, a.scale, "f")).V - a.rest.V;
+  const double unit = H * a.scale / 50;  // one step of lift in the output
   int whole = 0;
-  for (int v = 0; v < rest.num_vertices(); ++v) {
+  for (int v = 0; v < a.rest.num_vertices(); ++v) {
     const double steps = d.row(v).norm() / unit;
     ASSERT_LT(d.row(v).head<2>().norm(), 1e-3 * d.row(v).norm()) << v;
     ASSERT_GE(steps, 0.99) << v;  // a blend of turned lifts is a little shorter
     whole += std::abs(steps - std::round(steps)) < 1e-6;
   }
-  const int blended = rest.num_vertices() - whole;
+  const int blended = a.rest.num_vertices() - whole;
   EXPECT_GT(blended, 0);
-  EXPECT_LT(blended, rest.num_vertices() / 10);
-  double step = 0;
-  for (int f = 0; f < rest.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k)
-      step = std::max(step, (d.row(rest.F(f, k)) - d.row(rest.F(f, (k + 1) % 3))).norm());
+  EXPECT_LT(blended, a.rest.num_vertices() / 10);
+  const double step = largest_edge_change(d, a.rest.F);
   std::printf(
       "[ measure  ] stitched weave: %d elements of two threads, %d of %d vertices blended; the "
       "motion changes along an edge by at most %.3f lift steps\n",
-      of_two_threads, blended, rest.num_vertices(), step / unit);
+      of_two_threads, blended, a.rest.num_vertices(), step / unit);
   EXPECT_LT(step, 0.5 * unit);
 }
 
@@ -270,35 +289,19 @@ TEST(SwatchAnimation, StitchedThreadsBlendTheirPartsMotions) {
 // periodic) would step where two pieces along x are welded, by the ramp over one period (two
 // thread spacings); blended, the motion changes along any edge by a fraction of that.
 TEST(SwatchAnimation, WeldedThreadPiecesBlendAtTheirWelds) {
-  WeaveOptions w;
-  w.threads_x = w.threads_y = 4;
-  w.tube_segments = 8;
-  const TriMesh swatch = plain_weave(w);
-  SurfaceQuiltingOptions o;
-  o.scale = 0.2;
-  o.keep_sources = true;
-  TranslationCostCpu cpu;
-  SurfaceQuiltingStats stats;
+  const TriMesh swatch = small_weave();
   GlobalQuiltingStats g;
-  const SurfaceQuilt quilt =
-      quilt_surface_global(test::plane_grid(2, 1.5, 20, 15), swatch, o, cpu, &stats, &g);
+  const Animated a = quilt_with_sources(test::plane_grid(2, 1.5, 20, 15), swatch, 0.2, true, &g);
   ASSERT_TRUE(g.threads);
   ASSERT_GT(g.thread_welds, 0);
-  QuiltEmbeddingStats e;
-  TetStretchCpu stretch;
-  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
-  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
-  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, stats.swatch_scale, "f")).V == rest.V);
+  SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
+  EXPECT_TRUE(animation.frame(swatch_motion(swatch, swatch, a.scale, "f")).V == a.rest.V);
   TriMesh ramp = swatch;
   const double H = swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff();
   ramp.V.col(2) += 0.1 * H * swatch.V.col(0);
-  const MatrixX3d d =
-      animation.frame(swatch_motion(swatch, ramp, stats.swatch_scale, "f")).V - rest.V;
-  const double weld_step = 0.1 * H * 2 * w.spacing * stats.swatch_scale;
-  double step = 0;
-  for (int f = 0; f < rest.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k)
-      step = std::max(step, (d.row(rest.F(f, k)) - d.row(rest.F(f, (k + 1) % 3))).norm());
+  const MatrixX3d d = animation.frame(swatch_motion(swatch, ramp, a.scale, "f")).V - a.rest.V;
+  const double weld_step = 0.1 * H * 2 * WeaveOptions().spacing * a.scale;
+  const double step = largest_edge_change(d, a.rest.F);
   std::printf(
       "[ measure  ] welded weave: %d welds; the motion changes along an edge by at most %.3f of "
       "the step at a weld\n",
@@ -313,30 +316,21 @@ TEST(SwatchAnimation, WeldedThreadPiecesBlendAtTheirWelds) {
 // degrees off the normal and all 30 threads were damped.
 TEST(SwatchAnimation, ThreadsRoundASphereLiftAlongItsNormal) {
   const TriMesh swatch = plain_weave();
-  SurfaceQuiltingOptions o;
-  o.scale = 0.2;
-  o.keep_sources = true;
-  TranslationCostCpu cpu;
-  SurfaceQuiltingStats stats;
-  const SurfaceQuilt quilt =
-      quilt_surface_global(test::uv_sphere(1, 48, 24), swatch, o, cpu, &stats);
-  QuiltEmbeddingStats e;
-  TetStretchCpu stretch;
-  const TriMesh rest = embed_quilt(quilt, {}, stretch, &e);
-  SwatchAnimation animation(quilt, e.kept, rest, swatch, stats.swatch_scale);
+  const Animated a = quilt_with_sources(test::uv_sphere(1, 48, 24), swatch, 0.2, true);
+  SwatchAnimation animation(a.quilt, a.embedding.kept, a.rest, swatch, a.scale);
   TriMesh lifted = swatch;
   lifted.V.col(2).array() += 0.2 * (swatch.V.col(2).maxCoeff() - swatch.V.col(2).minCoeff());
-  const std::vector<SwatchMotion> motions{swatch_motion(swatch, lifted, stats.swatch_scale, "f")};
+  const std::vector<SwatchMotion> motions{swatch_motion(swatch, lifted, a.scale, "f")};
   SettledMotionStats settled;
   animation.settle(motions, &settled);
   EXPECT_EQ(settled.damped + settled.stilled, 0);
-  const MatrixX3d d = animation.frame(motions[0]).V - rest.V;
+  const MatrixX3d d = animation.frame(motions[0]).V - a.rest.V;
   double worst = 1;
-  for (int v = 0; v < rest.num_vertices(); ++v)
-    worst = std::min(worst, d.row(v).normalized().dot(rest.V.row(v).normalized()));
+  for (int v = 0; v < a.rest.num_vertices(); ++v)
+    worst = std::min(worst, d.row(v).normalized().dot(a.rest.V.row(v).normalized()));
   std::printf(
       "[ measure  ] weave round a sphere: %zu threads, lifts at least %.4f along the normal\n",
-      quilt.elements.size(), worst);
+      a.quilt.elements.size(), worst);
   EXPECT_GT(worst, 0.99);
 }
 
