@@ -211,11 +211,7 @@ int run_plane(int argc, char** argv, int first) {
   if (!run.quiet()) {
     print_detail(swatch_detail, detail);
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
-    if (!requested.empty())
-      std::printf(
-          "swatch animation: %zu frames (to %s); %d elements move at half their motion and %d "
-          "stay still, where they would meet another element\n",
-          requested.size(), requested.back().output.c_str(), settled.damped, settled.stilled);
+    if (!requested.empty()) print_swatch_animation(requested, settled);
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);
   }

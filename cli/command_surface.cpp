@@ -596,11 +596,7 @@ void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
         "placed (%d off the surface)\n",
         gstats.singular_vertices, gstats.cut_edges, gstats.seamless ? ", seamless" : "",
         gstats.tiled ? "tiled" : "quilted", gstats.placed, gstats.off_surface);
-  if (!r.frames.empty())
-    std::printf(
-        "swatch animation: %zu frames (to %s); %d elements move at half their motion and %d "
-        "stay still, where they would meet another element\n",
-        r.frames.size(), r.frames.back().output.c_str(), o.settled.damped, o.settled.stilled);
+  if (!r.frames.empty()) print_swatch_animation(r.frames, o.settled);
   if (vines)
     std::printf(
         "%d stems (spacing %.4g, median %.2f swatch vines long; %d cut where they would "

@@ -13,6 +13,17 @@
 
 namespace mq::cli {
 
+void print_swatch_animation(const std::vector<SwatchFrame>& frames,
+                            const SettledMotionStats& settled) {
+  std::printf(
+      "swatch animation: %zu frames (to %s); %d elements move at half their motion and %d "
+      "stay still, where they would meet another element",
+      frames.size(), frames.back().output.c_str(), settled.damped, settled.stilled);
+  if (settled.faded > 0)
+    std::printf("; %d threads slow down near where they would meet", settled.faded);
+  std::printf("\n");
+}
+
 std::vector<SwatchFrame> requested_swatch_frames(const CommandLine& cl) {
   if (cl.has("swatch-frames") != cl.has("frames"))
     throw UsageError("--swatch-frames and --frames A-B go together");

@@ -15,6 +15,7 @@
 #include "core/common/stage_timer.h"
 #include "core/mesh/element_detail.h"
 #include "core/mesh/mesh_io.h"
+#include "core/mesh/settled_motion.h"
 #include "host/device.h"
 
 namespace mq::cli {
@@ -93,6 +94,10 @@ struct SwatchFrame {
 // The frames --swatch-frames and --frames ask for, or none. Throws UsageError when one comes
 // without the other, with --detail below 1, or for a pattern without one frame number.
 std::vector<SwatchFrame> requested_swatch_frames(const CommandLine& cl);
+
+// The summary line of a swatch animation: the frames written and the elements damped.
+void print_swatch_animation(const std::vector<SwatchFrame>& frames,
+                            const SettledMotionStats& settled);
 
 // Applies the shared options for the lifetime of the object: thread limit and progress sink.
 class RunContext {

@@ -15,6 +15,9 @@ struct SettledMotionStats {
   int rounds = 0;   // passes over the frames
   int damped = 0;   // elements moving at half their motion
   int stilled = 0;  // elements not moving at all
+  // Elements whose motion fades where the frames would make faces meet, all alike there
+  // (interlaced threads: core/shell/swatch_animation); not counted above.
+  int faded = 0;
 };
 
 // The positions of frame k (#V by 3) with each element's motion scaled by amplitude[e].

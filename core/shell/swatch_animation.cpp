@@ -9,11 +9,13 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "core/common/errors.h"
 #include "core/common/union_find.h"
 #include "core/mesh/closest_point_query.h"
 #include "core/mesh/geometry_measures.h"
+#include "core/mesh/mesh_intersections.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/mesh/similarity_fit.h"
 #include "core/planar/quilt_elements.h"
@@ -114,6 +116,7 @@ SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<in
   // degrees on a plane, enough to push it through the threads crossing it), which a long one
   // bends with the surface (bend_with_surface).
   const double reach = prepared.size.z();
+  shell_ = reach;
   rotation_.resize(static_cast<size_t>(rest.num_vertices()));
   std::vector<Eigen::Index> first{0};
   for (const int k : kept)
@@ -126,6 +129,7 @@ SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<in
     long_element.push_back((e.hi - e.lo).maxCoeff() >= 4 * (e.hi - e.lo).minCoeff());
   const bool any_long =
       std::find(long_element.begin(), long_element.end(), 1) != long_element.end();
+  fade_ = quilt.stitched && any_long;
   const MatrixX3d normals = any_long ? vertex_normals(quilt.base.V, quilt.base.F) : MatrixX3d();
   tbb::parallel_for(size_t{0}, kept.size(), [&](size_t i) {
     const Eigen::Index v0 = first[i], n = first[i + 1] - first[i];
@@ -500,7 +504,8 @@ MatrixX3d SwatchAnimation::positions(const SwatchMotion& motion,
   const MatrixX3d sections = cross_sections(motion);
   MatrixX3d D = MatrixX3d::Zero(rest_.num_vertices(), 3);
   tbb::parallel_for(0, rest_.num_vertices(), [&](int v) {
-    const double a = amplitude[static_cast<size_t>(component_[static_cast<size_t>(v)])];
+    const double a = amplitude[static_cast<size_t>(component_[static_cast<size_t>(v)])] *
+                     (fade_share_.empty() ? 1.0 : fade_share_[static_cast<size_t>(v)]);
     if (a == 0) return;
     const Vector3d d = displacement(motion, sections, static_cast<size_t>(v));
     if (d.isZero(0)) return;
@@ -514,13 +519,80 @@ MatrixX3d SwatchAnimation::positions(const SwatchMotion& motion,
   return V;
 }
 
+// Interlaced threads cannot be damped one by one: a thread moving half as much, or not at all,
+// meets the threads crossing it as they move, and the damping spread to every thread (the cup's
+// weave lifted by 0.2 of its thickness: 7 threads folded in its concave corners, all 59 ended
+// still). So where the frames make faces meet, every vertex's motion fades alike, to none at the
+// meeting and in full beyond a radius (2, 4, 8 then 16 shell heights, while faces still meet):
+// neighbours there keep their places relative to each other.
+void SwatchAnimation::fade_near_meetings(const std::vector<SwatchMotion>& motions) {
+  const int nv = rest_.num_vertices();
+  IntersectionOptions all;
+  all.between_components_only = false;
+  const auto at_rest = intersecting_face_pairs(rest_.V, rest_.F, all);
+  const std::set<std::pair<int, int>> known(at_rest.begin(), at_rest.end());
+  std::vector<Vector3d> meetings;  // rest positions of the faces that meet in some frame
+  const std::vector<double> whole(amplitude_.size(), 1.0);
+  for (int round = 0; round < 4; ++round) {
+    const size_t before = meetings.size();
+    for (const SwatchMotion& m : motions) {
+      const MatrixX3d V = positions(m, whole);
+      std::vector<char> moved(static_cast<size_t>(rest_.num_faces()), 0);
+      for (int f = 0; f < rest_.num_faces(); ++f)
+        for (int k = 0; k < 3; ++k)
+          moved[static_cast<size_t>(f)] |= V.row(rest_.F(f, k)) != rest_.V.row(rest_.F(f, k));
+      for (const auto& [f, g] : intersecting_face_pairs_touching(V, rest_.F, moved)) {
+        if (known.count({f, g})) continue;
+        for (const int h : {f, g})
+          meetings.push_back(
+              (rest_.V.row(rest_.F(h, 0)) + rest_.V.row(rest_.F(h, 1)) + rest_.V.row(rest_.F(h, 2)))
+                  .transpose() /
+              3.0);
+      }
+    }
+    if (meetings.size() == before) break;
+    // Each vertex's share: the smoothstep of its distance to the nearest meeting over the
+    // radius, found among the meetings in the 27 cells of that size around it.
+    const double radius = 2 * shell_ * std::pow(2.0, round);
+    using Cell = std::array<std::int64_t, 3>;
+    const auto cell_of = [&](const Vector3d& p) {
+      return Cell{static_cast<std::int64_t>(std::floor(p.x() / radius)),
+                  static_cast<std::int64_t>(std::floor(p.y() / radius)),
+                  static_cast<std::int64_t>(std::floor(p.z() / radius))};
+    };
+    std::map<Cell, std::vector<Vector3d>> cells;
+    for (const Vector3d& p : meetings) cells[cell_of(p)].push_back(p);
+    fade_share_.assign(static_cast<size_t>(nv), 1.0);
+    tbb::parallel_for(0, nv, [&](int v) {
+      const Vector3d x = rest_.V.row(v).transpose();
+      const Cell c = cell_of(x);
+      double nearest = radius;
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy)
+          for (std::int64_t dz = -1; dz <= 1; ++dz) {
+            const auto it = cells.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == cells.end()) continue;
+            for (const Vector3d& p : it->second) nearest = std::min(nearest, (p - x).norm());
+          }
+      const double t = nearest / radius;
+      fade_share_[static_cast<size_t>(v)] = t * t * (3 - 2 * t);
+    });
+  }
+  std::vector<char> faded(amplitude_.size(), 0);
+  for (int v = 0; v < nv && !fade_share_.empty(); ++v)
+    if (fade_share_[static_cast<size_t>(v)] < 1) faded[component_[static_cast<size_t>(v)]] = 1;
+  faded_elements_ = static_cast<int>(std::count(faded.begin(), faded.end(), 1));
+}
+
 void SwatchAnimation::settle(const std::vector<SwatchMotion>& motions, SettledMotionStats* stats) {
+  if (fade_) fade_near_meetings(motions);
   amplitude_ = settled_amplitudes(
       rest_.V, rest_.F, static_cast<int>(motions.size()),
       [&](int k, const std::vector<double>& a) {
         return positions(motions[static_cast<size_t>(k)], a);
       },
       stats);
+  if (stats) stats->faded = faded_elements_;
 }
 
 TriMesh SwatchAnimation::frame(const SwatchMotion& motion) const {

@@ -87,6 +87,7 @@ class SwatchAnimation {
   void fit_parts(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0, Eigen::Index n);
   void find_seams();
   void blend_seams(MatrixX3d& D) const;
+  void fade_near_meetings(const std::vector<SwatchMotion>& motions);
   void fit_frames(const MatrixX3d& source, const MatrixX3d& out, Eigen::Index v0, Eigen::Index n,
                   double reach);
   MatrixX3d cross_sections(const SwatchMotion& motion) const;
@@ -122,6 +123,13 @@ class SwatchAnimation {
     Adjacency neighbours;
   } seams_;
   std::vector<double> amplitude_;  // per element of rest: its motion's share (settle)
+  // Threads stitched or welded of parts (SurfaceQuilt::stitched with long elements) are damped
+  // where they would meet, all of them alike, fading with the distance (fade_near_meetings):
+  // #V(rest) shares of each vertex's motion, or empty (1). The shell height scales the fade.
+  bool fade_ = false;
+  double shell_ = 0;
+  std::vector<double> fade_share_;
+  int faded_elements_ = 0;
 };
 
 }  // namespace mq
