@@ -9,6 +9,15 @@
 
 namespace mq {
 
+std::vector<char> moved_faces(const MatrixX3d& rest, const MatrixX3d& V, const MatrixX3i& F) {
+  std::vector<char> moved(static_cast<size_t>(F.rows()), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    moved[static_cast<size_t>(f)] = V.row(F(f, 0)) != rest.row(F(f, 0)) ||
+                                    V.row(F(f, 1)) != rest.row(F(f, 1)) ||
+                                    V.row(F(f, 2)) != rest.row(F(f, 2));
+  return moved;
+}
+
 std::vector<double> settled_amplitudes(const MatrixX3d& rest, const MatrixX3i& F, int frames,
                                        const FramePositions& positions, SettledMotionStats* stats) {
   std::vector<int> label;
@@ -42,12 +51,7 @@ std::vector<double> settled_amplitudes(const MatrixX3d& rest, const MatrixX3i& F
       const MatrixX3d V = positions(k, amplitude);
       // At first the faces that move in this frame (pairs of faces at rest are rest's), then
       // those of the elements just damped.
-      std::vector<char> tested = active;
-      if (first)
-        for (Eigen::Index f = 0; f < F.rows(); ++f)
-          tested[static_cast<size_t>(f)] = V.row(F(f, 0)) != rest.row(F(f, 0)) ||
-                                           V.row(F(f, 1)) != rest.row(F(f, 1)) ||
-                                           V.row(F(f, 2)) != rest.row(F(f, 2));
+      const std::vector<char> tested = first ? moved_faces(rest, V, F) : active;
       if (std::find(tested.begin(), tested.end(), 1) == tested.end()) continue;
       const auto pairs = intersecting_face_pairs_touching(V, F, tested);
       for (const auto& pair : pairs)

@@ -20,6 +20,9 @@ struct SettledMotionStats {
   int faded = 0;
 };
 
+// Per face of F (#F), whether a corner's position in V differs from rest (both #V by 3).
+std::vector<char> moved_faces(const MatrixX3d& rest, const MatrixX3d& V, const MatrixX3i& F);
+
 // The positions of frame k (#V by 3) with each element's motion scaled by amplitude[e].
 using FramePositions = std::function<MatrixX3d(int k, const std::vector<double>& amplitude)>;
 

@@ -537,11 +537,8 @@ void SwatchAnimation::fade_near_meetings(const std::vector<SwatchMotion>& motion
     const size_t before = meetings.size();
     for (const SwatchMotion& m : motions) {
       const MatrixX3d V = positions(m, whole);
-      std::vector<char> moved(static_cast<size_t>(rest_.num_faces()), 0);
-      for (int f = 0; f < rest_.num_faces(); ++f)
-        for (int k = 0; k < 3; ++k)
-          moved[static_cast<size_t>(f)] |= V.row(rest_.F(f, k)) != rest_.V.row(rest_.F(f, k));
-      for (const auto& [f, g] : intersecting_face_pairs_touching(V, rest_.F, moved)) {
+      for (const auto& [f, g] :
+           intersecting_face_pairs_touching(V, rest_.F, moved_faces(rest_.V, V, rest_.F))) {
         if (known.count({f, g})) continue;
         for (const int h : {f, g})
           meetings.push_back(
