@@ -283,4 +283,29 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
   }
 }
 
+void print_structure_kept(const StructureReport& r, const SwatchStructure& swatch,
+                          const StructureComparison& comparison) {
+  print_kept(r, comparison, swatch.ring_kinds() > 1);
+}
+
+void write_structure_check(JsonWriter& j, const std::vector<StructureShortfall>& shortfalls) {
+  j.begin_object("structure_check").value("passed", shortfalls.empty()).begin_array("shortfalls");
+  for (const StructureShortfall& s : shortfalls)
+    j.begin_object()
+        .value("measure", structure_measure_name(s.measure))
+        .value("value", s.value)
+        .value("limit", s.limit)
+        .value("text", s.text)
+        .end_object();
+  j.end_array().end_object();
+}
+
+void warn_structure(const char* command, const std::vector<StructureShortfall>& shortfalls,
+                    const std::string& hint) {
+  std::fflush(stdout);  // after the summary when both go to one terminal or file
+  for (const StructureShortfall& s : shortfalls)
+    std::fprintf(stderr, "meshquilt %s: warning: %s%s%s\n", command, s.text.c_str(),
+                 hint.empty() ? "" : "; ", hint.c_str());
+}
+
 }  // namespace mq::cli

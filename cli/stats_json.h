@@ -3,6 +3,7 @@
 
 #include "cli/json_writer.h"
 #include "core/planar/patch_quilting.h"
+#include "core/structure/structure_check.h"
 #include "core/structure/texture_structure.h"
 
 namespace mq::cli {
@@ -21,5 +22,19 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
 // The same as a few plain lines on stdout, each starting with `indent`.
 void print_structure(const StructureReport& r, const SwatchStructure* swatch,
                      const StructureComparison* comparison);
+
+// The comparison's kept-structure lines only (links, density, long elements): what a run
+// prints of its own check without --stats.
+void print_structure_kept(const StructureReport& r, const SwatchStructure& swatch,
+                          const StructureComparison& comparison);
+
+// Writes "structure_check": whether the result is within core/structure/structure_check's
+// limits ("passed") and each figure outside them (measure, value, limit, text).
+void write_structure_check(JsonWriter& j, const std::vector<StructureShortfall>& shortfalls);
+
+// Each shortfall as a line "meshquilt COMMAND: warning: TEXT; HINT" on stderr (shown with
+// --quiet too: a result outside the limits is never reported as a plain success).
+void warn_structure(const char* command, const std::vector<StructureShortfall>& shortfalls,
+                    const std::string& hint);
 
 }  // namespace mq::cli

@@ -736,6 +736,10 @@ class _Quilting:
                 run.cleanup()
             self.report({"INFO"}, "meshquilt: %s%s, %d faces" % (
                 obj.name, " (preview)" if run.preview else "", len(obj.data.polygons)))
+            # A result that lost the swatch's structure is made, and said so (issue 23).
+            warnings = (obj.get("meshquilt_report") or {}).get("warnings")
+            if warnings:
+                self.report({"WARNING"}, "meshquilt: %s: %s" % (obj.name, warnings))
             return {"FINISHED"}
         run.cleanup()
         if run.state == "failed":
@@ -1132,6 +1136,9 @@ def _draw_report(layout, obj):
         col.label(text="Links kept: %.0f%%" % report["links_kept"])
     if "coverage" in report:
         col.label(text="Coverage: %.0f%%" % report["coverage"])
+    for warning in (report.get("warnings") or "").split("; "):
+        if warning:
+            col.label(text=warning, icon="ERROR")
     if "distorted" in report:
         col.label(text="Over 1.5x size: %d" % report["distorted"])
         if report["distorted"]:

@@ -231,6 +231,11 @@ def structure_report(stats_path=None, elements_csv=None):
             report["links_kept"] = 100.0 * float(structure["share_with_swatch_links"])
         if stats.get("coverage") is not None:
             report["coverage"] = 100.0 * float(stats["coverage"])
+        # The engine's own check of the structure (core/structure/structure_check): each figure
+        # outside its limit, one sentence each, joined (ID properties hold no list of strings).
+        shortfalls = (stats.get("structure_check") or {}).get("shortfalls") or []
+        if shortfalls:
+            report["warnings"] = "; ".join(str(s["text"]) for s in shortfalls)
     if elements_csv and os.path.exists(elements_csv):
         ids, ratios = read_elements_csv(elements_csv)
         report.setdefault("elements", len(ids))

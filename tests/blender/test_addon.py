@@ -538,6 +538,43 @@ def test_structure_report_is_stored_on_the_result():
 
 
 @test
+def test_the_engines_structure_warnings_are_shown_on_the_result():
+    """A result whose structure the engine's own check finds short (issue 23) carries the
+    warnings into the panel's Structure box; one within the limits carries none."""
+    import subprocess
+    import meshquilt
+    scene = new_scene()
+    from meshquilt import exchange
+    base_obj = small_sphere()
+    V, T, _ = exchange.mesh_arrays(base_obj.data)
+    base = os.path.join(WORK, "check_base.ply")
+    exchange.write_ply(base, V, T)
+    sw = os.path.join(WORK, "check_sheet.obj")
+    subprocess.run([ENGINE, "swatch", "chainmail", "--rows", "2", "--cols", "4", "-o", sw,
+                    "--quiet"], check=True)
+    reports = {}
+    for method in ("patches", "global"):
+        out, stats = (os.path.join(WORK, "check_%s.%s" % (method, e)) for e in ("ply", "json"))
+        done = subprocess.run([ENGINE, "surface", "--base", base, "--swatch", sw, "--scale",
+                               "0.3", "--method", method, "-o", out, "--stats", stats,
+                               "--quiet"], capture_output=True, text=True, timeout=120)
+        check(done.returncode == 0, done.stderr)
+        reports[method] = exchange.structure_report(stats)
+    warned = reports["patches"].get("warnings", "")
+    check("of interior rings keep their swatch's links" in warned and "(gaps)" in warned,
+          "patches: %r" % warned)
+    check("warnings" not in reports["global"], "global: %r" % reports["global"])
+    obj = bpy.data.objects.new("Checked", bpy.data.meshes.new("Checked"))
+    obj.data.attributes.new("element_id", "INT", "FACE")  # what the panel knows a result by
+    scene.collection.objects.link(obj)
+    meshquilt.store_report(obj, reports["patches"])
+    bpy.context.view_layer.objects.active = obj
+    texts = drawn_panel()
+    for warning in warned.split("; "):
+        check(warning in texts, "the panel does not show %r: %s" % (warning, texts))
+
+
+@test
 def test_select_distorted_selects_their_faces_and_follows_removals():
     scene, obj = quilted_small_sphere()
     import meshquilt

@@ -1,0 +1,52 @@
+// The tool's verdict on its own result (issue 23: no silent wrong result): the structure
+// figures of core/structure/texture_structure set against limits below which the texture has
+// lost what makes it mesh quilting rather than scattered copies (paper section 1.2: elements
+// kept whole and interlinked, threads running on). A result within the limits can still miss
+// the gallery's figures; one outside them is broken somewhere a user can see: chain mail where
+// one ring in four lacks a link, a lattice with gaps (the local patches on a small sheet: 39%
+// of the swatch's density on the cup), threads cut at every patch seam (a bird's nest).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/structure/texture_structure.h"
+
+namespace mq {
+
+struct StructureCheckOptions {
+  // Interior rings with their own swatch kind's link count (degenerate rings are misses), as a
+  // fraction: under it more than one ring in four is off the swatch's pattern.
+  double min_link_share = 0.75;
+  // Compact elements per area against the swatch's at the output's scale (swatches of compact
+  // elements only: rings, apples; threads and vines join or space out by design).
+  double min_density = 0.7, max_density = 1.4;
+  // The median long element (thread, vine) in swatch long elements: 1 when every one is cut
+  // where a patch ends.
+  double min_long_length = 1.5;
+  // Throws InvalidInput unless 0 <= min_link_share <= 1, 0 < min_density <= 1 <= max_density
+  // and min_long_length >= 0, all finite.
+  void validate() const;
+};
+
+// One figure outside its limit.
+struct StructureShortfall {
+  enum class Measure { Links, Density, LongLength };
+  Measure measure = Measure::Links;
+  double value = 0;  // the figure (a fraction for links and density, swatch lengths for threads)
+  double limit = 0;  // the limit it is on the wrong side of
+  std::string text;  // one sentence in the user's terms, naming the figure and the limit
+};
+
+// Stable name of a measure, for the --stats file ("links", "density", "long_length").
+const char* structure_measure_name(StructureShortfall::Measure measure);
+
+// The figures of `summary` (summarize_structure of an output against its swatch) outside the
+// limits, in the order of StructureShortfall::Measure; empty for a result within them. A figure
+// the summary does not have (no rings, no long elements, a swatch with long elements for the
+// density) is not judged, nor are threads short because the surface is (most of their ends on
+// its border). Throws InvalidInput as StructureCheckOptions::validate.
+std::vector<StructureShortfall> check_structure(const StructureSummary& summary,
+                                                const StructureCheckOptions& options = {});
+
+}  // namespace mq

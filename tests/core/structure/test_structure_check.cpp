@@ -1,0 +1,119 @@
+// The structure check's limits (core/structure/structure_check) on comparisons made up to sit
+// either side of each limit (the CLI tests run it on real results).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/common/errors.h"
+#include "core/structure/structure_check.h"
+
+namespace mq {
+namespace {
+
+using Measure = StructureShortfall::Measure;
+
+// Rings: `interior` of them judged against a swatch kind of 4 links, `share` with them.
+StructureSummary rings(int interior, double share) {
+  StructureSummary s;
+  s.swatch.interior_links = 4;
+  s.comparison.interior_links = 4;
+  s.comparison.share_matching = share;
+  KindComparison k;
+  k.kind = "ring";
+  k.interior_links = 4;
+  k.interior_rings = interior;
+  k.share = share;
+  s.comparison.kinds.push_back(k);
+  return s;
+}
+
+// Threads `ratio` swatch threads long (median), `interior` of their `ends` inside the surface.
+StructureSummary threads(double ratio, int ends, int interior) {
+  StructureSummary s;
+  s.comparison.long_length_ratio = ratio;
+  s.output.ends = ends;
+  s.output.interior_ends = interior;
+  return s;
+}
+
+TEST(StructureCheck, RingsUnderTheShareAreFlaggedOnlyWhenThereAreEnoughToJudge) {
+  const std::vector<StructureShortfall> low = check_structure(rings(40, 0.5));
+  ASSERT_EQ(low.size(), 1u);
+  EXPECT_EQ(low[0].measure, Measure::Links);
+  EXPECT_DOUBLE_EQ(low[0].value, 0.5);
+  EXPECT_DOUBLE_EQ(low[0].limit, 0.75);
+  EXPECT_EQ(low[0].text, "50.0% of interior rings keep their swatch's links, under 75.0%");
+  EXPECT_TRUE(check_structure(rings(40, 0.75)).empty());
+  // 10 interior rings: one more or less moves the share by 10%; not judged.
+  EXPECT_TRUE(check_structure(rings(10, 0.2)).empty());
+  // A swatch without rings has no links to keep.
+  StructureSummary no_rings = rings(40, 0.0);
+  no_rings.swatch.interior_links = -1;
+  EXPECT_TRUE(check_structure(no_rings).empty());
+}
+
+TEST(StructureCheck, DensityIsJudgedBothWaysForCompactSwatchesOnly) {
+  StructureSummary c;  // a swatch without long elements
+  c.comparison.density_ratio = 0.5;
+  std::vector<StructureShortfall> s = check_structure(c);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].measure, Measure::Density);
+  EXPECT_DOUBLE_EQ(s[0].limit, 0.7);
+  EXPECT_NE(s[0].text.find("50.0% as dense as the swatch's, under 70.0% (gaps)"), std::string::npos)
+      << s[0].text;
+  c.comparison.density_ratio = 1.5;
+  s = check_structure(c);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_DOUBLE_EQ(s[0].limit, 1.4);
+  EXPECT_NE(s[0].text.find("over 140.0% (crowded)"), std::string::npos) << s[0].text;
+  c.comparison.density_ratio = 1.0;
+  EXPECT_TRUE(check_structure(c).empty());
+  // Vines with leaves: stems are spaced out by design, their leaves' density says nothing.
+  c.swatch.report.long_elements = 2;
+  c.comparison.density_ratio = 0.1;
+  EXPECT_TRUE(check_structure(c).empty());
+}
+
+TEST(StructureCheck, ThreadsCutInsideTheSurfaceAreFlaggedNotThoseItsBorderEnds) {
+  const std::vector<StructureShortfall> s = check_structure(threads(1.0, 148, 117));
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].measure, Measure::LongLength);
+  EXPECT_EQ(s[0].text,
+            "the median thread runs 1.00 swatch threads, under 1.5 (cut where patches meet)");
+  EXPECT_TRUE(check_structure(threads(3.2, 84, 19)).empty());
+  // No long elements measured.
+  EXPECT_TRUE(check_structure(threads(0, 0, 0)).empty());
+  // Short because the surface is: most ends on its border.
+  EXPECT_TRUE(check_structure(threads(1.0, 40, 10)).empty());
+}
+
+TEST(StructureCheck, EveryShortfallInMeasureOrderWithItsName) {
+  StructureSummary c = rings(100, 0.1);
+  c.comparison.density_ratio = 0.3;
+  c.comparison.long_length_ratio = 1.2;
+  c.output.ends = c.output.interior_ends = 10;
+  const std::vector<StructureShortfall> s = check_structure(c);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_STREQ(structure_measure_name(s[0].measure), "links");
+  EXPECT_STREQ(structure_measure_name(s[1].measure), "density");
+  EXPECT_STREQ(structure_measure_name(s[2].measure), "long_length");
+}
+
+TEST(StructureCheck, OptionsAreValidated) {
+  StructureCheckOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.min_link_share = 1.5;
+  EXPECT_THROW(check_structure(StructureSummary{}, o), InvalidInput);
+  o = {};
+  o.min_density = 0;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o = {};
+  o.max_density = 0.9;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o = {};
+  o.min_long_length = std::nan("");
+  EXPECT_THROW(o.validate(), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mq
