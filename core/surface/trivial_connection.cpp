@@ -380,16 +380,32 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index, const MatrixX
   const double unit = kTwoPi / N_;
   // Minimal rotation (in the cotangent-weighted norm) with the prescribed holonomy around every
   // interior vertex and generator: x = W A^T (A W A^T)^-1 b.
-  Eigen::VectorXd b(A_.rows());
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(A_.rows());
   for (int v = 0; v < nv; ++v)
     if (row_of_vertex_[v] >= 0) b(row_of_vertex_[v]) = index[static_cast<size_t>(v)] * unit - K_(v);
-  for (size_t g = 0; g < generator_holonomy_.size(); ++g) {
-    const double h = generator_holonomy_[g];
-    b(vertex_rows_ + static_cast<int>(g)) = unit * std::round(h / unit) - h;
-  }
   // With boundary values, x = W A^T lambda + y, y their own rotation: A x = b still holds.
   const Eigen::VectorXd y = boundary_rotation(boundary);
-  if (boundary.size()) b -= A_ * y;
+  if (boundary.size()) b.head(vertex_rows_) -= A_.topRows(vertex_rows_) * y;
+  // Each generator's holonomy is rounded to whole 1/N turns from the flat metric's own (the
+  // Levi-Civita one plus the rotation of the vertex rows alone, x_v = W A_v^T L^-1 b_v + y, the
+  // metric's connection): what is left, at most half a turn unit, is the rotation no conformal
+  // layout follows, spread over the surface as stretch (rounded from the Levi-Civita holonomy
+  // alone it could be anything: genus 3 at 0.08, 24% of the weave's pieces over aspect 1.6).
+  const Eigen::VectorXd lambda_v = laplacian_.solve(Eigen::VectorXd(b.head(vertex_rows_)));
+  MQ_CHECK(laplacian_.info() == Eigen::Success && lambda_v.allFinite(), SolverFailure,
+           "trivial connection: the metric's rotation could not be solved");
+  Eigen::VectorXd x_v = weight_.cwiseProduct(
+      Eigen::SparseMatrix<double>(A_.topRows(vertex_rows_)).transpose() * lambda_v);
+  if (boundary.size()) x_v += y;
+  const Eigen::VectorXd flux = A_.bottomRows(A_.rows() - vertex_rows_) * x_v;
+  const Eigen::VectorXd boundary_flux =
+      boundary.size() ? Eigen::VectorXd(A_.bottomRows(A_.rows() - vertex_rows_) * y)
+                      : Eigen::VectorXd::Zero(flux.size());
+  for (size_t g = 0; g < generator_holonomy_.size(); ++g) {
+    const Eigen::Index r = static_cast<Eigen::Index>(g);
+    const double h = generator_holonomy_[g], flat = h + flux(r);
+    b(vertex_rows_ + r) = unit * std::round(flat / unit) - h - boundary_flux(r);
+  }
   const Eigen::VectorXd lambda = augmented_.solve(b);
   MQ_CHECK(augmented_.info() == Eigen::Success && lambda.allFinite(), SolverFailure,
            "trivial connection: the generator solve failed");
