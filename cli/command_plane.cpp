@@ -24,8 +24,9 @@ namespace {
 // The --stats file's JSON (written with the mesh, as one commit).
 std::string stats_json(const PlanarQuiltingStats& s, const std::string& device, int threads,
                        double wall, const std::string& swatch, double length, double width,
-                       const StructureSummary& structure, const ElementDetail& detail,
-                       double detail_share) {
+                       const StructureSummary& structure,
+                       const std::vector<StructureShortfall>& shortfalls,
+                       const ElementDetail& detail, double detail_share) {
   JsonWriter j;
   j.begin_object()
       .value("command", "plane")
@@ -50,11 +51,24 @@ std::string stats_json(const PlanarQuiltingStats& s, const std::string& device, 
   write_match_counts(j, s.counts);
   j.value("matched_point_offsets", s.matched_point_offsets);
   write_structure(j, structure.output, &structure.swatch, &structure.comparison);
+  write_structure_check(j, shortfalls);
   write_detail(j, detail, detail_share);
   j.begin_object("stage_seconds");
   for (const auto& [stage, seconds] : s.times.stages()) j.value(stage, seconds);
   j.end_object().end_object();
   return j.str();
+}
+
+// The structure figures and the run's own check of them (issue 23, as `surface`), not part of
+// the run's wall time (returns the seconds taken); the stats then land with the mesh as one
+// commit (issue 28), made once it is written.
+double measure_structure(const TriMesh& result, const TriMesh& swatch, PlanarQuiltingStats& stats,
+                         StructureSummary& structure, std::vector<StructureShortfall>& shortfalls) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ScopedStageTimer timer(stats.times, Stage::Structure);
+  structure = summarize_structure(result, swatch, nullptr, 1.0);
+  shortfalls = check_structure(structure);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void declare_plane_options(CommandLine& cl) {
@@ -125,6 +139,24 @@ void print_plane_summary(const std::string& out_path, const PlanarQuiltingStats&
       stats.counts.added, stats.counts.matched, stats.removed_post);
 }
 
+// Every file the run writes (the mesh or each frame's, their .mtl, the stats) checked against
+// the inputs and for a known format before any work.
+void check_plane_paths(const CommandLine& cl, const std::vector<SwatchFrame>& requested,
+                       const std::string& out_path, const WriteOptions& write_options) {
+  std::vector<std::string> outputs, inputs{cl.get("swatch")};
+  for (const SwatchFrame& f : requested) inputs.push_back(f.swatch);
+  if (requested.empty()) {
+    mesh_format_from_path(out_path);  // fail on an unknown extension before any work
+    for (const std::string& file : output_files(out_path, write_options)) outputs.push_back(file);
+  }
+  for (const SwatchFrame& f : requested) {
+    mesh_format_from_path(f.output);
+    for (const std::string& file : output_files(f.output, write_options)) outputs.push_back(file);
+  }
+  outputs.push_back(cl.get("stats"));
+  check_paths(outputs, inputs);
+}
+
 }  // namespace
 
 int run_plane(int argc, char** argv, int first) {
@@ -141,19 +173,7 @@ int run_plane(int argc, char** argv, int first) {
   const std::vector<SwatchFrame> requested = requested_swatch_frames(cl);
   const std::string out_path = requested.empty() ? cl.get("output") : requested.front().output;
   const WriteOptions write_options = output_options(cl);
-  std::vector<std::string> outputs, inputs{cl.get("swatch")};
-  for (const SwatchFrame& f : requested) inputs.push_back(f.swatch);
-  for (const std::string& out :
-       requested.empty() ? std::vector<std::string>{out_path} : std::vector<std::string>{}) {
-    mesh_format_from_path(out);  // fail on an unknown extension before any work
-    for (const std::string& file : output_files(out, write_options)) outputs.push_back(file);
-  }
-  for (const SwatchFrame& f : requested) {
-    mesh_format_from_path(f.output);
-    for (const std::string& file : output_files(f.output, write_options)) outputs.push_back(file);
-  }
-  outputs.push_back(cl.get("stats"));
-  check_paths(outputs, inputs);
+  check_plane_paths(cl, requested, out_path, write_options);
 
   const PlanarQuiltingOptions options = plane_options(cl);
   const double detail = detail_share(cl);
@@ -177,16 +197,9 @@ int run_plane(int argc, char** argv, int first) {
   MQ_CHECK(result.num_faces() > 0, InvalidInput,
            "the layer is empty: no element of the swatch fits the ", options.length, " x ",
            options.width, " domain; nothing written");
-  // The structure figures for --stats, not part of the run's wall time; the stats then land
-  // with the mesh as one commit (issue 28), made once it is written out.
   StructureSummary structure;
-  double measuring = 0;
-  if (!run.stats_path().empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    ScopedStageTimer timer(stats.times, Stage::Structure);
-    structure = summarize_structure(result, swatch, nullptr, 1.0);
-    measuring = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  std::vector<StructureShortfall> shortfalls;
+  const double measuring = measure_structure(result, swatch, stats, structure, shortfalls);
   // The mesh and the --stats file are one commit (issue 28); with --swatch-frames the mesh is
   // the first frame's, and the others follow.
   std::optional<SwatchAnimation> animation;
@@ -197,12 +210,13 @@ int run_plane(int argc, char** argv, int first) {
     animation = animate_layer(result, sources, swatch, requested, frames, motions, settled);
   }
   const auto frame = [&](size_t k) { return animation->frame(motions[k]); };
-  const double wall = write_output_and_stats(
-      run, out_path, animation ? frame(0) : result, write_options, stats.times, start, measuring,
-      [&](double w) {
-        return stats_json(stats, evaluator->name(), run.threads(), w, cl.get("swatch"),
-                          options.length, options.width, structure, swatch_detail, detail);
-      });
+  const double wall =
+      write_output_and_stats(run, out_path, animation ? frame(0) : result, write_options,
+                             stats.times, start, measuring, [&](double w) {
+                               return stats_json(stats, evaluator->name(), run.threads(), w,
+                                                 cl.get("swatch"), options.length, options.width,
+                                                 structure, shortfalls, swatch_detail, detail);
+                             });
   for (size_t k = 1; k < requested.size(); ++k) {
     ScopedStageProgress shown(run.progress(), Stage::Writing);
     write_output(requested[k].output, frame(k), write_options);
@@ -214,7 +228,11 @@ int run_plane(int argc, char** argv, int first) {
     if (!requested.empty()) print_swatch_animation(requested, settled);
     if (!run.stats_path().empty())
       print_structure(structure.output, &structure.swatch, &structure.comparison);
+    else
+      print_structure_kept(structure.output, structure.swatch, structure.comparison);
   }
+  // A swatch of few elements leaves the patches little to match across their overlaps.
+  warn_structure("plane", shortfalls, "a swatch of more elements gives the patches more to match");
   return 0;
 }
 

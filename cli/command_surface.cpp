@@ -560,6 +560,17 @@ SwatchAnimation animate(const SurfaceRequest& r, const SurfaceInputs& in, const 
   return animation;
 }
 
+// Every method keeps the sources when asked (SurfaceQuiltingOptions::keep_sources, issue 25):
+// an element without them is a fault of ours, found before the embedding.
+void check_sources(const SurfaceRequest& r, const SurfaceQuilt& quilt) {
+  const bool sourced =
+      std::all_of(quilt.elements.begin(), quilt.elements.end(), [](const SurfaceElement& e) {
+        return e.source.rows() == static_cast<Eigen::Index>(e.face.size());
+      });
+  MQ_CHECK(r.frames.empty() || sourced, InternalError,
+           "--swatch-frames: the result's elements do not say where in the swatch they come from");
+}
+
 // The summary a run prints unless --quiet (the structure follows with --stats).
 void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
                            const SurfaceOutcome& o, const std::string& device, int threads) {
@@ -663,14 +674,7 @@ int run_surface(int argc, char** argv, int first) {
   std::unique_ptr<TranslationCostEvaluator> evaluator = make_translation_cost_evaluator(r.device);
   SurfaceOutcome o;
   SurfaceQuilt quilt = quilt_by_method(r, in, *evaluator, run.progress(), o);
-  // Every method keeps the sources when asked (SurfaceQuiltingOptions::keep_sources, issue 25):
-  // an element without them is a fault of ours, found before the embedding.
-  const bool sourced =
-      std::all_of(quilt.elements.begin(), quilt.elements.end(), [](const SurfaceElement& e) {
-        return e.source.rows() == static_cast<Eigen::Index>(e.face.size());
-      });
-  MQ_CHECK(r.frames.empty() || sourced, InternalError,
-           "--swatch-frames: the result's elements do not say where in the swatch they come from");
+  check_sources(r, quilt);
   if (cl.has("mask")) {
     r.embedding.coverage_faces = mask_quilt_faces(in.mask, in.base, quilt);
     drop_unmasked_elements(quilt, r.embedding.coverage_faces);

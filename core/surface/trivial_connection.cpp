@@ -369,6 +369,32 @@ Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index,
   return u;
 }
 
+// Each generator's holonomy is rounded to whole 1/N turns from the flat metric's own (the
+// Levi-Civita one plus the rotation of the vertex rows alone, x_v = W A_v^T L^-1 b_v + y, the
+// metric's connection): what is left, at most half a turn unit, is the rotation no conformal
+// layout follows, spread over the surface as stretch (rounded from the Levi-Civita holonomy alone
+// it could be anything: genus 3 at 0.08, 24% of the weave's pieces over aspect 1.6; issue 23).
+void TrivialConnection::set_generator_rows(Eigen::VectorXd& b, const Eigen::VectorXd& y,
+                                           bool has_boundary) const {
+  const double unit = kTwoPi / N_;
+  const Eigen::VectorXd lambda_v = laplacian_.solve(Eigen::VectorXd(b.head(vertex_rows_)));
+  MQ_CHECK(laplacian_.info() == Eigen::Success && lambda_v.allFinite(), SolverFailure,
+           "trivial connection: the metric's rotation could not be solved");
+  Eigen::VectorXd x_v = weight_.cwiseProduct(
+      Eigen::SparseMatrix<double>(A_.topRows(vertex_rows_)).transpose() * lambda_v);
+  const Eigen::Index generators = A_.rows() - vertex_rows_;
+  Eigen::VectorXd boundary_flux = Eigen::VectorXd::Zero(generators);
+  if (has_boundary) {
+    x_v += y;
+    boundary_flux = A_.bottomRows(generators) * y;
+  }
+  const Eigen::VectorXd flux = A_.bottomRows(generators) * x_v;
+  for (Eigen::Index g = 0; g < generators; ++g) {
+    const double h = generator_holonomy_[static_cast<size_t>(g)], flat = h + flux(g);
+    b(vertex_rows_ + g) = unit * std::round(flat / unit) - h - boundary_flux(g);
+  }
+}
+
 ConeMetric TrivialConnection::solve(const std::vector<int>& index, const MatrixX3d& guidance,
                                     const Eigen::VectorXd& boundary) const {
   const int nv = static_cast<int>(V_.rows()), nf = static_cast<int>(F_.rows());
@@ -386,26 +412,7 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index, const MatrixX
   // With boundary values, x = W A^T lambda + y, y their own rotation: A x = b still holds.
   const Eigen::VectorXd y = boundary_rotation(boundary);
   if (boundary.size()) b.head(vertex_rows_) -= A_.topRows(vertex_rows_) * y;
-  // Each generator's holonomy is rounded to whole 1/N turns from the flat metric's own (the
-  // Levi-Civita one plus the rotation of the vertex rows alone, x_v = W A_v^T L^-1 b_v + y, the
-  // metric's connection): what is left, at most half a turn unit, is the rotation no conformal
-  // layout follows, spread over the surface as stretch (rounded from the Levi-Civita holonomy
-  // alone it could be anything: genus 3 at 0.08, 24% of the weave's pieces over aspect 1.6).
-  const Eigen::VectorXd lambda_v = laplacian_.solve(Eigen::VectorXd(b.head(vertex_rows_)));
-  MQ_CHECK(laplacian_.info() == Eigen::Success && lambda_v.allFinite(), SolverFailure,
-           "trivial connection: the metric's rotation could not be solved");
-  Eigen::VectorXd x_v = weight_.cwiseProduct(
-      Eigen::SparseMatrix<double>(A_.topRows(vertex_rows_)).transpose() * lambda_v);
-  if (boundary.size()) x_v += y;
-  const Eigen::VectorXd flux = A_.bottomRows(A_.rows() - vertex_rows_) * x_v;
-  const Eigen::VectorXd boundary_flux =
-      boundary.size() ? Eigen::VectorXd(A_.bottomRows(A_.rows() - vertex_rows_) * y)
-                      : Eigen::VectorXd::Zero(flux.size());
-  for (size_t g = 0; g < generator_holonomy_.size(); ++g) {
-    const Eigen::Index r = static_cast<Eigen::Index>(g);
-    const double h = generator_holonomy_[g], flat = h + flux(r);
-    b(vertex_rows_ + r) = unit * std::round(flat / unit) - h - boundary_flux(r);
-  }
+  set_generator_rows(b, y, boundary.size() > 0);
   const Eigen::VectorXd lambda = augmented_.solve(b);
   MQ_CHECK(augmented_.info() == Eigen::Success && lambda.allFinite(), SolverFailure,
            "trivial connection: the generator solve failed");

@@ -101,6 +101,9 @@ TEST(Cli, PlaneEndToEndWithStats) {
                           "added", "removed_post", "stage_seconds", "matching", "merging"})
     EXPECT_NE(stats.find("\"" + std::string(key) + "\":"), std::string::npos) << key;
   EXPECT_GT(std::stoi(json_value(stats, "iterations")), 1);
+  // The run's own check of its structure (issue 23): nothing short on a chain mail layer.
+  EXPECT_EQ(json_value(stats, "passed"), "true");
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   // The counts agree with what info reads back from the file.
   const CliRun i = meshquilt(dir, "info out.ply --json");
   ASSERT_EQ(i.status, 0) << i.err;
