@@ -16,7 +16,8 @@ namespace mq {
 
 struct StructureCheckOptions {
   // Interior rings with their own swatch kind's link count (degenerate rings are misses), as a
-  // fraction: under it more than one ring in four is off the swatch's pattern.
+  // fraction: under it more than one ring in four is off the swatch's pattern (judged on 50
+  // interior rings or more).
   double min_link_share = 0.75;
   // Compact elements per area against the swatch's at the output's scale (swatches of compact
   // elements only: rings, apples; threads and vines join or space out by design).
@@ -44,8 +45,9 @@ const char* structure_measure_name(StructureShortfall::Measure measure);
 // The figures of `summary` (summarize_structure of an output against its swatch) outside the
 // limits, in the order of StructureShortfall::Measure; empty for a result within them. A figure
 // the summary does not have (no rings, no long elements, a swatch with long elements for the
-// density) is not judged, nor are threads short because the surface is (most of their ends on
-// its border). Throws InvalidInput as StructureCheckOptions::validate.
+// density) or has on fewer than 50 interior rings or closed density cells is not judged, nor are
+// threads short because the surface is (most of their ends on its border). Throws InvalidInput as
+// StructureCheckOptions::validate.
 std::vector<StructureShortfall> check_structure(const StructureSummary& summary,
                                                 const StructureCheckOptions& options = {});
 

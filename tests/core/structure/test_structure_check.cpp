@@ -37,23 +37,25 @@ StructureSummary threads(double ratio, int ends, int interior) {
 }
 
 TEST(StructureCheck, RingsUnderTheShareAreFlaggedOnlyWhenThereAreEnoughToJudge) {
-  const std::vector<StructureShortfall> low = check_structure(rings(40, 0.5));
+  const std::vector<StructureShortfall> low = check_structure(rings(60, 0.5));
   ASSERT_EQ(low.size(), 1u);
   EXPECT_EQ(low[0].measure, Measure::Links);
   EXPECT_DOUBLE_EQ(low[0].value, 0.5);
   EXPECT_DOUBLE_EQ(low[0].limit, 0.75);
   EXPECT_EQ(low[0].text, "50.0% of interior rings keep their swatch's links, under 75.0%");
-  EXPECT_TRUE(check_structure(rings(40, 0.75)).empty());
-  // 10 interior rings: one more or less moves the share by 10%; not judged.
-  EXPECT_TRUE(check_structure(rings(10, 0.2)).empty());
+  EXPECT_TRUE(check_structure(rings(60, 0.75)).empty());
+  // 40 interior rings (of a soup of open pieces, all but a few border rings): one more or less
+  // moves the share by 2.5%; not judged.
+  EXPECT_TRUE(check_structure(rings(40, 0.2)).empty());
   // A swatch without rings has no links to keep.
-  StructureSummary no_rings = rings(40, 0.0);
+  StructureSummary no_rings = rings(60, 0.0);
   no_rings.swatch.interior_links = -1;
   EXPECT_TRUE(check_structure(no_rings).empty());
 }
 
 TEST(StructureCheck, DensityIsJudgedBothWaysForCompactSwatchesOnly) {
   StructureSummary c;  // a swatch without long elements
+  c.output.density_cells = 100;
   c.comparison.density_ratio = 0.5;
   std::vector<StructureShortfall> s = check_structure(c);
   ASSERT_EQ(s.size(), 1u);
@@ -68,6 +70,11 @@ TEST(StructureCheck, DensityIsJudgedBothWaysForCompactSwatchesOnly) {
   EXPECT_NE(s[0].text.find("over 140.0% (crowded)"), std::string::npos) << s[0].text;
   c.comparison.density_ratio = 1.0;
   EXPECT_TRUE(check_structure(c).empty());
+  // Measured on 30 closed cells: not judged.
+  c.output.density_cells = 30;
+  c.comparison.density_ratio = 0.5;
+  EXPECT_TRUE(check_structure(c).empty());
+  c.output.density_cells = 100;
   // Vines with leaves: stems are spaced out by design, their leaves' density says nothing.
   c.swatch.report.long_elements = 2;
   c.comparison.density_ratio = 0.1;
@@ -89,6 +96,7 @@ TEST(StructureCheck, ThreadsCutInsideTheSurfaceAreFlaggedNotThoseItsBorderEnds) 
 
 TEST(StructureCheck, EveryShortfallInMeasureOrderWithItsName) {
   StructureSummary c = rings(100, 0.1);
+  c.output.density_cells = 100;
   c.comparison.density_ratio = 0.3;
   c.comparison.long_length_ratio = 1.2;
   c.output.ends = c.output.interior_ends = 10;
