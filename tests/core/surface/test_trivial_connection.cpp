@@ -80,6 +80,15 @@ TEST(TrivialConnection, SphereFieldHasExactlyThePrescribedCones) {
   }
 }
 
+// Layout options that scale each face by e^u at its corners' mean u (the metric's scale).
+GlobalParameterizationOptions scaled_by_metric(const ConeMetric& cm, const TriMesh& m) {
+  GlobalParameterizationOptions o;
+  o.face_scale.resize(m.num_faces());
+  for (int f = 0; f < m.num_faces(); ++f)
+    o.face_scale(f) = std::exp((cm.u(m.F(f, 0)) + cm.u(m.F(f, 1)) + cm.u(m.F(f, 2))) / 3);
+  return o;
+}
+
 TEST(TrivialConnection, ScaledByItsMetricTheLayoutIsConformal) {
   const Mesh s(test::icosphere(4));
   const std::vector<int> cones = tetrahedral_cones(s.m);
@@ -88,11 +97,7 @@ TEST(TrivialConnection, ScaledByItsMetricTheLayoutIsConformal) {
   GlobalParameterizationOptions unit;
   const double unit_aspect =
       median_aspect(global_parameterization(s.m.V, s.m.F, s.topo, s.TT, cm.field, unit), s.m);
-  GlobalParameterizationOptions scaled;
-  scaled.face_scale.resize(s.m.num_faces());
-  for (int f = 0; f < s.m.num_faces(); ++f)
-    scaled.face_scale(f) =
-        std::exp((cm.u(s.m.F(f, 0)) + cm.u(s.m.F(f, 1)) + cm.u(s.m.F(f, 2))) / 3);
+  const GlobalParameterizationOptions scaled = scaled_by_metric(cm, s.m);
   const double conformal_aspect =
       median_aspect(global_parameterization(s.m.V, s.m.F, s.topo, s.TT, cm.field, scaled), s.m);
   std::printf("[ measure  ] sphere, median aspect of the layout: unit frames %.3f, e^u %.3f\n",
@@ -171,11 +176,7 @@ TEST(TrivialConnection, AroundHandlesTheLayoutScaledByItsMetricIsConformal) {
     const ConeMetric cm =
         trivial_connection(t.m.V, t.m.F, t.topo, t.TT, std::vector<int>(t.m.num_vertices(), 0),
                            MatrixX3d::Zero(t.m.num_faces(), 3));
-    GlobalParameterizationOptions scaled;
-    scaled.face_scale.resize(t.m.num_faces());
-    for (int f = 0; f < t.m.num_faces(); ++f)
-      scaled.face_scale(f) =
-          std::exp((cm.u(t.m.F(f, 0)) + cm.u(t.m.F(f, 1)) + cm.u(t.m.F(f, 2))) / 3);
+    const GlobalParameterizationOptions scaled = scaled_by_metric(cm, t.m);
     const double aspect =
         median_aspect(global_parameterization(t.m.V, t.m.F, t.topo, t.TT, cm.field, scaled), t.m);
     std::printf(
