@@ -37,6 +37,10 @@ void StructureCheckOptions::validate() const {
                min_density <= 1 && max_density >= 1,
            InvalidInput, "structure check: the density limits must hold 1 between them, got ",
            min_density, " and ", max_density);
+  MQ_CHECK(std::isfinite(min_size) && std::isfinite(max_size) && min_size > 0 && min_size <= 1 &&
+               max_size >= 1,
+           InvalidInput, "structure check: the size limits must hold 1 between them, got ",
+           min_size, " and ", max_size);
   MQ_CHECK(std::isfinite(min_long_length) && min_long_length >= 0, InvalidInput,
            "structure check: the least thread length must be finite and >= 0, got ",
            min_long_length);
@@ -50,6 +54,8 @@ const char* structure_measure_name(StructureShortfall::Measure measure) {
       return "density";
     case StructureShortfall::Measure::LongLength:
       return "long_length";
+    case StructureShortfall::Measure::Size:
+      return "size";
   }
   return "links";
 }
@@ -87,6 +93,15 @@ std::vector<StructureShortfall> check_structure(const StructureSummary& summary,
     out.push_back({Measure::LongLength, l, options.min_long_length,
                    "the median thread runs " + fixed(l, 2) + " swatch threads, under " +
                        fixed(options.min_long_length, 1) + " (cut where patches meet)"});
+  const ShapeSummary& shape = comparison.shape;
+  if (shape.elements >= kMinJudged &&
+      (shape.size_median < options.min_size || shape.size_median > options.max_size)) {
+    const bool small = shape.size_median < options.min_size;
+    out.push_back({Measure::Size, shape.size_median, small ? options.min_size : options.max_size,
+                   "the median element is " + fixed(shape.size_median, 2) + "x the swatch's, " +
+                       (small ? "under " : "over ") +
+                       fixed(small ? options.min_size : options.max_size, 2) + "x"});
+  }
   return out;
 }
 

@@ -94,17 +94,39 @@ TEST(StructureCheck, ThreadsCutInsideTheSurfaceAreFlaggedNotThoseItsBorderEnds) 
   EXPECT_TRUE(check_structure(threads(1.0, 40, 10)).empty());
 }
 
+TEST(StructureCheck, AMedianElementFarFromTheSwatchsSizeIsFlagged) {
+  StructureSummary c;
+  c.comparison.shape.elements = 100;
+  c.comparison.shape.size_median = 0.37;  // the dragon's rings when its metric was followed
+  std::vector<StructureShortfall> s = check_structure(c);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].measure, Measure::Size);
+  EXPECT_EQ(s[0].text, "the median element is 0.37x the swatch's, under 0.75x");
+  c.comparison.shape.size_median = 1.5;
+  s = check_structure(c);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].text, "the median element is 1.50x the swatch's, over 1.33x");
+  c.comparison.shape.size_median = 0.876;  // the armor's
+  EXPECT_TRUE(check_structure(c).empty());
+  c.comparison.shape.size_median = 0.37;
+  c.comparison.shape.elements = 30;  // too few to judge
+  EXPECT_TRUE(check_structure(c).empty());
+}
+
 TEST(StructureCheck, EveryShortfallInMeasureOrderWithItsName) {
   StructureSummary c = rings(100, 0.1);
   c.output.density_cells = 100;
   c.comparison.density_ratio = 0.3;
   c.comparison.long_length_ratio = 1.2;
   c.output.ends = c.output.interior_ends = 10;
+  c.comparison.shape.elements = 100;
+  c.comparison.shape.size_median = 2.0;
   const std::vector<StructureShortfall> s = check_structure(c);
-  ASSERT_EQ(s.size(), 3u);
+  ASSERT_EQ(s.size(), 4u);
   EXPECT_STREQ(structure_measure_name(s[0].measure), "links");
   EXPECT_STREQ(structure_measure_name(s[1].measure), "density");
   EXPECT_STREQ(structure_measure_name(s[2].measure), "long_length");
+  EXPECT_STREQ(structure_measure_name(s[3].measure), "size");
 }
 
 TEST(StructureCheck, OptionsAreValidated) {
@@ -117,6 +139,9 @@ TEST(StructureCheck, OptionsAreValidated) {
   EXPECT_THROW(o.validate(), InvalidInput);
   o = {};
   o.max_density = 0.9;
+  EXPECT_THROW(o.validate(), InvalidInput);
+  o = {};
+  o.max_size = 0.9;
   EXPECT_THROW(o.validate(), InvalidInput);
   o = {};
   o.min_long_length = std::nan("");
