@@ -226,10 +226,7 @@ int run_plane(int argc, char** argv, int first) {
     print_detail(swatch_detail, detail);
     print_plane_summary(out_path, stats, wall, evaluator->name(), run.threads());
     if (!requested.empty()) print_swatch_animation(requested, settled);
-    if (!run.stats_path().empty())
-      print_structure(structure.output, &structure.swatch, &structure.comparison);
-    else
-      print_structure_kept(structure.output, structure.swatch, structure.comparison);
+    print_run_structure(structure, !run.stats_path().empty());
   }
   // A swatch of few elements leaves the patches little to match across their overlaps.
   warn_structure("plane", shortfalls, "a swatch of more elements gives the patches more to match");

@@ -722,10 +722,7 @@ int run_surface(int argc, char** argv, int first) {
   run.progress()->finish();
   if (!run.quiet()) {
     print_surface_summary(r, in, o, evaluator->name(), run.threads());
-    if (!run.stats_path().empty())
-      print_structure(o.structure.output, &o.structure.swatch, &o.structure.comparison);
-    else
-      print_structure_kept(o.structure.output, o.structure.swatch, o.structure.comparison);
+    print_run_structure(o.structure, !run.stats_path().empty());
   }
   warn_structure("surface", o.shortfalls, structure_hint(o));
   return 0;

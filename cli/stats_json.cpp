@@ -283,9 +283,11 @@ void print_structure(const StructureReport& r, const SwatchStructure* swatch,
   }
 }
 
-void print_structure_kept(const StructureReport& r, const SwatchStructure& swatch,
-                          const StructureComparison& comparison) {
-  print_kept(r, comparison, swatch.ring_kinds() > 1);
+void print_run_structure(const StructureSummary& s, bool full) {
+  if (full)
+    print_structure(s.output, &s.swatch, &s.comparison);
+  else
+    print_kept(s.output, s.comparison, s.swatch.ring_kinds() > 1);
 }
 
 void write_structure_check(JsonWriter& j, const std::vector<StructureShortfall>& shortfalls) {

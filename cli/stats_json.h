@@ -23,10 +23,9 @@ void write_structure(JsonWriter& j, const StructureReport& r, const SwatchStruct
 void print_structure(const StructureReport& r, const SwatchStructure* swatch,
                      const StructureComparison* comparison);
 
-// The comparison's kept-structure lines only (links, density, long elements): what a run
-// prints of its own check without --stats.
-void print_structure_kept(const StructureReport& r, const SwatchStructure& swatch,
-                          const StructureComparison& comparison);
+// A run's structure after its summary: every figure (print_structure) when `full` (--stats),
+// else only the kept-structure lines (links, density, long elements) its own check judges.
+void print_run_structure(const StructureSummary& s, bool full);
 
 // Writes "structure_check": whether the result is within core/structure/structure_check's
 // limits ("passed") and each figure outside them (measure, value, limit, text).

@@ -374,21 +374,19 @@ Eigen::VectorXd TrivialConnection::log_scale(const std::vector<int>& index,
 // metric's connection): what is left, at most half a turn unit, is the rotation no conformal
 // layout follows, spread over the surface as stretch (rounded from the Levi-Civita holonomy alone
 // it could be anything: genus 3 at 0.08, 24% of the weave's pieces over aspect 1.6; issue 23).
-void TrivialConnection::set_generator_rows(Eigen::VectorXd& b, const Eigen::VectorXd& y,
-                                           bool has_boundary) const {
+void TrivialConnection::set_generator_rows(Eigen::VectorXd& b, const Eigen::VectorXd& y) const {
+  const Eigen::Index generators = A_.rows() - vertex_rows_;
+  if (generators == 0) return;  // a closed sphere-like base: no solve to spend
   const double unit = kTwoPi / N_;
   const Eigen::VectorXd lambda_v = laplacian_.solve(Eigen::VectorXd(b.head(vertex_rows_)));
   MQ_CHECK(laplacian_.info() == Eigen::Success && lambda_v.allFinite(), SolverFailure,
            "trivial connection: the metric's rotation could not be solved");
-  Eigen::VectorXd x_v = weight_.cwiseProduct(
-      Eigen::SparseMatrix<double>(A_.topRows(vertex_rows_)).transpose() * lambda_v);
-  const Eigen::Index generators = A_.rows() - vertex_rows_;
-  Eigen::VectorXd boundary_flux = Eigen::VectorXd::Zero(generators);
-  if (has_boundary) {
-    x_v += y;
-    boundary_flux = A_.bottomRows(generators) * y;
-  }
-  const Eigen::VectorXd flux = A_.bottomRows(generators) * x_v;
+  const Eigen::VectorXd x_v =
+      weight_.cwiseProduct(Eigen::SparseMatrix<double>(A_.topRows(vertex_rows_)).transpose() *
+                           lambda_v) +
+      y;
+  const Eigen::VectorXd flux = A_.bottomRows(generators) * x_v,
+                        boundary_flux = A_.bottomRows(generators) * y;
   for (Eigen::Index g = 0; g < generators; ++g) {
     const double h = generator_holonomy_[static_cast<size_t>(g)], flat = h + flux(g);
     b(vertex_rows_ + g) = unit * std::round(flat / unit) - h - boundary_flux(g);
@@ -412,7 +410,7 @@ ConeMetric TrivialConnection::solve(const std::vector<int>& index, const MatrixX
   // With boundary values, x = W A^T lambda + y, y their own rotation: A x = b still holds.
   const Eigen::VectorXd y = boundary_rotation(boundary);
   if (boundary.size()) b.head(vertex_rows_) -= A_.topRows(vertex_rows_) * y;
-  set_generator_rows(b, y, boundary.size() > 0);
+  set_generator_rows(b, y);
   const Eigen::VectorXd lambda = augmented_.solve(b);
   MQ_CHECK(augmented_.info() == Eigen::Success && lambda.allFinite(), SolverFailure,
            "trivial connection: the generator solve failed");

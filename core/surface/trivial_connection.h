@@ -91,9 +91,9 @@ class TrivialConnection {
   int add_generator_rows(const std::vector<char>& in_tree,
                          std::vector<Eigen::Triplet<double>>& t);  // returns all rows
   void factorise(const std::vector<Eigen::Triplet<double>>& t, int rows);
-  // b's generator rows (b's vertex rows set, y = boundary_rotation): each generator's holonomy
-  // rounded to whole 1/N turns from the flat metric's own.
-  void set_generator_rows(Eigen::VectorXd& b, const Eigen::VectorXd& y, bool has_boundary) const;
+  // b's generator rows (b's vertex rows set; y = boundary_rotation, zero without boundary
+  // values): each generator's holonomy rounded to whole 1/N turns from the flat metric's own.
+  void set_generator_rows(Eigen::VectorXd& b, const Eigen::VectorXd& y) const;
   // #E: W A_B^T u_B, the rotation the boundary values alone give (A_B the signed incidence of the
   // vertices that are not interior, built as the vertex rows'). Empty boundary: zero.
   Eigen::VectorXd boundary_rotation(const Eigen::VectorXd& boundary) const;
