@@ -133,12 +133,26 @@ TEST(SwatchSymmetry, RepeatingElementsComesBeforeTileable) {
     EXPECT_TRUE(repeating_elements(d.swatch));
     EXPECT_TRUE(tileable(d.swatch, d.symmetry));
   }
+  // At the generators' own detail too, and with odd row counts: the rings reach past their
+  // centres, so a shift of the last row lands inside the footprint where no ring can be (the
+  // 3 x 3 sheet was sent to the patches: 7% of rings linked on Spot).
+  for (const auto& [rows, cols] : {std::pair{3, 3}, std::pair{3, 5}, std::pair{5, 3}}) {
+    ChainMailOptions o;
+    o.rows = rows;
+    o.cols = cols;
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols << " at full detail");
+    EXPECT_TRUE(repeating_elements(prepare_swatch(chainmail_4in1(o))));
+  }
+  EXPECT_TRUE(repeating_elements(prepare_swatch(chainmail_square({}))));
   WeaveOptions w;
   w.threads_x = w.threads_y = 4;
   EXPECT_FALSE(repeating_elements(prepare_swatch(plain_weave(w))));
-  AppleOptions a;
-  a.count = 12;
-  EXPECT_FALSE(repeating_elements(prepare_swatch(apple_layer(a))));
+  for (const int count : {11, 12, 24, 58}) {
+    AppleOptions a;
+    a.count = count;
+    SCOPED_TRACE(testing::Message() << count << " apples");
+    EXPECT_FALSE(repeating_elements(prepare_swatch(apple_layer(a))));
+  }
   EXPECT_FALSE(repeating_elements(prepare_swatch(ivy_section({}))));
   // Each ring of a 3 x 3 sheet moved by its own amount: no shift repeats the centres.
   ChainMailOptions o;
