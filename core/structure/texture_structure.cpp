@@ -867,6 +867,61 @@ void add_to_kind(const ElementStructure& e, const TriMesh& part, SwatchKind& kin
   if (!known && same_count < 16) kind.shapes.push_back({centred, axes.leftCols<2>()});
 }
 
+// Per ring that is not degenerate, the links an interior copy of it has in the sheet the swatch
+// repeats: its rings fall into classes of translates (same kind, vertices equal up to a
+// translation), and every copy of a class links the union of the class's partners (offsets to
+// their centres). A sheet two rings wide has no ring with all of its links (the
+// square 4-in-1 pattern's flat rings showed 3 of their 4), but together its translates show
+// them all. -1 for the others. parts: each element's mesh.
+std::vector<int> repeated_link_counts(const StructureReport& r, const std::vector<TriMesh>& parts) {
+  const int n = static_cast<int>(r.elements.size());
+  const double tol = 1e-4 * std::max(r.median_size, 1e-12);
+  std::vector<int> cls(static_cast<size_t>(n), -1);
+  std::vector<int> reps;  // an element of each class
+  const auto translates = [&](int a, int b) {
+    const MatrixX3d& A = parts[static_cast<size_t>(a)].V;
+    const MatrixX3d& B = parts[static_cast<size_t>(b)].V;
+    if (A.rows() != B.rows() || A.rows() == 0) return false;
+    const Eigen::RowVector3d shift = B.row(0) - A.row(0);
+    for (Eigen::Index v = 1; v < A.rows(); ++v)
+      if ((B.row(v) - A.row(v) - shift).cwiseAbs().maxCoeff() > tol) return false;
+    return true;
+  };
+  for (int i = 0; i < n; ++i) {
+    const ElementStructure& e = r.elements[static_cast<size_t>(i)];
+    if (!e.ring || e.degenerate()) continue;
+    for (size_t c = 0; c < reps.size() && cls[i] < 0; ++c)
+      if (r.elements[static_cast<size_t>(reps[c])].kind == e.kind && translates(reps[c], i))
+        cls[i] = static_cast<int>(c);
+    if (cls[i] < 0) {
+      cls[i] = static_cast<int>(reps.size());
+      reps.push_back(i);
+    }
+  }
+  // Each class's partners: offsets to their centres, equal within a tenth of a ring (two rings
+  // never share a place; a partner's own class does not matter: a ring moved out of its class
+  // still stands where its copies would).
+  std::vector<std::vector<Vector3d>> partners(reps.size());
+  const double same = 0.1 * r.median_size;
+  const auto add = [&](int a, int b) {
+    if (cls[a] < 0) return;
+    const Vector3d d =
+        r.elements[static_cast<size_t>(b)].centre - r.elements[static_cast<size_t>(a)].centre;
+    std::vector<Vector3d>& list = partners[static_cast<size_t>(cls[a])];
+    for (const Vector3d& p : list)
+      if ((p - d).norm() <= same) return;
+    list.push_back(d);
+  };
+  for (const auto& [a, b] : r.linked_pairs) {
+    add(a, b);
+    add(b, a);
+  }
+  std::vector<int> out(static_cast<size_t>(n), -1);
+  for (int i = 0; i < n; ++i)
+    if (cls[i] >= 0) out[i] = static_cast<int>(partners[static_cast<size_t>(cls[i])].size());
+  return out;
+}
+
 // Per kind: ring-ness, link count, fold, extents and the distinct shapes of its elements.
 std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport& r) {
   std::vector<int> fc;
@@ -875,10 +930,22 @@ std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport&
   std::vector<SwatchKind> kinds(r.kinds.size());
   std::vector<KindSamples> samples(r.kinds.size());
   for (size_t k = 0; k < r.kinds.size(); ++k) kinds[k].name = r.kinds[k];
+  std::vector<TriMesh> parts(static_cast<size_t>(ne));
   for (int c = 0; c < ne; ++c) {
     const ElementStructure& e = r.elements[static_cast<size_t>(c)];
     const size_t k = static_cast<size_t>(e.kind);
-    add_to_kind(e, extract_faces(mesh, groups[static_cast<size_t>(c)]), kinds[k], samples[k]);
+    parts[static_cast<size_t>(c)] = extract_faces(mesh, groups[static_cast<size_t>(c)]);
+    add_to_kind(e, parts[static_cast<size_t>(c)], kinds[k], samples[k]);
+  }
+  // Judged as in the sheet the swatch repeats (a ring's count in it is never below its own).
+  const std::vector<int> repeated = repeated_link_counts(r, parts);
+  std::vector<std::vector<int>> repeated_histogram(kinds.size());
+  for (int c = 0; c < ne; ++c) {
+    const int links = repeated[static_cast<size_t>(c)];
+    if (links < 0) continue;
+    std::vector<int>& h = repeated_histogram[static_cast<size_t>(r.elements[c].kind)];
+    if (h.size() <= static_cast<size_t>(links)) h.resize(static_cast<size_t>(links) + 1, 0);
+    ++h[static_cast<size_t>(links)];
   }
   for (size_t k = 0; k < kinds.size(); ++k) {
     SwatchKind& kind = kinds[k];
@@ -886,7 +953,9 @@ std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport&
     kind.compact = 2 * kind.long_elements <= kind.elements;
     int judged = 0;
     for (const int h : samples[k].histogram) judged += h;
-    if (kind.ring) kind.interior_links = common_count(samples[k].histogram, judged);
+    if (kind.ring)
+      kind.interior_links = std::max(common_count(samples[k].histogram, judged),
+                                     common_count(repeated_histogram[k], judged));
     kind.fold = median(samples[k].folds);
     for (int a = 0; a < 3; ++a) kind.extents(a) = median(samples[k].extents[a]);
   }

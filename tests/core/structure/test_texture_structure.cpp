@@ -376,6 +376,42 @@ TEST(TextureStructure, TwoRingKindsAreJudgedEachByItsOwnCount) {
   }
 }
 
+// A sheet two rings wide has no ring with all its links (the square pattern's flat rings show 3
+// of their 4, the 4-in-1 sheet of one row 2); its translates together show them all, as in the
+// sheet it repeats. A sheet whose rings are no translates of each other is judged by its own.
+TEST(TextureStructure, ASheetTwoRingsWideIsJudgedAsTheSheetItRepeats) {
+  for (const auto& [rows, cols] : {std::pair{2, 5}, std::pair{5, 2}, std::pair{2, 2}}) {
+    SquareMailOptions o;
+    o.rows = rows;
+    o.cols = cols;
+    o.ring_segments = 16;
+    o.wire_segments = 4;
+    SCOPED_TRACE(testing::Message() << rows << " x " << cols);
+    const SwatchStructure s = measure_swatch_structure(chainmail_square(o));
+    ASSERT_EQ(s.kinds.size(), 2u);
+    EXPECT_EQ(s.kinds[0].interior_links, 4);
+    EXPECT_EQ(s.kinds[1].interior_links, 2);
+  }
+  ChainMailOptions m;
+  m.rows = 2;
+  m.cols = 4;
+  m.ring_segments = 16;
+  m.wire_segments = 4;
+  EXPECT_EQ(measure_swatch_structure(chainmail_4in1(m)).kinds[0].interior_links, 4);
+  // One ring moved by its own amount breaks its class: the rest still judge 4.
+  m.rows = m.cols = 4;
+  TriMesh sheet = chainmail_4in1(m);
+  std::vector<int> fc;
+  connected_components(sheet.F, sheet.num_vertices(), fc);
+  std::vector<char> moved_vertex(static_cast<size_t>(sheet.num_vertices()), 0);
+  for (int f = 0; f < sheet.F.rows(); ++f)
+    if (fc[static_cast<size_t>(f)] == 0)
+      for (int k = 0; k < 3; ++k) moved_vertex[static_cast<size_t>(sheet.F(f, k))] = 1;
+  for (int v = 0; v < sheet.num_vertices(); ++v)
+    if (moved_vertex[static_cast<size_t>(v)]) sheet.V(v, 2) += 1e-3 * sheet.V(v, 0);
+  EXPECT_EQ(measure_swatch_structure(sheet).kinds[0].interior_links, 4);
+}
+
 // Every figure is the same whatever the thread count.
 TEST(TextureStructure, SameFiguresWhateverTheThreadCount) {
   SquareMailOptions o;
