@@ -540,10 +540,18 @@ double measure_structure(const TriMesh& result, const SurfaceInputs& in, const S
 
 // What to try when the check finds the structure lost: the local patches cut a periodic
 // swatch where they meet, the global layout does not; elsewhere, elements pressed together
-// between cones and over creases get more room at a smaller size.
-std::string structure_hint(const SurfaceOutcome& o) {
-  return o.global || o.vines ? "a smaller --scale gives each element more room"
-                             : "--method global lays a periodic swatch out whole";
+// between cones and over creases get more room at a smaller size. A sheet of rings in which no
+// lattice was found repeating (a 2 x 2 chain mail sheet: auto quilts it by patches, 10.7% of
+// rings linked on a cube; --method global only quilts the parameter plane, 45.3%) needs a
+// larger sheet, and a swatch of other elements the patches take by design needs more of them.
+std::string structure_hint(const SurfaceRequest& r, const SurfaceOutcome& o) {
+  if (o.vines || (o.global && o.global_stats.periodic))
+    return "a smaller --scale gives each element more room";
+  if (r.method == "patches") return "--method global lays a periodic swatch out whole";
+  if (o.structure.swatch.ring_kinds() > 0)
+    return "no lattice repeats in the swatch; a sheet of two periods or more each way lets the "
+           "layout repeat it whole";
+  return "a swatch of more elements gives the patches more to match";
 }
 
 // --swatch-frames: the result's vertices located in the swatch and the frames' motions, settled
@@ -724,7 +732,7 @@ int run_surface(int argc, char** argv, int first) {
     print_surface_summary(r, in, o, evaluator->name(), run.threads());
     print_run_structure(o.structure, !run.stats_path().empty());
   }
-  warn_structure("surface", o.shortfalls, structure_hint(o));
+  warn_structure("surface", o.shortfalls, structure_hint(r, o));
   return 0;
 }
 

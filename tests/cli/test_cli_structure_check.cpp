@@ -58,6 +58,29 @@ TEST_F(CliStructureCheck, ChainMailByPatchesOnASphereIsFlaggedTheGlobalLayoutIsN
   EXPECT_GE(std::stod(json_value(g, "share_with_swatch_links")), 0.75);
 }
 
+TEST_F(CliStructureCheck, AutoLaysAnOddRowSheetOutWholeAndSaysWhenNoLatticeRepeats) {
+  // The 3 x 3 sheet at the generator's detail went to the patches (its last row's rings reach
+  // past their centres: a shifted row was judged missing) and lost its links; it is a lattice.
+  write_obj(dir_ + "/sphere.obj", test::uv_sphere(1.0, 16, 8));
+  ASSERT_EQ(meshquilt(dir_, "swatch chainmail --rows 3 --cols 3 -o s33.obj --quiet").status, 0);
+  const std::string job = "surface --base sphere.obj -o o.ply --quiet";
+  const CliRun odd = meshquilt(dir_, job + " --swatch s33.obj --scale 0.3 --stats o.json");
+  ASSERT_EQ(odd.status, 0) << odd.err;
+  EXPECT_EQ(odd.err.find("warning"), std::string::npos) << odd.err;
+  const std::string o = slurp(dir_ + "/o.json");
+  EXPECT_EQ(json_value(o, "method"), "\"global\"");
+  EXPECT_GE(std::stod(json_value(o, "share_with_swatch_links")), 0.75);
+  // A 2 x 2 sheet shows no period twice: no layout can repeat it (the patches: 21.5% linked,
+  // 25% of its density at 0.2), and the hint says so rather than sending the user to --method
+  // global.
+  ASSERT_EQ(meshquilt(dir_, "swatch chainmail --rows 2 --cols 2 -o s22.obj --quiet").status, 0);
+  const CliRun small = meshquilt(dir_, job + " --swatch s22.obj --scale 0.2");
+  ASSERT_EQ(small.status, 0) << small.err;
+  EXPECT_GE(count(small.err, "warning: "), 1) << small.err;
+  EXPECT_EQ(count(small.err, "warning: "), count(small.err, "no lattice repeats in the swatch"))
+      << small.err;
+}
+
 TEST_F(CliStructureCheck, WeaveByPatchesOnAPlaneIsFlaggedForThreadsCutAtSeams) {
   // Every thread of the local patches' weave is one swatch thread long (cut where patches
   // meet); the global layout's run 3.2 swatch threads (median) on the same 2 x 2 square.
