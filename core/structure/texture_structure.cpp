@@ -827,6 +827,13 @@ int common_count(const std::vector<int>& histogram, int rings) {
 
 namespace {
 
+// One more of `value` in a histogram of counts, grown as needed.
+void count_in(std::vector<int>& histogram, int value) {
+  if (histogram.size() <= static_cast<size_t>(value))
+    histogram.resize(static_cast<size_t>(value) + 1, 0);
+  ++histogram[static_cast<size_t>(value)];
+}
+
 // What a swatch kind's elements gather before their medians: the link counts of its rings
 // that are not degenerate, their folds and the elements' principal extents.
 struct KindSamples {
@@ -843,11 +850,7 @@ void add_to_kind(const ElementStructure& e, const TriMesh& part, SwatchKind& kin
   ++kind.elements;
   kind.rings += e.ring_shaped ? 1 : 0;
   kind.long_elements += e.long_element ? 1 : 0;
-  if (e.ring && !e.degenerate()) {
-    if (samples.histogram.size() <= static_cast<size_t>(e.links))
-      samples.histogram.resize(static_cast<size_t>(e.links) + 1, 0);
-    ++samples.histogram[static_cast<size_t>(e.links)];
-  }
+  if (e.ring && !e.degenerate()) count_in(samples.histogram, e.links);
   if (e.ring_shaped) samples.folds.push_back(e.fold);
   Vector3d s;
   Eigen::Matrix3d axes;
@@ -938,6 +941,14 @@ std::vector<int> repeated_link_counts(const StructureReport& r, const std::vecto
 struct ClassLattice {
   int rows = 0;
   Vector2d v1 = Vector2d::Zero(), v2 = Vector2d::Zero();
+  double area() const { return std::abs(v1.x() * v2.y() - v1.y() * v2.x()); }  // of a basis
+  // Whether d is a whole combination of the basis (to a tenth).
+  bool holds(const Vector2d& d) const {
+    Eigen::Matrix2d basis;
+    basis << v1, v2;
+    const Vector2d c = basis.inverse() * d;
+    return (c - c.array().round().matrix()).cwiseAbs().maxCoeff() <= 0.1;
+  }
 };
 
 ClassLattice class_lattice(const std::vector<Vector2d>& members) {
@@ -961,20 +972,16 @@ ClassLattice class_lattice(const std::vector<Vector2d>& members) {
       out.v2 = d;
       break;
     }
-  const auto whole = [](double x) { return std::abs(x - std::round(x)) <= 0.1; };
   if (out.v2.norm() > 0) {
-    Eigen::Matrix2d basis;
-    basis << out.v1, out.v2;
-    const Eigen::Matrix2d inv = basis.inverse();
-    for (const Vector2d& d : offsets) {
-      const Vector2d c = inv * d;
-      if (!whole(c.x()) || !whole(c.y())) return {};
-    }
+    for (const Vector2d& d : offsets)
+      if (!out.holds(d)) return {};
     out.rows = 2;
     return out;
   }
-  for (const Vector2d& d : offsets)  // one row: every offset a whole number of v1
-    if (!whole(d.dot(out.v1) / out.v1.squaredNorm())) return {};
+  for (const Vector2d& d : offsets) {  // one row: every offset a whole number of v1
+    const double c = d.dot(out.v1) / out.v1.squaredNorm();
+    if (std::abs(c - std::round(c)) > 0.1) return {};
+  }
   out.rows = 1;
   return out;
 }
@@ -992,24 +999,11 @@ double class_lattice_density(const StructureReport& r, const std::vector<int>& c
   std::transform(members.begin(), members.end(), lattices.begin(), class_lattice);
   double density = 0;
   for (const ClassLattice& l : lattices) {
-    if (l.rows == 2) {
-      density += 1 / std::abs(l.v1.x() * l.v2.y() - l.v1.y() * l.v2.x());
-      continue;
-    }
-    if (l.rows == 0) return 0;
-    double cell = 0;
-    for (const ClassLattice& o : lattices) {
-      if (o.rows != 2) continue;
-      Eigen::Matrix2d basis;
-      basis << o.v1, o.v2;
-      const Vector2d c = basis.inverse() * l.v1;
-      if ((c - c.array().round().matrix()).cwiseAbs().maxCoeff() <= 0.1) {
-        cell = std::abs(o.v1.x() * o.v2.y() - o.v1.y() * o.v2.x());
-        break;
-      }
-    }
-    if (!(cell > 0)) return 0;
-    density += 1 / cell;
+    const ClassLattice* cell = l.rows == 2 ? &l : nullptr;
+    for (const ClassLattice& o : lattices)  // a row takes the cell of a basis holding its period
+      if (!cell && l.rows == 1 && o.rows == 2 && o.holds(l.v1)) cell = &o;
+    if (!cell) return 0;
+    density += 1 / cell->area();
   }
   return density;
 }
@@ -1037,10 +1031,7 @@ std::vector<SwatchKind> swatch_kinds(const TriMesh& mesh, const StructureReport&
   std::vector<std::vector<int>> repeated_histogram(kinds.size());
   for (int c = 0; c < ne; ++c) {
     const int links = repeated[static_cast<size_t>(c)];
-    if (links < 0) continue;
-    std::vector<int>& h = repeated_histogram[static_cast<size_t>(r.elements[c].kind)];
-    if (h.size() <= static_cast<size_t>(links)) h.resize(static_cast<size_t>(links) + 1, 0);
-    ++h[static_cast<size_t>(links)];
+    if (links >= 0) count_in(repeated_histogram[static_cast<size_t>(r.elements[c].kind)], links);
   }
   for (size_t k = 0; k < kinds.size(); ++k) {
     SwatchKind& kind = kinds[k];

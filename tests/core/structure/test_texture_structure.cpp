@@ -24,6 +24,24 @@ TriMesh moved(TriMesh m, const Eigen::Matrix3d& R, const Vector3d& t) {
 
 // A chain of n tori (radius 1, wire 0.15) along x, alternately in the xy and xz planes, each
 // threaded through the next.
+// Sheets of few segments (fast to measure), rows x cols.
+SquareMailOptions small_square(int rows, int cols) {
+  SquareMailOptions o;
+  o.rows = rows;
+  o.cols = cols;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  return o;
+}
+ChainMailOptions small_4in1(int rows, int cols) {
+  ChainMailOptions o;
+  o.rows = rows;
+  o.cols = cols;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  return o;
+}
+
 TriMesh chain(int n) {
   const TriMesh ring = test::torus(1.0, 0.15, 32, 8);
   const Eigen::Matrix3d flip = Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitX()).toRotationMatrix();
@@ -381,26 +399,15 @@ TEST(TextureStructure, TwoRingKindsAreJudgedEachByItsOwnCount) {
 // sheet it repeats. A sheet whose rings are no translates of each other is judged by its own.
 TEST(TextureStructure, ASheetTwoRingsWideIsJudgedAsTheSheetItRepeats) {
   for (const auto& [rows, cols] : {std::pair{2, 5}, std::pair{5, 2}, std::pair{2, 2}}) {
-    SquareMailOptions o;
-    o.rows = rows;
-    o.cols = cols;
-    o.ring_segments = 16;
-    o.wire_segments = 4;
     SCOPED_TRACE(testing::Message() << rows << " x " << cols);
-    const SwatchStructure s = measure_swatch_structure(chainmail_square(o));
+    const SwatchStructure s = measure_swatch_structure(chainmail_square(small_square(rows, cols)));
     ASSERT_EQ(s.kinds.size(), 2u);
     EXPECT_EQ(s.kinds[0].interior_links, 4);
     EXPECT_EQ(s.kinds[1].interior_links, 2);
   }
-  ChainMailOptions m;
-  m.rows = 2;
-  m.cols = 4;
-  m.ring_segments = 16;
-  m.wire_segments = 4;
-  EXPECT_EQ(measure_swatch_structure(chainmail_4in1(m)).kinds[0].interior_links, 4);
+  EXPECT_EQ(measure_swatch_structure(chainmail_4in1(small_4in1(2, 4))).kinds[0].interior_links, 4);
   // One ring moved by its own amount breaks its class: the rest still judge 4.
-  m.rows = m.cols = 4;
-  TriMesh sheet = chainmail_4in1(m);
+  TriMesh sheet = chainmail_4in1(small_4in1(4, 4));
   std::vector<int> fc;
   connected_components(sheet.F, sheet.num_vertices(), fc);
   std::vector<char> moved_vertex(static_cast<size_t>(sheet.num_vertices()), 0);
@@ -418,24 +425,14 @@ TEST(TextureStructure, ASheetTwoRingsWideIsJudgedAsTheSheetItRepeats) {
 // Elements that are no copies (apples) keep the Voronoi figure.
 TEST(TextureStructure, ASwatchOfCopiesHasTheDensityOfTheSheetItRepeats) {
   for (const auto& [rows, cols] : {std::pair{2, 5}, std::pair{3, 3}, std::pair{6, 6}}) {
-    SquareMailOptions o;
-    o.rows = rows;
-    o.cols = cols;
-    o.ring_segments = 16;
-    o.wire_segments = 4;
+    const SquareMailOptions o = small_square(rows, cols);
     const double period = chainmail_square_period(o);
     SCOPED_TRACE(testing::Message() << "square " << rows << " x " << cols);
     EXPECT_NEAR(measure_swatch_structure(chainmail_square(o)).density, 3 / (period * period), 1e-9);
   }
   std::vector<double> d;
-  for (const auto& [rows, cols] : {std::pair{3, 3}, std::pair{2, 4}, std::pair{5, 6}}) {
-    ChainMailOptions m;
-    m.rows = rows;
-    m.cols = cols;
-    m.ring_segments = 16;
-    m.wire_segments = 4;
-    d.push_back(measure_swatch_structure(chainmail_4in1(m)).density);
-  }
+  for (const auto& [rows, cols] : {std::pair{3, 3}, std::pair{2, 4}, std::pair{5, 6}})
+    d.push_back(measure_swatch_structure(chainmail_4in1(small_4in1(rows, cols))).density);
   EXPECT_GT(d[0], 0);
   EXPECT_NEAR(d[1], d[0], 1e-9 * d[0]);
   EXPECT_NEAR(d[2], d[0], 1e-9 * d[0]);
@@ -449,11 +446,7 @@ TEST(TextureStructure, ASwatchOfCopiesHasTheDensityOfTheSheetItRepeats) {
 
 // Every figure is the same whatever the thread count.
 TEST(TextureStructure, SameFiguresWhateverTheThreadCount) {
-  SquareMailOptions o;
-  o.rows = o.cols = 4;
-  o.ring_segments = 16;
-  o.wire_segments = 4;
-  const TriMesh sheet = chainmail_square(o);
+  const TriMesh sheet = chainmail_square(small_square(4, 4));
   const SwatchStructure s = measure_swatch_structure(sheet);
   TriMesh out = test::mapped(sheet, [](const Vector3d& p) { return test::over_cylinder(p, 6); });
   StructureOptions so;
