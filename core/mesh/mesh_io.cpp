@@ -1167,6 +1167,12 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".off") return MeshFormat::Off;
   if (ext == ".glb") return MeshFormat::Glb;
+  // A directory has no extension to judge: say what it is rather than "unknown format ''".
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    MQ_THROW(InvalidInput, path,
+             ": is a directory, not a mesh file (expected a name ending in .obj, .ply, .off or, "
+             "for output, .glb)");
   MQ_THROW(InvalidInput, path, ": unknown mesh format '", ext,
            "' (expected .obj, .ply, .off or, for output, .glb)");
 }

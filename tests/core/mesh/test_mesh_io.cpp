@@ -181,6 +181,11 @@ TEST(MeshIo, MalformedInputNamesFileAndLine) {
   expect_read_error(write_text(dir, "header.off", "3 1 0\n0 0 0\n"), 1, "missing OFF header");
   expect_read_error(dir + "/does_not_exist.obj", 0, "cannot open");
   expect_read_error(write_text(dir, "mesh.stl", "solid x\n"), 0, "unknown mesh format");
+  // A directory given for a mesh (no extension, or a mesh's) says so, not "format ''".
+  std::filesystem::create_directories(dir + "/folder");
+  std::filesystem::create_directories(dir + "/folder.obj");
+  expect_read_error(dir + "/folder", 0, "is a directory, not a mesh file");
+  expect_read_error(dir + "/folder.obj", 0, "is a directory");
   // PLY header problems.
   expect_read_error(write_text(dir, "type.ply",
                                "ply\nformat ascii 1.0\nelement vertex 3\nproperty int128 x\n"
