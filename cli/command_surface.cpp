@@ -89,6 +89,8 @@ void write_element_figures(JsonWriter& j, const SurfaceQuiltingStats& s,
       .value("shrunk_to_fit", em.shrunk_to_fit)
       .value("linked_versions", em.linked_versions)
       .value("layout_versions", em.layout_versions)
+      .value("folded_rings", em.folded_rings)
+      .value("unbent_rings", em.unbent_rings)
       .value("separated_rings", em.separated_rings)
       .value("separation_reverted", em.separation_reverted)
       .value("separation_left_shell", em.separation_left_shell)
@@ -648,9 +650,11 @@ void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
         vstats.streamlines_short, vstats.leaves, vstats.leaf_slots, vstats.leaves_shifted, o.wall,
         threads, e.removed_intersecting + e.removed_self_intersecting, e.removed_self_intersecting);
   else if (global && gstats.tiled)
-    std::printf("%.2f s on %s (%d threads); %d folded elements repaired, %d removed\n", o.wall,
-                device.c_str(), threads, e.rigid_repairs,
-                e.removed_intersecting + e.removed_self_intersecting);
+    std::printf(
+        "%.2f s on %s (%d threads); %d folded elements repaired, %d of %d rings folded over an "
+        "edge hung over it, %d removed\n",
+        o.wall, device.c_str(), threads, e.rigid_repairs, e.unbent_rings, e.folded_rings,
+        e.removed_intersecting + e.removed_self_intersecting);
   else
     std::printf(
         "%d %s in %.2f s on %s (%d threads); elements: %d stitched, %d replaced, "

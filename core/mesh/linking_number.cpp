@@ -92,12 +92,30 @@ int linking_number(const Loop& a, const Loop& b) {
   return crossings;
 }
 
+bool closed_genus_one(const MatrixX3i& F, Eigen::Index num_vertices) {
+  if (F.rows() == 0 || num_vertices == 0) return false;
+  MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < num_vertices, InvalidInput,
+           "closed_genus_one: a face index is out of range");
+  const EdgeTopology topo = edge_topology(F, static_cast<int>(num_vertices));
+  for (int e = 0; e < topo.num_edges(); ++e)
+    if (topo.edge_faces.degree(e) != 2) return false;
+  std::vector<char> used(static_cast<size_t>(num_vertices), 0);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
+  const auto nv = std::count(used.begin(), used.end(), 1);
+  // Euler characteristic V - E + F of a closed genus-1 surface is 0.
+  return nv - topo.num_edges() + F.rows() == 0;
+}
+
 std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, int bins) {
   MQ_CHECK(bins >= 8, InvalidInput, "a centre loop needs at least 8 bins, got ", bins);
+  if (!closed_genus_one(F, V.rows())) return std::nullopt;
+  return ring_loop_bins_unchecked(V, F, bins);
+}
+
+std::optional<RingBins> ring_loop_bins_unchecked(const MatrixX3d& V, const MatrixX3i& F, int bins) {
+  MQ_CHECK(bins >= 8, InvalidInput, "a centre loop needs at least 8 bins, got ", bins);
   if (F.rows() == 0 || V.rows() == 0) return std::nullopt;
-  const EdgeTopology topo = edge_topology(F, static_cast<int>(V.rows()));
-  for (int e = 0; e < topo.num_edges(); ++e)
-    if (topo.edge_faces.degree(e) != 2) return std::nullopt;
   std::vector<char> used(V.rows(), 0);
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) used[F(f, k)] = 1;
@@ -108,8 +126,6 @@ std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, i
       ++nv;
       mean += V.row(v).transpose();
     }
-  // Euler characteristic V - E + F of a closed genus-1 surface is 0.
-  if (nv - topo.num_edges() + F.rows() != 0) return std::nullopt;
   mean /= static_cast<double>(nv);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (Eigen::Index v = 0; v < V.rows(); ++v)
@@ -284,6 +300,43 @@ double free_opening(const std::vector<Vector2d>& poly, const std::vector<Vector2
          });
 }
 
+// RingShape::fold of a loop whose area-oriented plane normal is given.
+double fold_of_halves(const Loop& loop, const Vector3d& normal) {
+  const size_t n = loop.size();
+  double fold = 0;
+  // Halves of consecutive points: [s, s + h] and [s + h, s + n], sharing their end points. A
+  // half that is nearly straight has no plane of its own and takes the loop's.
+  const size_t h = n / 2;
+  std::vector<Vector3d> half;
+  const auto half_normal = [&](size_t from, size_t count) {
+    half.clear();
+    for (size_t k = 0; k <= count; ++k) half.push_back(loop[(from + k) % n]);
+    Vector3d m;
+    const auto e = spread(half.data(), half.data() + half.size(), m);
+    if (!(e.eigenvalues()(1) > 1e-4 * e.eigenvalues()(2))) return normal;
+    const Vector3d hn = e.eigenvectors().col(0);
+    return hn.dot(normal) < 0 ? Vector3d(-hn) : hn;
+  };
+  for (size_t s = 0; s < h; ++s) {
+    const Vector3d a = half_normal(s, h), b = half_normal(s + h, n - h);
+    fold = std::max(fold, std::atan2(a.cross(b).norm(), a.dot(b)));
+  }
+  return fold;
+}
+
+// The loop's mean point and plane normal, turned along its area vector (the loop winds once
+// around its mean point there: ring_centre_loop bins it so); u the plane's longest axis.
+Vector3d loop_plane(const Loop& loop, Vector3d& mean, Vector3d* u) {
+  const size_t n = loop.size();
+  const auto eig = spread(loop.data(), loop.data() + n, mean);
+  Vector3d normal = eig.eigenvectors().col(0);
+  if (u) *u = eig.eigenvectors().col(2);
+  Vector3d area_vector = Vector3d::Zero();
+  for (size_t k = 0; k < n; ++k) area_vector += (loop[k] - mean).cross(loop[(k + 1) % n] - mean);
+  if (area_vector.dot(normal) < 0) normal = -normal;
+  return normal;
+}
+
 }  // namespace
 
 RingShape ring_shape(const MatrixX3d& V, const MatrixX3i& F, const Loop& loop) {
@@ -304,15 +357,8 @@ RingShape ring_shape(const MatrixX3d& V, const MatrixX3i& F, const Loop& loop) {
   }
   out.wire = length > 0 ? area / (M_PI * length) : 0;
 
-  // The loop's plane, its normal turned along the loop's area vector (the loop winds once
-  // around its mean point there: ring_centre_loop bins it so).
-  Vector3d mean;
-  const auto eig = spread(loop.data(), loop.data() + n, mean);
-  Vector3d normal = eig.eigenvectors().col(0);
-  const Vector3d u = eig.eigenvectors().col(2);
-  Vector3d area_vector = Vector3d::Zero();
-  for (size_t k = 0; k < n; ++k) area_vector += (loop[k] - mean).cross(loop[(k + 1) % n] - mean);
-  if (area_vector.dot(normal) < 0) normal = -normal;
+  Vector3d mean, u;
+  const Vector3d normal = loop_plane(loop, mean, &u);
   const Vector3d w = normal.cross(u);
 
   std::vector<Vector2d> poly(n), points;
@@ -338,24 +384,16 @@ RingShape ring_shape(const MatrixX3d& V, const MatrixX3i& F, const Loop& loop) {
   // Exact where the figure decides (issue 23's criterion is one wire diameter), with a margin.
   out.opening = free_opening(poly, points, edges, 2 * out.wire);
 
-  // Halves of consecutive points: [s, s + h] and [s + h, s + n], sharing their end points. A
-  // half that is nearly straight has no plane of its own and takes the loop's.
-  const size_t h = n / 2;
-  std::vector<Vector3d> half;
-  const auto half_normal = [&](size_t from, size_t count) {
-    half.clear();
-    for (size_t k = 0; k <= count; ++k) half.push_back(loop[(from + k) % n]);
-    Vector3d m;
-    const auto e = spread(half.data(), half.data() + half.size(), m);
-    if (!(e.eigenvalues()(1) > 1e-4 * e.eigenvalues()(2))) return normal;
-    const Vector3d hn = e.eigenvectors().col(0);
-    return hn.dot(normal) < 0 ? Vector3d(-hn) : hn;
-  };
-  for (size_t s = 0; s < h; ++s) {
-    const Vector3d a = half_normal(s, h), b = half_normal(s + h, n - h);
-    out.fold = std::max(out.fold, std::atan2(a.cross(b).norm(), a.dot(b)));
-  }
+  out.fold = fold_of_halves(loop, normal);
   return out;
+}
+
+double ring_fold(const Loop& loop) {
+  MQ_CHECK(loop.size() >= 4, InvalidInput, "ring_fold: a loop needs at least 4 points, got ",
+           loop.size());
+  Vector3d mean;
+  const Vector3d normal = loop_plane(loop, mean, nullptr);
+  return fold_of_halves(loop, normal);
 }
 
 std::optional<Loop> ring_centre_loop(const MatrixX3d& V, const MatrixX3i& F, int bins) {

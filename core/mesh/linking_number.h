@@ -44,6 +44,13 @@ struct RingBins {
 };
 // Nothing when ring_centre_loop would return nothing. Same arguments and throws.
 std::optional<RingBins> ring_loop_bins(const MatrixX3d& V, const MatrixX3i& F, int bins = 32);
+// Whether faces F (#F by 3, indices below num_vertices) make a closed (every edge in two faces)
+// genus-1 surface: ring_loop_bins' test of the faces, which depends on them alone (copies of
+// one ring share it). Throws InvalidInput for an index out of range.
+bool closed_genus_one(const MatrixX3i& F, Eigen::Index num_vertices);
+// ring_loop_bins without the test of the faces, for faces known closed_genus_one. Same throws.
+std::optional<RingBins> ring_loop_bins_unchecked(const MatrixX3d& V, const MatrixX3i& F,
+                                                 int bins = 32);
 // The centre loop of positions V binned by `bins` (found on these or on other positions of
 // the same vertices: a ring's flat shape bins its bent copies). Throws InvalidInput when the
 // sizes differ.
@@ -75,5 +82,9 @@ struct RingShape {
 // Throws InvalidInput for a shorter loop or an out-of-range index. O(#V + #F + #loop^2) with a
 // few dozen evaluations of the vertices' distance for the hole.
 RingShape ring_shape(const MatrixX3d& V, const MatrixX3i& F, const Loop& loop);
+
+// RingShape::fold alone (it depends on the loop only; ring_shape's hole costs most of its time).
+// Throws InvalidInput for a loop of fewer than 4 points.
+double ring_fold(const Loop& loop);
 
 }  // namespace mq

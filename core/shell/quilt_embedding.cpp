@@ -22,6 +22,7 @@
 #include "core/shell/placement_check.h"
 #include "core/shell/quilt_intersections.h"
 #include "core/shell/ring_separation.h"
+#include "core/shell/ring_unbending.h"
 #include "core/shell/shell_embedding.h"
 #include "core/shell/shell_map.h"
 #include "core/shell/signed_height.h"
@@ -98,6 +99,7 @@ class QuiltEmbedder {
   void choose_linked_versions();
   void check_placement();
   void repair_folds();
+  void unbend_folded_rings();
   void separate_touching_rings();
   void remove_intersecting();
   void check_output();
@@ -494,11 +496,36 @@ void QuiltEmbedder::repair_folds() {
     stale_[k] = stale_[k] || folded_now[k];
     moved_after_check_[k] = moved_after_check_[k] || folded_now[k];
   }
+  if (options_.unbend_rings) unbend_folded_rings();
   const std::vector<char> lifted = lift_moved();
   for (size_t k = 0; k < ne_; ++k) stale_[k] = stale_[k] || lifted[k];
   if (!have_pairs_) return;
   update_pairs(stale_);
   std::fill(stale_.begin(), stale_.end(), 0);
+}
+
+// Rings folded over edges they cannot follow hang over them rigidly instead
+// (core/shell/ring_unbending); part of the fold repair, whose lift and pair update take the
+// moved rings too.
+void QuiltEmbedder::unbend_folded_rings() {
+  std::vector<const MatrixX3i*> faces(ne_);
+  std::vector<const MatrixX3d*> flat(ne_);
+  std::vector<char> skip(ne_, 0);
+  for (size_t k = 0; k < ne_; ++k) {
+    faces[k] = &quilt_.elements[k].F;
+    flat[k] = &quilt_.elements[k].flat;
+    skip[k] = drop_[k] || sunk_[k];
+  }
+  RingUnbendingStats unbending;
+  const std::vector<char> moved =
+      mq::unbend_folded_rings(all_.V, first_, faces, flat, skip,
+                              base_height_ ? &*base_height_ : nullptr, check_, {}, &unbending);
+  stats_.folded_rings = unbending.folded;
+  stats_.unbent_rings = unbending.unbent;
+  for (size_t k = 0; k < ne_; ++k) {
+    stale_[k] = stale_[k] || moved[k];
+    moved_after_check_[k] = moved_after_check_[k] || moved[k];
+  }
 }
 
 // Rings pressed into each other are moved apart whole, links kept (core/shell/ring_separation);

@@ -24,6 +24,9 @@ struct QuiltEmbeddingOptions {
   // Rings placed as even copies take the layout's version where it keeps more links
   // (core/shell/linked_versions).
   bool choose_linked_versions = true;
+  // Rings folded over an edge sharper than they can follow are hung over it rigidly instead
+  // (core/shell/ring_unbending).
+  bool unbend_rings = true;
   std::uint64_t seed = 1;
   // Per face of quilt.base, where coverage is measured (a mask, core/surface/surface_mask);
   // empty: the whole base.
@@ -43,6 +46,8 @@ struct QuiltEmbeddingStats {
   int linked_versions = 0;  // even copies replaced by the layout's version, which links more
   int layout_versions = 0;  // even copies that touched a neighbour, kept as the layout placed them
   int separated_rings = 0;  // rings moved apart from those they touched
+  int folded_rings = 0;     // rings folded over an edge beyond the structure measure's limit
+  int unbent_rings = 0;     // of them, hung over it rigidly enough (core/shell/ring_unbending)
   int separation_reverted = 0;    // moved, then put back: a link would have changed
   int separation_left_shell = 0;  // moved, then put back: it left the shell
   int separation_iterations = 0;

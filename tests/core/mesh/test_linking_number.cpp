@@ -241,6 +241,20 @@ TEST(RingShape, FoldIsTheTurnBetweenTheRingsHalves) {
 TEST(RingShape, ShortLoopThrows) {
   const TriMesh ring = test::torus(1.0, 0.15, 16, 4);
   EXPECT_THROW(ring_shape(ring.V, ring.F, Loop(3, Vector3d::Zero())), InvalidInput);
+  EXPECT_THROW(ring_fold(Loop(3, Vector3d::Zero())), InvalidInput);
+}
+
+// ring_fold is ring_shape's fold without the hole, to the bit.
+TEST(RingShape, FoldAloneIsTheShapesFold) {
+  const TriMesh ring = test::torus(1.0, 0.15, 48, 12);
+  for (const double shift : {0.0, 0.4, 0.8}) {
+    const TriMesh bent = test::mapped(ring, [shift](const Vector3d& p) {
+      return test::over_edge(p + Vector3d(shift, 0, 0), 0.2);
+    });
+    const Loop loop = *ring_centre_loop(bent.V, bent.F);
+    EXPECT_EQ(ring_fold(loop), ring_shape(bent.V, bent.F, loop).fold) << shift;
+    EXPECT_GT(ring_fold(loop), 0.0);
+  }
 }
 
 }  // namespace

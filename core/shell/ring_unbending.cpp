@@ -1,0 +1,211 @@
+#include "core/shell/ring_unbending.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+#include <utility>
+
+#include "core/common/errors.h"
+#include "core/common/fnv1a.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/mesh/similarity_fit.h"
+#include "core/shell/element_grid.h"
+#include "core/structure/texture_structure.h"
+
+namespace mq {
+
+void RingUnbendingOptions::validate() const {
+  MQ_CHECK(target_fold > 0 && target_fold <= M_PI, InvalidInput,
+           "ring unbending: target_fold must be in (0, pi], got ", target_fold);
+  for (const double k : keep)
+    MQ_CHECK(k >= 0 && k < 1, InvalidInput, "ring unbending: keep must be in [0, 1), got ", k);
+  MQ_CHECK(loop_bins >= 8, InvalidInput, "ring unbending: loop_bins must be >= 8, got ", loop_bins);
+}
+
+namespace {
+
+// How a candidate ended (RingUnbendingStats' counts).
+enum class Outcome { NotFolded, Unbent, IntoBase, LinksChanged, SelfCrossing };
+
+struct Candidate {
+  Outcome outcome = Outcome::NotFolded;
+  MatrixX3d V;              // the unbent ring (Outcome::Unbent)
+  std::vector<int> near;    // ring-shaped neighbours
+  std::vector<int> linked;  // per neighbour: the linking number as placed
+};
+
+// The centre loop of a ring whose faces are known closed and of genus 1.
+std::optional<Loop> loop_of(const MatrixX3d& V, const MatrixX3i& F, int bins) {
+  const std::optional<RingBins> b = ring_loop_bins_unchecked(V, F, bins);
+  if (!b) return std::nullopt;
+  return loop_from_bins(V, *b);
+}
+
+// Per element, whether its faces make a ring (closed_genus_one), tested once per distinct face
+// matrix: copies of a swatch ring share theirs, and the test (sorting the edges) costs more than
+// everything else done to a ring that is not folded.
+std::vector<char> ring_faces(const std::vector<const MatrixX3i*>& F,
+                             const std::vector<Eigen::Index>& first,
+                             const std::vector<char>& skip) {
+  const size_t ne = F.size();
+  std::vector<std::uint64_t> hash(ne, 0);
+  tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
+    if (skip[k] || !F[k]) return;
+    std::uint64_t h = kFnv1aOffset;
+    const Eigen::Index nv = first[k + 1] - first[k];
+    fnv1a(h, &nv, sizeof nv);
+    fnv1a(h, F[k]->data(), sizeof(int) * static_cast<size_t>(F[k]->size()));
+    hash[k] = h;
+  });
+  // Representatives in element order; a hash match counts only with equal faces.
+  std::unordered_map<std::uint64_t, std::vector<size_t>> by_hash;
+  std::vector<size_t> rep(ne, 0), reps;
+  for (size_t k = 0; k < ne; ++k) {
+    if (skip[k] || !F[k]) continue;
+    std::vector<size_t>& same = by_hash[hash[k]];
+    bool found = false;
+    for (const size_t r : same)
+      if (first[r + 1] - first[r] == first[k + 1] - first[k] && F[r]->rows() == F[k]->rows() &&
+          std::memcmp(F[r]->data(), F[k]->data(), sizeof(int) * F[k]->size()) == 0) {
+        rep[k] = r;
+        found = true;
+        break;
+      }
+    if (found) continue;
+    same.push_back(k);
+    rep[k] = k;
+    reps.push_back(k);
+  }
+  std::vector<char> ring(ne, 0);
+  tbb::parallel_for(size_t{0}, reps.size(), [&](size_t i) {
+    const size_t r = reps[i];
+    ring[r] = closed_genus_one(*F[r], first[r + 1] - first[r]);
+  });
+  for (size_t k = 0; k < ne; ++k)
+    if (!skip[k] && F[k]) ring[k] = ring[rep[k]];
+  return ring;
+}
+
+// The least blend of `placed` towards its fitted flat shape whose fold is within the target,
+// if one stays whole, out of the base and keeps every neighbour's linking number.
+void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
+            const std::vector<Loop>& loops, const SignedHeight* ground,
+            const PlacementCheckOptions& check, const RingUnbendingOptions& options,
+            double reference, Candidate& c) {
+  const MatrixX3d rigid = similarity_fit(flat, placed);
+  const std::vector<Eigen::Index> whole = {0, placed.rows()};
+  c.outcome = Outcome::SelfCrossing;
+  for (const double keep : options.keep) {
+    MatrixX3d blend = keep * placed + (1 - keep) * rigid;
+    std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
+    if (!loop || ring_fold(*loop) - reference > options.target_fold) continue;
+    if (!self_intersecting_components(blend, F).empty()) continue;
+    // A ring hung straighter over a convex edge dips into the base beside it: lifted out whole
+    // (its links are checked after).
+    if (ground && check_element_heights(*ground, blend, whole, check)[0].below > 0) {
+      const std::vector<ElementHeights> lifted =
+          lift_out_of_base(*ground, blend, whole, check, {1});
+      if (lifted[0].below > 0) {
+        c.outcome = Outcome::IntoBase;
+        continue;
+      }
+      loop = loop_of(blend, F, options.loop_bins);
+      if (!loop) continue;
+    }
+    bool same = true;
+    for (size_t j = 0; j < c.near.size() && same; ++j)
+      same = linking_number(*loop, loops[static_cast<size_t>(c.near[j])]) == c.linked[j];
+    if (!same) {
+      c.outcome = Outcome::LinksChanged;
+      continue;
+    }
+    c.V = std::move(blend);
+    c.outcome = Outcome::Unbent;
+    return;
+  }
+}
+
+}  // namespace
+
+std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Index>& first,
+                                      const std::vector<const MatrixX3i*>& F,
+                                      const std::vector<const MatrixX3d*>& flat,
+                                      const std::vector<char>& skip, const SignedHeight* ground,
+                                      const PlacementCheckOptions& check,
+                                      const RingUnbendingOptions& options,
+                                      RingUnbendingStats* stats) {
+  options.validate();
+  const size_t ne = F.size();
+  MQ_CHECK(first.size() == ne + 1 && flat.size() == ne && skip.size() == ne && !first.empty() &&
+               first.back() == V.rows(),
+           InvalidInput, "ring unbending: ", ne, " elements with ", first.size(), " offsets, ",
+           flat.size(), " flat shapes and ", skip.size(), " flags over ", V.rows(), " vertices");
+  const auto rows = [&](size_t k) { return V.middleRows(first[k], first[k + 1] - first[k]); };
+  // Every element's centre loop as placed (none: not ring-shaped), and the folded candidates.
+  std::vector<Loop> loops(ne);
+  std::vector<char> ring = ring_faces(F, first, skip), folded(ne, 0);
+  std::vector<double> reference(ne, 0);
+  tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
+    if (!ring[k]) return;
+    const MatrixX3d placed = rows(k);
+    std::optional<Loop> loop = loop_of(placed, *F[k], options.loop_bins);
+    if (!loop) {
+      ring[k] = 0;  // does not surround its mean point
+      return;
+    }
+    const MatrixX3d* shape = flat[k];
+    const double fold = ring_fold(*loop);
+    // The flat shape's own fold (>= 0) only where the placed one could exceed it by the limit.
+    if (shape && shape->rows() == placed.rows() && fold > kFoldLimit) {
+      const std::optional<Loop> own = loop_of(*shape, *F[k], options.loop_bins);
+      reference[k] = own ? ring_fold(*own) : M_PI;
+      folded[k] = fold - reference[k] > kFoldLimit;
+    }
+    loops[k] = std::move(*loop);
+  });
+  std::vector<char> grid_skip(ne, 0);
+  for (size_t k = 0; k < ne; ++k) grid_skip[k] = !ring[k];
+  const ElementGrid grid(V, first, grid_skip);
+  std::vector<Candidate> candidates(ne);
+  tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
+    if (!folded[k]) return;
+    Candidate& c = candidates[k];
+    for (const int j : grid.near(grid.box[k]))
+      if (static_cast<size_t>(j) != k) {
+        c.near.push_back(j);
+        c.linked.push_back(linking_number(loops[k], loops[static_cast<size_t>(j)]));
+      }
+    unbend(rows(k), *flat[k], *F[k], loops, ground, check, options, reference[k], c);
+  });
+  // Two unbent neighbours: the later is put back if their linking changed.
+  std::vector<char> moved(ne, 0);
+  RingUnbendingStats s;
+  for (size_t k = 0; k < ne; ++k) {
+    Candidate& c = candidates[k];
+    if (!folded[k]) continue;
+    ++s.folded;
+    if (c.outcome == Outcome::Unbent) {
+      const std::optional<Loop> now = loop_of(c.V, *F[k], options.loop_bins);
+      for (size_t j = 0; j < c.near.size() && c.outcome == Outcome::Unbent; ++j) {
+        const auto n = static_cast<size_t>(c.near[j]);
+        if (n < k && moved[n] && linking_number(*now, loops[n]) != c.linked[j])
+          c.outcome = Outcome::LinksChanged;
+      }
+      if (c.outcome == Outcome::Unbent) {
+        rows(k) = c.V;
+        loops[k] = *now;
+        moved[k] = 1;
+      }
+    }
+    s.unbent += c.outcome == Outcome::Unbent;
+    s.into_base += c.outcome == Outcome::IntoBase;
+    s.links_changed += c.outcome == Outcome::LinksChanged;
+    s.self_crossing += c.outcome == Outcome::SelfCrossing;
+  }
+  if (stats) *stats = s;
+  return moved;
+}
+
+}  // namespace mq

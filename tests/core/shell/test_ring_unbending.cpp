@@ -1,0 +1,189 @@
+// Ring unbending (core/shell/ring_unbending): a ring folded over an edge beyond the structure
+// measure's limit hangs over it within the limit, out of the base, whole, with its links; a ring
+// bent along the surface is left alone; the result does not depend on the thread count.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "core/common/errors.h"
+#include "core/mesh/linking_number.h"
+#include "core/mesh/mesh_intersections.h"
+#include "core/shell/ring_unbending.h"
+#include "core/structure/texture_structure.h"
+#include "tests/test_support.h"
+
+namespace mq {
+namespace {
+
+constexpr double kWire = 0.15;
+constexpr double kLift = 0.3;  // the flat ring's centre plane above the top face
+
+// A block whose top face is z = 0 and front face y = 0, meeting in the edge along x.
+TriMesh block() {
+  TriMesh b = test::unit_cube();
+  for (Eigen::Index v = 0; v < b.V.rows(); ++v)
+    b.V.row(v) = Eigen::RowVector3d(8 * b.V(v, 0) - 4, 6 * b.V(v, 1) - 6, 6 * b.V(v, 2) - 6);
+  return b;
+}
+
+// The flat ring (centre radius 1, axis z) lying on the top face at `y`, its centre plane kLift up.
+MatrixX3d flat_ring(const TriMesh& torus, double y) {
+  MatrixX3d V = torus.V;
+  V.col(1).array() += y;
+  V.col(2).array() += kLift;
+  return V;
+}
+
+// The flat ring bent with the surface as a shell map bends it: the part beyond the edge (y > 0)
+// wrapped round it at its own height, up to `turn` radians, then running straight on down the
+// front face.
+MatrixX3d bent_over_edge(const MatrixX3d& flat, double turn) {
+  MatrixX3d V = flat;
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const double y = flat(v, 1), rho = flat(v, 2);
+    if (y <= 0) continue;
+    const double phi = std::min(y / kLift, turn), rest = y - phi * kLift;
+    const Vector3d out(0, std::sin(phi), std::cos(phi)), along(0, std::cos(phi), -std::sin(phi));
+    const Vector3d p = rho * out + rest * along;
+    V(v, 1) = p.y();
+    V(v, 2) = p.z();
+  }
+  return V;
+}
+
+double fold(const MatrixX3d& V, const MatrixX3i& F) { return ring_fold(*ring_centre_loop(V, F)); }
+
+struct Scene {
+  std::vector<TriMesh> rings;
+  std::vector<MatrixX3d> flats;
+  MatrixX3d V;
+  std::vector<Eigen::Index> first{0};
+
+  void add(const TriMesh& ring, const MatrixX3d& placed, const MatrixX3d& flat) {
+    rings.push_back(ring);
+    flats.push_back(flat);
+    MatrixX3d all(V.rows() + placed.rows(), 3);
+    all << V, placed;
+    V = all;
+    first.push_back(V.rows());
+  }
+  MatrixX3d element(size_t k) const { return V.middleRows(first[k], first[k + 1] - first[k]); }
+  std::vector<char> unbend(const SignedHeight* ground, RingUnbendingStats* stats) {
+    std::vector<const MatrixX3i*> F;
+    std::vector<const MatrixX3d*> flat;
+    for (size_t k = 0; k < rings.size(); ++k) {
+      F.push_back(&rings[k].F);
+      flat.push_back(&flats[k]);
+    }
+    PlacementCheckOptions check;
+    check.height = 2 * kLift;
+    return unbend_folded_rings(V, first, F, flat, std::vector<char>(rings.size(), 0), ground, check,
+                               {}, stats);
+  }
+};
+
+TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBase) {
+  const TriMesh base = block();
+  const SignedHeight ground(base.V, base.F);
+  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
+  const MatrixX3d flat = flat_ring(torus, 0.0);
+  Scene s;
+  s.add(torus, bent_over_edge(flat, M_PI / 2), flat);
+  const double before = fold(s.element(0), torus.F) - fold(flat, torus.F);
+  ASSERT_GT(before, kFoldLimit);  // the measure would call it folded
+  PlacementCheckOptions check;
+  check.height = 2 * kLift;
+  ASSERT_EQ(check_element_heights(ground, s.V, s.first, check)[0].below, 0);
+
+  RingUnbendingStats stats;
+  const std::vector<char> moved = s.unbend(&ground, &stats);
+  EXPECT_EQ(stats.folded, 1);
+  EXPECT_EQ(stats.unbent, 1);
+  ASSERT_TRUE(moved[0]);
+  const MatrixX3d after = s.element(0);
+  EXPECT_LE(fold(after, torus.F) - fold(flat, torus.F), RingUnbendingOptions{}.target_fold + 1e-9);
+  EXPECT_EQ(check_element_heights(ground, s.V, s.first, check)[0].below, 0);
+  EXPECT_TRUE(self_intersecting_components(after, torus.F).empty());
+  // Still over the edge: its centre within a ring radius of it, the edge through its hole.
+  const Vector3d centre = after.colwise().mean().transpose();
+  EXPECT_LT(std::hypot(centre.y(), centre.z()), 1.0);
+}
+
+TEST(RingUnbending, ARingBentAlongTheSurfaceIsLeftAsItIs) {
+  const TriMesh base = block();
+  const SignedHeight ground(base.V, base.F);
+  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
+  // A gentle turn: half the limit.
+  const MatrixX3d flat = flat_ring(torus, -0.6);
+  Scene s;
+  s.add(torus, bent_over_edge(flat, kFoldLimit / 4), flat);
+  const MatrixX3d before = s.V;
+  RingUnbendingStats stats;
+  const std::vector<char> moved = s.unbend(&ground, &stats);
+  EXPECT_FALSE(moved[0]);
+  EXPECT_EQ(stats.folded, 0);
+  EXPECT_EQ(s.V, before);
+}
+
+// A folded ring with a ring through its hole on the top face, and a second folded ring beside
+// it: every pair's linking number is as before, whatever moved; the same bytes on 1 and 2
+// threads.
+TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
+  const TriMesh base = block();
+  const SignedHeight ground(base.V, base.F);
+  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
+  Scene s;
+  const MatrixX3d flat = flat_ring(torus, 0.0);
+  s.add(torus, bent_over_edge(flat, M_PI / 2), flat);
+  // Upright through the first one's wire on the top face (y = -1), lying along y.
+  MatrixX3d upright = torus.V;
+  for (Eigen::Index v = 0; v < upright.rows(); ++v)
+    upright.row(v) = Eigen::RowVector3d(torus.V(v, 2), torus.V(v, 0) - 1.0, torus.V(v, 1) + kLift);
+  s.add(torus, upright, upright);
+  MatrixX3d beside = flat;
+  beside.col(0).array() += 2.6;
+  s.add(torus, bent_over_edge(beside, M_PI / 2), beside);
+  const int linked = linking_number(*ring_centre_loop(s.element(0), torus.F),
+                                    *ring_centre_loop(s.element(1), torus.F));
+  ASSERT_EQ(std::abs(linked), 1);
+
+  std::vector<MatrixX3d> results;
+  for (const int threads : {1, 2}) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    Scene t = s;
+    RingUnbendingStats stats;
+    t.unbend(&ground, &stats);
+    EXPECT_EQ(stats.folded, 2);
+    EXPECT_GE(stats.unbent, 1);  // something moved: the links were at stake
+    for (size_t a = 0; a < 3; ++a)
+      for (size_t b = a + 1; b < 3; ++b)
+        EXPECT_EQ(linking_number(*ring_centre_loop(t.element(a), torus.F),
+                                 *ring_centre_loop(t.element(b), torus.F)),
+                  linking_number(*ring_centre_loop(s.element(a), torus.F),
+                                 *ring_centre_loop(s.element(b), torus.F)))
+            << a << " " << b;
+    results.push_back(t.V);
+  }
+  EXPECT_EQ(results[0], results[1]);
+}
+
+TEST(RingUnbending, SizesThatDisagreeAndBadOptionsAreRefused) {
+  const TriMesh torus = test::torus(1.0, kWire, 24, 8);
+  MatrixX3d V = torus.V;
+  const std::vector<const MatrixX3i*> F = {&torus.F};
+  const std::vector<const MatrixX3d*> flat = {&torus.V};
+  const PlacementCheckOptions check;
+  EXPECT_THROW(unbend_folded_rings(V, {0, V.rows() + 1}, F, flat, {0}, nullptr, check),
+               InvalidInput);
+  EXPECT_THROW(unbend_folded_rings(V, {0, V.rows()}, F, flat, {0, 0}, nullptr, check),
+               InvalidInput);
+  RingUnbendingOptions bad;
+  bad.keep = {1.0};
+  EXPECT_THROW(unbend_folded_rings(V, {0, V.rows()}, F, flat, {0}, nullptr, check, bad),
+               InvalidInput);
+  bad = {};
+  bad.target_fold = 0;
+  EXPECT_THROW(bad.validate(), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mq
