@@ -14,34 +14,35 @@
 namespace mq {
 namespace {
 
-constexpr double kWire = 0.15;
-constexpr double kLift = 0.3;  // the flat ring's centre plane above the top face
+constexpr double kHungWire = 0.15;
+constexpr double kHungLift = 0.3;  // the flat ring's centre plane above the top face
 
 // A block whose top face is z = 0 and front face y = 0, meeting in the edge along x.
-TriMesh block() {
+TriMesh edge_block() {
   TriMesh b = test::unit_cube();
   for (Eigen::Index v = 0; v < b.V.rows(); ++v)
     b.V.row(v) = Eigen::RowVector3d(8 * b.V(v, 0) - 4, 6 * b.V(v, 1) - 6, 6 * b.V(v, 2) - 6);
   return b;
 }
 
-// The flat ring (centre radius 1, axis z) lying on the top face at `y`, its centre plane kLift up.
-MatrixX3d flat_ring(const TriMesh& torus, double y) {
+// The flat ring (centre radius 1, axis z) lying on the top face at `y`, its centre plane kHungLift
+// up.
+MatrixX3d hung_flat_ring(const TriMesh& torus, double y) {
   MatrixX3d V = torus.V;
   V.col(1).array() += y;
-  V.col(2).array() += kLift;
+  V.col(2).array() += kHungLift;
   return V;
 }
 
 // The flat ring bent with the surface as a shell map bends it: the part beyond the edge (y > 0)
 // wrapped round it at its own height, up to `turn` radians, then running straight on down the
 // front face.
-MatrixX3d bent_over_edge(const MatrixX3d& flat, double turn) {
+MatrixX3d bent_over_block_edge(const MatrixX3d& flat, double turn) {
   MatrixX3d V = flat;
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     const double y = flat(v, 1), rho = flat(v, 2);
     if (y <= 0) continue;
-    const double phi = std::min(y / kLift, turn), rest = y - phi * kLift;
+    const double phi = std::min(y / kHungLift, turn), rest = y - phi * kHungLift;
     const Vector3d out(0, std::sin(phi), std::cos(phi)), along(0, std::cos(phi), -std::sin(phi));
     const Vector3d p = rho * out + rest * along;
     V(v, 1) = p.y();
@@ -50,9 +51,11 @@ MatrixX3d bent_over_edge(const MatrixX3d& flat, double turn) {
   return V;
 }
 
-double fold(const MatrixX3d& V, const MatrixX3i& F) { return ring_fold(*ring_centre_loop(V, F)); }
+double hung_fold(const MatrixX3d& V, const MatrixX3i& F) {
+  return ring_fold(*ring_centre_loop(V, F));
+}
 
-struct Scene {
+struct HungScene {
   std::vector<TriMesh> rings;
   std::vector<MatrixX3d> flats;
   MatrixX3d V;
@@ -75,23 +78,23 @@ struct Scene {
       flat.push_back(&flats[k]);
     }
     PlacementCheckOptions check;
-    check.height = 2 * kLift;
+    check.height = 2 * kHungLift;
     return unbend_folded_rings(V, first, F, flat, std::vector<char>(rings.size(), 0), ground, check,
                                {}, stats);
   }
 };
 
 TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBase) {
-  const TriMesh base = block();
+  const TriMesh base = edge_block();
   const SignedHeight ground(base.V, base.F);
-  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
-  const MatrixX3d flat = flat_ring(torus, 0.0);
-  Scene s;
-  s.add(torus, bent_over_edge(flat, M_PI / 2), flat);
-  const double before = fold(s.element(0), torus.F) - fold(flat, torus.F);
+  const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
+  const MatrixX3d flat = hung_flat_ring(torus, 0.0);
+  HungScene s;
+  s.add(torus, bent_over_block_edge(flat, M_PI / 2), flat);
+  const double before = hung_fold(s.element(0), torus.F) - hung_fold(flat, torus.F);
   ASSERT_GT(before, kFoldLimit);  // the measure would call it folded
   PlacementCheckOptions check;
-  check.height = 2 * kLift;
+  check.height = 2 * kHungLift;
   ASSERT_EQ(check_element_heights(ground, s.V, s.first, check)[0].below, 0);
 
   RingUnbendingStats stats;
@@ -100,7 +103,8 @@ TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBas
   EXPECT_EQ(stats.unbent, 1);
   ASSERT_TRUE(moved[0]);
   const MatrixX3d after = s.element(0);
-  EXPECT_LE(fold(after, torus.F) - fold(flat, torus.F), RingUnbendingOptions{}.target_fold + 1e-9);
+  EXPECT_LE(hung_fold(after, torus.F) - hung_fold(flat, torus.F),
+            RingUnbendingOptions{}.target_fold + 1e-9);
   EXPECT_EQ(check_element_heights(ground, s.V, s.first, check)[0].below, 0);
   EXPECT_TRUE(self_intersecting_components(after, torus.F).empty());
   // Still over the edge: its centre within a ring radius of it, the edge through its hole.
@@ -109,13 +113,13 @@ TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBas
 }
 
 TEST(RingUnbending, ARingBentAlongTheSurfaceIsLeftAsItIs) {
-  const TriMesh base = block();
+  const TriMesh base = edge_block();
   const SignedHeight ground(base.V, base.F);
-  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
+  const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
   // A gentle turn: half the limit.
-  const MatrixX3d flat = flat_ring(torus, -0.6);
-  Scene s;
-  s.add(torus, bent_over_edge(flat, kFoldLimit / 4), flat);
+  const MatrixX3d flat = hung_flat_ring(torus, -0.6);
+  HungScene s;
+  s.add(torus, bent_over_block_edge(flat, kFoldLimit / 4), flat);
   const MatrixX3d before = s.V;
   RingUnbendingStats stats;
   const std::vector<char> moved = s.unbend(&ground, &stats);
@@ -128,20 +132,21 @@ TEST(RingUnbending, ARingBentAlongTheSurfaceIsLeftAsItIs) {
 // it: every pair's linking number is as before, whatever moved; the same bytes on 1 and 2
 // threads.
 TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
-  const TriMesh base = block();
+  const TriMesh base = edge_block();
   const SignedHeight ground(base.V, base.F);
-  const TriMesh torus = test::torus(1.0, kWire, 48, 12);
-  Scene s;
-  const MatrixX3d flat = flat_ring(torus, 0.0);
-  s.add(torus, bent_over_edge(flat, M_PI / 2), flat);
+  const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
+  HungScene s;
+  const MatrixX3d flat = hung_flat_ring(torus, 0.0);
+  s.add(torus, bent_over_block_edge(flat, M_PI / 2), flat);
   // Upright through the first one's wire on the top face (y = -1), lying along y.
   MatrixX3d upright = torus.V;
   for (Eigen::Index v = 0; v < upright.rows(); ++v)
-    upright.row(v) = Eigen::RowVector3d(torus.V(v, 2), torus.V(v, 0) - 1.0, torus.V(v, 1) + kLift);
+    upright.row(v) =
+        Eigen::RowVector3d(torus.V(v, 2), torus.V(v, 0) - 1.0, torus.V(v, 1) + kHungLift);
   s.add(torus, upright, upright);
   MatrixX3d beside = flat;
   beside.col(0).array() += 2.6;
-  s.add(torus, bent_over_edge(beside, M_PI / 2), beside);
+  s.add(torus, bent_over_block_edge(beside, M_PI / 2), beside);
   const int linked = linking_number(*ring_centre_loop(s.element(0), torus.F),
                                     *ring_centre_loop(s.element(1), torus.F));
   ASSERT_EQ(std::abs(linked), 1);
@@ -149,7 +154,7 @@ TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
   std::vector<MatrixX3d> results;
   for (const int threads : {1, 2}) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    Scene t = s;
+    HungScene t = s;
     RingUnbendingStats stats;
     t.unbend(&ground, &stats);
     EXPECT_EQ(stats.folded, 2);
@@ -167,7 +172,7 @@ TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
 }
 
 TEST(RingUnbending, SizesThatDisagreeAndBadOptionsAreRefused) {
-  const TriMesh torus = test::torus(1.0, kWire, 24, 8);
+  const TriMesh torus = test::torus(1.0, kHungWire, 24, 8);
   MatrixX3d V = torus.V;
   const std::vector<const MatrixX3i*> F = {&torus.F};
   const std::vector<const MatrixX3d*> flat = {&torus.V};
