@@ -27,11 +27,11 @@ void RingUnbendingOptions::validate() const {
 namespace {
 
 // How a candidate ended (RingUnbendingStats' counts).
-enum class Outcome { NotFolded, Unbent, IntoBase, LinksChanged, SelfCrossing };
+enum class UnbendOutcome { NotFolded, Unbent, IntoBase, LinksChanged, SelfCrossing };
 
-struct Candidate {
-  Outcome outcome = Outcome::NotFolded;
-  MatrixX3d V;              // the unbent ring (Outcome::Unbent)
+struct UnbendCandidate {
+  UnbendOutcome outcome = UnbendOutcome::NotFolded;
+  MatrixX3d V;              // the unbent ring (UnbendOutcome::Unbent)
   std::vector<int> near;    // ring-shaped neighbours
   std::vector<int> linked;  // per neighbour: the linking number as placed
 };
@@ -93,10 +93,10 @@ std::vector<char> ring_faces(const std::vector<const MatrixX3i*>& F,
 void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
             const std::vector<Loop>& loops, const SignedHeight* ground,
             const PlacementCheckOptions& check, const RingUnbendingOptions& options,
-            double reference, Candidate& c) {
+            double reference, UnbendCandidate& c) {
   const MatrixX3d rigid = similarity_fit(flat, placed);
   const std::vector<Eigen::Index> whole = {0, placed.rows()};
-  c.outcome = Outcome::SelfCrossing;
+  c.outcome = UnbendOutcome::SelfCrossing;
   for (const double keep : options.keep) {
     MatrixX3d blend = keep * placed + (1 - keep) * rigid;
     std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
@@ -108,7 +108,7 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
       const std::vector<ElementHeights> lifted =
           lift_out_of_base(*ground, blend, whole, check, {1});
       if (lifted[0].below > 0) {
-        c.outcome = Outcome::IntoBase;
+        c.outcome = UnbendOutcome::IntoBase;
         continue;
       }
       loop = loop_of(blend, F, options.loop_bins);
@@ -118,11 +118,11 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
     for (size_t j = 0; j < c.near.size() && same; ++j)
       same = linking_number(*loop, loops[static_cast<size_t>(c.near[j])]) == c.linked[j];
     if (!same) {
-      c.outcome = Outcome::LinksChanged;
+      c.outcome = UnbendOutcome::LinksChanged;
       continue;
     }
     c.V = std::move(blend);
-    c.outcome = Outcome::Unbent;
+    c.outcome = UnbendOutcome::Unbent;
     return;
   }
 }
@@ -168,10 +168,10 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
   std::vector<char> grid_skip(ne, 0);
   for (size_t k = 0; k < ne; ++k) grid_skip[k] = !ring[k];
   const ElementGrid grid(V, first, grid_skip);
-  std::vector<Candidate> candidates(ne);
+  std::vector<UnbendCandidate> candidates(ne);
   tbb::parallel_for(size_t{0}, ne, [&](size_t k) {
     if (!folded[k]) return;
-    Candidate& c = candidates[k];
+    UnbendCandidate& c = candidates[k];
     for (const int j : grid.near(grid.box[k]))
       if (static_cast<size_t>(j) != k) {
         c.near.push_back(j);
@@ -183,26 +183,26 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
   std::vector<char> moved(ne, 0);
   RingUnbendingStats s;
   for (size_t k = 0; k < ne; ++k) {
-    Candidate& c = candidates[k];
+    UnbendCandidate& c = candidates[k];
     if (!folded[k]) continue;
     ++s.folded;
-    if (c.outcome == Outcome::Unbent) {
+    if (c.outcome == UnbendOutcome::Unbent) {
       const std::optional<Loop> now = loop_of(c.V, *F[k], options.loop_bins);
-      for (size_t j = 0; j < c.near.size() && c.outcome == Outcome::Unbent; ++j) {
+      for (size_t j = 0; j < c.near.size() && c.outcome == UnbendOutcome::Unbent; ++j) {
         const auto n = static_cast<size_t>(c.near[j]);
         if (n < k && moved[n] && linking_number(*now, loops[n]) != c.linked[j])
-          c.outcome = Outcome::LinksChanged;
+          c.outcome = UnbendOutcome::LinksChanged;
       }
-      if (c.outcome == Outcome::Unbent) {
+      if (c.outcome == UnbendOutcome::Unbent) {
         rows(k) = c.V;
         loops[k] = *now;
         moved[k] = 1;
       }
     }
-    s.unbent += c.outcome == Outcome::Unbent;
-    s.into_base += c.outcome == Outcome::IntoBase;
-    s.links_changed += c.outcome == Outcome::LinksChanged;
-    s.self_crossing += c.outcome == Outcome::SelfCrossing;
+    s.unbent += c.outcome == UnbendOutcome::Unbent;
+    s.into_base += c.outcome == UnbendOutcome::IntoBase;
+    s.links_changed += c.outcome == UnbendOutcome::LinksChanged;
+    s.self_crossing += c.outcome == UnbendOutcome::SelfCrossing;
   }
   if (stats) *stats = s;
   return moved;
