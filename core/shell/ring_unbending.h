@@ -26,7 +26,7 @@ struct RingUnbendingOptions {
   // not judged folded by the measure's own binning of the output.
   double target_fold = 0.8 * (M_PI / 3);
   // Shares of the placed (bent) shape tried, in order; the rest is the rigid flat shape.
-  std::vector<double> keep = {0.75, 0.5, 0.25, 0.0};
+  std::vector<double> keep = {0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1, 0.0};
   int loop_bins = 32;  // centre loop points, as the structure measure bins rings
 
   // Throws InvalidInput unless target_fold is in (0, pi] and every keep in [0, 1).
