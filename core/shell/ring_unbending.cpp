@@ -10,8 +10,8 @@
 #include "core/common/errors.h"
 #include "core/common/fnv1a.h"
 #include "core/mesh/mesh_intersections.h"
-#include "core/mesh/similarity_fit.h"
 #include "core/shell/element_grid.h"
+#include "core/shell/element_unfolding.h"
 #include "core/structure/texture_structure.h"
 
 namespace mq {
@@ -26,12 +26,14 @@ void RingUnbendingOptions::validate() const {
 
 namespace {
 
-// How a candidate ended (RingUnbendingStats' counts).
-enum class UnbendOutcome { NotFolded, Unbent, IntoBase, LinksChanged, SelfCrossing };
+// How a candidate ended (RingUnbendingStats' counts): no blend within the target fold stayed
+// whole, unless a later check turned one down.
+enum class UnbendOutcome { SelfCrossing, Unbent, IntoBase, LinksChanged };
 
 struct UnbendCandidate {
-  UnbendOutcome outcome = UnbendOutcome::NotFolded;
+  UnbendOutcome outcome = UnbendOutcome::SelfCrossing;
   MatrixX3d V;              // the unbent ring (UnbendOutcome::Unbent)
+  Loop loop;                // and its centre loop
   std::vector<int> near;    // ring-shaped neighbours
   std::vector<int> linked;  // per neighbour: the linking number as placed
 };
@@ -94,37 +96,31 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
             const std::vector<Loop>& loops, const SignedHeight* ground,
             const PlacementCheckOptions& check, const RingUnbendingOptions& options,
             double reference, UnbendCandidate& c) {
-  const MatrixX3d rigid = similarity_fit(flat, placed);
   const std::vector<Eigen::Index> whole = {0, placed.rows()};
-  c.outcome = UnbendOutcome::SelfCrossing;
-  for (const double keep : options.keep) {
-    MatrixX3d blend = keep * placed + (1 - keep) * rigid;
+  blend_towards_flat(placed, flat, options.keep, [&](MatrixX3d& blend, double) {
     std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
-    if (!loop || ring_fold(*loop) - reference > options.target_fold) continue;
-    if (!self_intersecting_components(blend, F).empty()) continue;
+    if (!loop || ring_fold(*loop) - reference > options.target_fold) return false;
+    if (!self_intersecting_components(blend, F).empty()) return false;
     // A ring hung straighter over a convex edge dips into the base beside it: lifted out whole
     // (its links are checked after).
     if (ground && check_element_heights(*ground, blend, whole, check)[0].below > 0) {
-      const std::vector<ElementHeights> lifted =
-          lift_out_of_base(*ground, blend, whole, check, {1});
-      if (lifted[0].below > 0) {
+      if (lift_out_of_base(*ground, blend, whole, check, {1})[0].below > 0) {
         c.outcome = UnbendOutcome::IntoBase;
-        continue;
+        return false;
       }
       loop = loop_of(blend, F, options.loop_bins);
-      if (!loop) continue;
+      if (!loop) return false;
     }
-    bool same = true;
-    for (size_t j = 0; j < c.near.size() && same; ++j)
-      same = linking_number(*loop, loops[static_cast<size_t>(c.near[j])]) == c.linked[j];
-    if (!same) {
-      c.outcome = UnbendOutcome::LinksChanged;
-      continue;
-    }
+    for (size_t j = 0; j < c.near.size(); ++j)
+      if (linking_number(*loop, loops[static_cast<size_t>(c.near[j])]) != c.linked[j]) {
+        c.outcome = UnbendOutcome::LinksChanged;
+        return false;
+      }
     c.V = std::move(blend);
+    c.loop = std::move(*loop);
     c.outcome = UnbendOutcome::Unbent;
-    return;
-  }
+    return true;
+  });
 }
 
 }  // namespace
@@ -186,18 +182,15 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
     UnbendCandidate& c = candidates[k];
     if (!folded[k]) continue;
     ++s.folded;
+    for (size_t j = 0; j < c.near.size() && c.outcome == UnbendOutcome::Unbent; ++j) {
+      const auto n = static_cast<size_t>(c.near[j]);
+      if (n < k && moved[n] && linking_number(c.loop, loops[n]) != c.linked[j])
+        c.outcome = UnbendOutcome::LinksChanged;
+    }
     if (c.outcome == UnbendOutcome::Unbent) {
-      const std::optional<Loop> now = loop_of(c.V, *F[k], options.loop_bins);
-      for (size_t j = 0; j < c.near.size() && c.outcome == UnbendOutcome::Unbent; ++j) {
-        const auto n = static_cast<size_t>(c.near[j]);
-        if (n < k && moved[n] && linking_number(*now, loops[n]) != c.linked[j])
-          c.outcome = UnbendOutcome::LinksChanged;
-      }
-      if (c.outcome == UnbendOutcome::Unbent) {
-        rows(k) = c.V;
-        loops[k] = *now;
-        moved[k] = 1;
-      }
+      rows(k) = c.V;
+      loops[k] = std::move(c.loop);
+      moved[k] = 1;
     }
     s.unbent += c.outcome == UnbendOutcome::Unbent;
     s.into_base += c.outcome == UnbendOutcome::IntoBase;

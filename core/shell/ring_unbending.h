@@ -5,7 +5,7 @@
 // halves turn more than the structure measure's limit (kFoldLimit) against each other, a
 // degenerate ring that links nothing. A real ring is rigid and hangs over such an edge, the edge
 // through its hole: each folded ring is blended towards its flat shape moved rigidly to where it
-// lies (similarity_fit, as the fold repair does), the least blend that brings its fold within
+// lies (blend_towards_flat, the fold repair's step), the least blend that brings its fold within
 // the limit, provided it stays whole, out of the base, and keeps the linking number with every
 // ring near it.
 #pragma once

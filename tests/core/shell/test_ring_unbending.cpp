@@ -9,45 +9,40 @@
 #include "core/mesh/mesh_intersections.h"
 #include "core/shell/ring_unbending.h"
 #include "core/structure/texture_structure.h"
+#include "tests/core/ring_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
 namespace {
 
 constexpr double kHungWire = 0.15;
-constexpr double kHungLift = 0.3;  // the flat ring's centre plane above the top face
+constexpr double kHungLift = 0.3;   // the flat ring's centre plane above the top face
+constexpr double kHungRound = 0.2;  // the edge's rounding (test::over_edge)
 
-// A block whose top face is z = 0 and front face y = 0, meeting in the edge along x.
+// A block whose top face is z = 0 (x <= kHungRound) and side face x = kHungRound, meeting in
+// the edge along y that test::over_edge rounds.
 TriMesh edge_block() {
   TriMesh b = test::unit_cube();
   for (Eigen::Index v = 0; v < b.V.rows(); ++v)
-    b.V.row(v) = Eigen::RowVector3d(8 * b.V(v, 0) - 4, 6 * b.V(v, 1) - 6, 6 * b.V(v, 2) - 6);
+    b.V.row(v) =
+        Eigen::RowVector3d((8 + kHungRound) * b.V(v, 0) - 8, 8 * b.V(v, 1) - 4, 6 * b.V(v, 2) - 6);
   return b;
 }
 
-// The flat ring (centre radius 1, axis z) lying on the top face at `y`, its centre plane kHungLift
+// The flat ring (centre radius 1, axis z) lying on the top face at x, its centre plane kHungLift
 // up.
-MatrixX3d hung_flat_ring(const TriMesh& torus, double y) {
+MatrixX3d hung_flat_ring(const TriMesh& torus, double x) {
   MatrixX3d V = torus.V;
-  V.col(1).array() += y;
+  V.col(0).array() += x;
   V.col(2).array() += kHungLift;
   return V;
 }
 
-// The flat ring bent with the surface as a shell map bends it: the part beyond the edge (y > 0)
-// wrapped round it at its own height, up to `turn` radians, then running straight on down the
-// front face.
-MatrixX3d bent_over_block_edge(const MatrixX3d& flat, double turn) {
+// The flat ring bent with the surface over the edge, at its own height, as a shell map bends it.
+MatrixX3d bent_over_block_edge(const MatrixX3d& flat) {
   MatrixX3d V = flat;
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    const double y = flat(v, 1), rho = flat(v, 2);
-    if (y <= 0) continue;
-    const double phi = std::min(y / kHungLift, turn), rest = y - phi * kHungLift;
-    const Vector3d out(0, std::sin(phi), std::cos(phi)), along(0, std::cos(phi), -std::sin(phi));
-    const Vector3d p = rho * out + rest * along;
-    V(v, 1) = p.y();
-    V(v, 2) = p.z();
-  }
+  for (Eigen::Index v = 0; v < V.rows(); ++v)
+    V.row(v) = test::over_edge(flat.row(v).transpose(), kHungRound).transpose();
   return V;
 }
 
@@ -90,7 +85,7 @@ TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBas
   const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
   const MatrixX3d flat = hung_flat_ring(torus, 0.0);
   HungScene s;
-  s.add(torus, bent_over_block_edge(flat, M_PI / 2), flat);
+  s.add(torus, bent_over_block_edge(flat), flat);
   const double before = hung_fold(s.element(0), torus.F) - hung_fold(flat, torus.F);
   ASSERT_GT(before, kFoldLimit);  // the measure would call it folded
   PlacementCheckOptions check;
@@ -109,17 +104,23 @@ TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBas
   EXPECT_TRUE(self_intersecting_components(after, torus.F).empty());
   // Still over the edge: its centre within a ring radius of it, the edge through its hole.
   const Vector3d centre = after.colwise().mean().transpose();
-  EXPECT_LT(std::hypot(centre.y(), centre.z()), 1.0);
+  EXPECT_LT(std::hypot(centre.x(), centre.z()), 1.0);
 }
 
 TEST(RingUnbending, ARingBentAlongTheSurfaceIsLeftAsItIs) {
   const TriMesh base = edge_block();
   const SignedHeight ground(base.V, base.F);
   const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
-  // A gentle turn: half the limit.
-  const MatrixX3d flat = hung_flat_ring(torus, -0.6);
+  // Wrapped round a cylinder of 6 ring radii on the top face, well away from the edge: bent
+  // about 10 degrees, a sixth of the limit.
+  const MatrixX3d flat = hung_flat_ring(torus, -2.0);
+  MatrixX3d bent = flat;
+  for (Eigen::Index v = 0; v < bent.rows(); ++v)
+    bent.row(v) =
+        (test::over_cylinder(flat.row(v).transpose() + Vector3d(2, 0, 0), 6.0) - Vector3d(2, 0, 0))
+            .transpose();
   HungScene s;
-  s.add(torus, bent_over_block_edge(flat, kFoldLimit / 4), flat);
+  s.add(torus, bent, flat);
   const MatrixX3d before = s.V;
   RingUnbendingStats stats;
   const std::vector<char> moved = s.unbend(&ground, &stats);
@@ -137,16 +138,16 @@ TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
   const TriMesh torus = test::torus(1.0, kHungWire, 48, 12);
   HungScene s;
   const MatrixX3d flat = hung_flat_ring(torus, 0.0);
-  s.add(torus, bent_over_block_edge(flat, M_PI / 2), flat);
-  // Upright through the first one's wire on the top face (y = -1), lying along y.
+  s.add(torus, bent_over_block_edge(flat), flat);
+  // Upright through the first one's wire on the top face (x = -1), its axis along y.
   MatrixX3d upright = torus.V;
   for (Eigen::Index v = 0; v < upright.rows(); ++v)
     upright.row(v) =
-        Eigen::RowVector3d(torus.V(v, 2), torus.V(v, 0) - 1.0, torus.V(v, 1) + kHungLift);
+        Eigen::RowVector3d(torus.V(v, 0) - 1.0, torus.V(v, 2), torus.V(v, 1) + kHungLift);
   s.add(torus, upright, upright);
   MatrixX3d beside = flat;
-  beside.col(0).array() += 2.6;
-  s.add(torus, bent_over_block_edge(beside, M_PI / 2), beside);
+  beside.col(1).array() += 2.6;
+  s.add(torus, bent_over_block_edge(beside), beside);
   const int linked = linking_number(*ring_centre_loop(s.element(0), torus.F),
                                     *ring_centre_loop(s.element(1), torus.F));
   ASSERT_EQ(std::abs(linked), 1);

@@ -22,26 +22,26 @@ TriMesh moved(TriMesh m, const Eigen::Matrix3d& R, const Vector3d& t) {
   return m;
 }
 
-// A chain of n tori (radius 1, wire 0.15) along x, alternately in the xy and xz planes, each
-// threaded through the next.
-// Sheets of few segments (fast to measure), rows x cols.
-SquareMailOptions small_square(int rows, int cols) {
-  SquareMailOptions o;
+// A sheet's options (ChainMailOptions or SquareMailOptions) at few segments (fast to measure),
+// rows x cols.
+template <class Options>
+Options small_sheet(int rows, int cols) {
+  Options o;
   o.rows = rows;
   o.cols = cols;
   o.ring_segments = 16;
   o.wire_segments = 4;
   return o;
+}
+SquareMailOptions small_square(int rows, int cols) {
+  return small_sheet<SquareMailOptions>(rows, cols);
 }
 ChainMailOptions small_4in1(int rows, int cols) {
-  ChainMailOptions o;
-  o.rows = rows;
-  o.cols = cols;
-  o.ring_segments = 16;
-  o.wire_segments = 4;
-  return o;
+  return small_sheet<ChainMailOptions>(rows, cols);
 }
 
+// A chain of n tori (radius 1, wire 0.15) along x, alternately in the xy and xz planes, each
+// threaded through the next.
 TriMesh chain(int n) {
   const TriMesh ring = test::torus(1.0, 0.15, 32, 8);
   const Eigen::Matrix3d flip = Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitX()).toRotationMatrix();
