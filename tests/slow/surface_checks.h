@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <set>
+#include <utility>
+#include <vector>
 
 #include "core/mesh/closest_point_query.h"
 #include "core/mesh/geometry_measures.h"
@@ -54,6 +57,22 @@ inline size_t intersecting_pairs_when_embedded(const SurfaceQuilt& quilt, bool s
   TetStretchCpu stretch;
   const TriMesh out = embed_quilt(quilt, options, stretch, stats);
   return intersecting_face_pairs(out.V, out.F).size();
+}
+
+// The distinct pairs of elements (connected components) with intersecting faces when `quilt` is
+// embedded as intersecting_pairs_when_embedded does it.
+inline size_t intersecting_elements_when_embedded(const SurfaceQuilt& quilt, bool shell_map) {
+  QuiltEmbeddingOptions options;
+  options.shell_map = shell_map;
+  options.remove_intersecting = false;
+  TetStretchCpu stretch;
+  const TriMesh out = embed_quilt(quilt, options, stretch);
+  std::vector<int> element;
+  connected_components(out.F, out.num_vertices(), element);
+  std::set<std::pair<int, int>> pairs;
+  for (const auto& [f, g] : intersecting_face_pairs(out.V, out.F))
+    pairs.emplace(std::min(element[f], element[g]), std::max(element[f], element[g]));
+  return pairs.size();
 }
 
 // Mean face count and mean surface area of the elements (connected components) of a mesh.
