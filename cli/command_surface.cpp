@@ -274,10 +274,9 @@ void declare_surface_options(CommandLine& cl) {
       "print the job's size and stop, writing nothing: one line 'estimate faces N bytes B "
       "seconds T fits 0|1'. N is the global layout's count of copies (within 10% of the "
       "faces written), the vines' stems at their spacing (within 10% on the sample ivy), or for "
-      "the patches whole swatch copies over the area (apples: within 10%; sheets the patches cut: "
-      "up "
-      "to 2x over); T is rough (4 us a face on 2 "
-      "cores, plus 0.5 s); fits: within --max-faces and --max-memory");
+      "the patches whole swatch copies over the area (apples: within 10%; sheets the patches "
+      "cut: up to 2x over); T is rough (4 us a face on 2 cores, plus 0.5 s); fits: within "
+      "--max-faces and --max-memory");
   cl.option("save-quilt", "FILE",
             "also save the result in local coordinates over the base (elements, their kinds, "
             "the embedding's options; docs/saved-quilt.md), for 'meshquilt embed' to place it "

@@ -30,12 +30,10 @@ struct SurfaceRun {
   TriMesh output;
 };
 
-inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double scale,
-                              bool shell_map = true, const MatrixX3d& field = MatrixX3d()) {
+// The quilt of `swatch` over `base` by `options`, embedded with or without the shell map.
+inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch,
+                              const SurfaceQuiltingOptions& options, bool shell_map = true) {
   SurfaceRun run;
-  SurfaceQuiltingOptions options;
-  options.scale = scale;
-  options.field = field;
   TranslationCostCpu cost;
   run.quilt = quilt_surface(base, swatch, options, cost, &run.stats);
   QuiltEmbeddingOptions embedding;
@@ -45,34 +43,41 @@ inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double
   return run;
 }
 
-// Face pairs of different elements that intersect when `quilt` is embedded with the given
-// options but without removing intersecting elements (how much the embedding itself creates).
-inline size_t intersecting_pairs_when_embedded(const SurfaceQuilt& quilt, bool shell_map,
-                                               bool optimize_stretch = true,
-                                               QuiltEmbeddingStats* stats = nullptr) {
+inline SurfaceRun run_surface(const TriMesh& base, const TriMesh& swatch, double scale,
+                              bool shell_map = true, const MatrixX3d& field = MatrixX3d()) {
+  SurfaceQuiltingOptions options;
+  options.scale = scale;
+  options.field = field;
+  return run_surface(base, swatch, options, shell_map);
+}
+
+// What intersects when `quilt` is embedded with the given options but without removing
+// intersecting elements (how much the embedding itself creates): face pairs of different
+// elements, and the distinct pairs of elements (connected components) they belong to.
+struct Intersections {
+  size_t faces = 0, elements = 0;
+};
+inline Intersections intersections_when_embedded(const SurfaceQuilt& quilt, bool shell_map,
+                                                 bool optimize_stretch = true,
+                                                 QuiltEmbeddingStats* stats = nullptr) {
   QuiltEmbeddingOptions options;
   options.shell_map = shell_map;
   options.optimize_stretch = optimize_stretch;
   options.remove_intersecting = false;
   TetStretchCpu stretch;
   const TriMesh out = embed_quilt(quilt, options, stretch, stats);
-  return intersecting_face_pairs(out.V, out.F).size();
-}
-
-// The distinct pairs of elements (connected components) with intersecting faces when `quilt` is
-// embedded as intersecting_pairs_when_embedded does it.
-inline size_t intersecting_elements_when_embedded(const SurfaceQuilt& quilt, bool shell_map) {
-  QuiltEmbeddingOptions options;
-  options.shell_map = shell_map;
-  options.remove_intersecting = false;
-  TetStretchCpu stretch;
-  const TriMesh out = embed_quilt(quilt, options, stretch);
+  const std::vector<std::pair<int, int>> faces = intersecting_face_pairs(out.V, out.F);
   std::vector<int> element;
   connected_components(out.F, out.num_vertices(), element);
   std::set<std::pair<int, int>> pairs;
-  for (const auto& [f, g] : intersecting_face_pairs(out.V, out.F))
+  for (const auto& [f, g] : faces)
     pairs.emplace(std::min(element[f], element[g]), std::max(element[f], element[g]));
-  return pairs.size();
+  return {faces.size(), pairs.size()};
+}
+inline size_t intersecting_pairs_when_embedded(const SurfaceQuilt& quilt, bool shell_map,
+                                               bool optimize_stretch = true,
+                                               QuiltEmbeddingStats* stats = nullptr) {
+  return intersections_when_embedded(quilt, shell_map, optimize_stretch, stats).faces;
 }
 
 // Mean face count and mean surface area of the elements (connected components) of a mesh.

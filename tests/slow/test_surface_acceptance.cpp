@@ -36,7 +36,8 @@ double scaled_swatch_element_area(const TriMesh& swatch, double swatch_scale) {
 
 // Issue 4's checks plus a sane element-size spread, then issue 5's comparison of the two
 // embeddings of the same quilt. Returns the intersecting pairs {normal, shell map}.
-std::pair<size_t, size_t> check_chain_mail(const char* name, const test::SurfaceRun& run) {
+std::pair<test::Intersections, test::Intersections> check_chain_mail(const char* name,
+                                                                     const test::SurfaceRun& run) {
   SCOPED_TRACE(name);
   const QuiltEmbeddingStats& es = run.embedding_stats;
   EXPECT_TRUE(es.shell_map_failure.empty()) << es.shell_map_failure;
@@ -57,11 +58,13 @@ std::pair<size_t, size_t> check_chain_mail(const char* name, const test::Surface
   EXPECT_LT(es.element_area_mean, 2.0 * ring);
 
   // Issue 5: the same quilt, embedded without removing anything.
-  const size_t normal = test::intersecting_pairs_when_embedded(run.quilt, false);
-  const size_t shell = test::intersecting_pairs_when_embedded(run.quilt, true);
-  std::printf("[ measure  ] %s: intersecting face pairs, normal displacement %zu, shell map %zu\n",
-              name, normal, shell);
-  EXPECT_GT(normal, 0u) << "normal displacement should intersect in concave regions";
+  const test::Intersections normal = test::intersections_when_embedded(run.quilt, false);
+  const test::Intersections shell = test::intersections_when_embedded(run.quilt, true);
+  std::printf(
+      "[ measure  ] %s: intersecting face pairs, normal displacement %zu, shell map %zu; element "
+      "pairs %zu, %zu\n",
+      name, normal.faces, shell.faces, normal.elements, shell.elements);
+  EXPECT_GT(normal.faces, 0u) << "normal displacement should intersect in concave regions";
   return {normal, shell};
 }
 
@@ -93,13 +96,8 @@ TEST_P(ChainMailOverRealBase, ValidCoveredAndShellMapRemovesIntersections) {
   const test::SurfaceRun run = test::run_surface(base, test::tiny_chainmail(), 0.16);
   test::expect_valid_surface_quilt(base, run, 0.95);
   const auto [normal, shell] = check_chain_mail(GetParam(), run);
-  const size_t shell_elements = test::intersecting_elements_when_embedded(run.quilt, true);
-  const size_t normal_elements = test::intersecting_elements_when_embedded(run.quilt, false);
-  std::printf(
-      "[ measure  ] %s: intersecting element pairs, normal displacement %zu, shell map %zu\n",
-      GetParam(), normal_elements, shell_elements);
-  EXPECT_LE(shell_elements, std::max<size_t>(normal_elements / 3, 8));
-  EXPECT_LE(shell, test::intersecting_pairs_when_embedded(run.quilt, true, false));
+  EXPECT_LE(shell.elements, std::max<size_t>(normal.elements / 3, 8));
+  EXPECT_LE(shell.faces, test::intersecting_pairs_when_embedded(run.quilt, true, false));
 }
 
 INSTANTIATE_TEST_SUITE_P(SurfaceAcceptance, ChainMailOverRealBase,

@@ -16,6 +16,7 @@
 #include "core/surface/surface_quilting.h"
 #include "tests/core/planar_checks.h"
 #include "tests/core/shell_fixtures.h"
+#include "tests/slow/surface_checks.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -79,20 +80,13 @@ CapSizes apples_on_caps(const Eigen::VectorXd& size_map) {
   SurfaceQuiltingOptions o;
   o.scale = 0.2;
   o.size_map = size_map;
-  TranslationCostCpu cost;
-  SurfaceQuiltingStats stats;
-  const SurfaceQuilt quilt = quilt_surface(base, swatch, o, cost, &stats);
-  QuiltEmbeddingOptions e;
-  e.shell_map = false;
-  TetStretchCpu stretch;
-  QuiltEmbeddingStats es;
-  const TriMesh out = embed_quilt(quilt, e, stretch, &es);
+  const test::SurfaceRun run = test::run_surface(base, swatch, o, false);
   CapSizes r;
-  r.coverage = es.coverage;
-  r.intersecting = !intersecting_face_pairs(out.V, out.F).empty();
-  for (const SurfaceElement& el : quilt.elements)
-    r.within_shell &= el.height.maxCoeff() <= quilt.shell_height * (1 + 1e-12);
-  const StructureSummary s = summarize_structure(out, swatch, &base, stats.swatch_scale);
+  r.coverage = run.embedding_stats.coverage;
+  r.intersecting = !intersecting_face_pairs(run.output.V, run.output.F).empty();
+  for (const SurfaceElement& el : run.quilt.elements)
+    r.within_shell &= el.height.maxCoeff() <= run.quilt.shell_height * (1 + 1e-12);
+  const StructureSummary s = summarize_structure(run.output, swatch, &base, run.stats.swatch_scale);
   for (const ElementStructure& el : s.output.elements) {
     const double z = el.centre.z() / el.centre.norm();
     if (z > 0.24) r.top.push_back(el.size);
@@ -142,21 +136,14 @@ TEST(SurfaceQuilting, SizeMapSizesThePatchesElements) {
 TEST(SurfaceQuilting, TallElementsLeaveNoStreaksBetweenPatches) {
   const TriMesh base = test::plane_grid(3.0, 3.0, 24, 24);
   const TriMesh swatch = test::small_apples(11);
-  SurfaceQuiltingOptions o;
-  o.scale = 0.13;
-  TranslationCostCpu cost;
-  SurfaceQuiltingStats stats;
-  const SurfaceQuilt quilt = quilt_surface(base, swatch, o, cost, &stats);
-  QuiltEmbeddingOptions e;
-  e.shell_map = false;
-  TetStretchCpu stretch;
-  const TriMesh out = embed_quilt(quilt, e, stretch);
-  const StructureSummary s = summarize_structure(out, swatch, &base, stats.swatch_scale);
+  const test::SurfaceRun run = test::run_surface(base, swatch, 0.13, false);
+  const TriMesh& out = run.output;
+  const double scale = run.stats.swatch_scale;
+  const StructureSummary s = summarize_structure(out, swatch, &base, scale);
   // The swatch's apples per footprint area at the output's scale, against the apples whose
   // centre lies an apple or more inside the sheet's border per that inner area.
   const Vector3d lo = swatch.V.colwise().minCoeff(), hi = swatch.V.colwise().maxCoeff();
-  const double per_area =
-      11.0 / ((hi - lo).x() * (hi - lo).y()) / (stats.swatch_scale * stats.swatch_scale);
+  const double per_area = 11.0 / ((hi - lo).x() * (hi - lo).y()) / (scale * scale);
   const double inset = s.output.median_size;
   int inside = 0;
   for (const ElementStructure& el : s.output.elements)
