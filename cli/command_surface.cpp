@@ -162,8 +162,15 @@ void write_global_layout(JsonWriter& j, const GlobalQuiltingStats& g) {
       .value("thread_welds", g.thread_welds)
       .value("thread_ends", g.thread_ends)
       .value("closed_threads", g.closed_threads)
-      .value("short_threads", g.short_threads)
-      .end_object();
+      .value("short_threads", g.short_threads);
+  j.begin_array("cones");
+  for (Eigen::Index i = 0; i < g.cones.rows(); ++i)
+    j.begin_array()
+        .value("", g.cones(i, 0))
+        .value("", g.cones(i, 1))
+        .value("", g.cones(i, 2))
+        .end_array();
+  j.end_array().end_object();
 }
 
 std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats& em,

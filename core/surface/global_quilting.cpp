@@ -1223,6 +1223,10 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   const GlobalParameterization gp =
       global_layout(job, symmetry, options.global, anchor, gstats, times, progress);
   gstats.singular_vertices = gp.num_singular;
+  gstats.cones.resize(gp.num_singular, 3);
+  for (Eigen::Index v = 0, i = 0; v < job.base.V.rows(); ++v)
+    if (gp.singular[static_cast<size_t>(v)] && i < gstats.cones.rows())
+      gstats.cones.row(i++) = job.base.V.row(v);
   gstats.cut_edges = gp.num_cut_edges;
   const Vector2d lo = plane_origin(gp, symmetry, anchor, gstats);
   const Vector2d hi = gp.wedge_uv.colwise().maxCoeff().transpose();

@@ -33,6 +33,9 @@ struct GlobalQuiltingStats {
   double scale_exponent = 0;
   double scale_energy_before = 0, scale_energy = 0;
   int pinned_cones = 0;
+  // #singular_vertices by 3: where the cones are on the base, in the base's units (a ring
+  // lattice's defects: most of its misses lie within a ring or two of one).
+  MatrixX3d cones;
   int cut_edges = 0, cut_paths = 0;
   // Largest distance of a transition from the texture's nearest symmetry, in lattice periods
   // (the constraints are soft; a ring's clearance in the 4-in-1 sheet is about 0.2).

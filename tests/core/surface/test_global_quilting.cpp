@@ -118,6 +118,14 @@ TEST(GlobalQuilting, SphereWithItsFourCones) {
   expect_mail(r, {0.93}, "sphere, rings a fifth of the radius");
   EXPECT_EQ(r.global.singular_vertices, 4);
   EXPECT_EQ(r.global.pinned_cones, 3);  // the fourth is where the other three put it
+  // Where they are (--stats global.cones): vertices of the base, on the sphere of radius 3,
+  // apart from each other (four half-turn cones: no two within a radius).
+  ASSERT_EQ(r.global.cones.rows(), 4);
+  for (Eigen::Index i = 0; i < 4; ++i) {
+    EXPECT_NEAR(r.global.cones.row(i).norm(), 3.0, 1e-9);
+    for (Eigen::Index j = 0; j < i; ++j)
+      EXPECT_GT((r.global.cones.row(i) - r.global.cones.row(j)).norm(), 3.0);
+  }
   EXPECT_TRUE(r.global.seamless);
   EXPECT_LT(r.global.worst_transition_error, 0.01);
 }
