@@ -146,8 +146,9 @@ Eigen::MatrixXd layout_differential(const GlobalParameterization& gp, const TriM
 // within max_element_variation of each other: no teardrop), each face's differential taken into
 // the element's chart (turn: place_from's). Intrinsic: the surface's bending
 // of the element is not distortion; averaged: the layout's per-triangle noise is not either.
-// Smaller elements pass: they lie where the layout gathers curvature (around + cones), are
-// linked as densely as the lattice there, and an even copy of full size would collide.
+// Smaller elements pass, at any variation and up to small_element_aspect: they lie where the
+// layout gathers curvature (around + cones), are linked as densely as the lattice there, and an
+// even copy of full size would collide.
 bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P,
                          const SurfaceElement& s, const std::vector<signed char>& turn,
                          const SurfaceQuiltingOptions::Global& options,
@@ -186,6 +187,9 @@ bool within_shape_limits(const Eigen::MatrixXd& differential, const MatrixX3d& P
     const double a = scale_of(sum[0] / count[0], nullptr), b = scale_of(sum[1] / count[1], nullptr);
     even = std::max(a, b) <= options.max_element_variation * std::min(a, b);
   }
+  if (element_scale / nominal < options.small_element_scale &&
+      aspect <= options.small_element_aspect)
+    return true;  // around a positive cone (SurfaceQuiltingOptions::Global::small_element_scale)
   return element_scale / nominal <= options.max_element_scale &&
          aspect <= options.max_element_aspect && even;
 }
@@ -799,6 +803,7 @@ class ThreadPiecePlacer {
       if (gp.singular[static_cast<size_t>(v)]) cones_.push_back(job.base.V.row(v).transpose());
     limits_.max_element_scale = limits_.max_element_aspect = limits_.max_element_variation =
         kThreadShapeLimit;
+    limits_.small_element_scale = 0;  // a thread piece bends with its neighbours or is left out
   }
 
   // Copy c placed into pp, its vertices embedded by normal displacement into X when it is kept.

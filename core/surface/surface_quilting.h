@@ -190,6 +190,14 @@ struct SurfaceQuiltingOptions {
     double max_element_scale = 1.3;
     double max_element_aspect = 1.3;
     double max_element_variation = 1.3;
+    // An element the layout makes smaller than small_element_scale times the swatch's keeps the
+    // layout's version at any variation across it and an aspect up to small_element_aspect. It
+    // lies where the layout gathers curvature (around a positive cone), among neighbours as
+    // small: an even copy of full size collides with them and is removed, and the ring lattice
+    // loses its links there (bunny: 79 elements removed against 23, 92.0% of rings linked
+    // against 94.3%). 0 turns the exception off.
+    double small_element_scale = 0.95;
+    double small_element_aspect = 2.0;
     // A periodic swatch of compact elements is tiled over the parameter plane (the planar
     // quilt it would give), one of threads by one-period pieces welded into threads
     // (core/surface/thread_tiling); else the plane is quilted.
