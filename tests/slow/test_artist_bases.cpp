@@ -98,19 +98,26 @@ TriMesh blender(const std::string& name) { return read_mesh(test::blender_base(n
 
 TEST(ArtistBases, BlenderPrimitivesWithTheSampleMail) {
   const TriMesh mail = sample_mail();
+  // 99.3-99.9% linked on the four with cones (96.8-97.8% before small rings around them kept
+  // the layout's version).
+  Keep sphere;
+  sphere.share = 0.975;
   expect_even_mail("UV sphere 32 x 16",
-                   quilt_artist_base(blender("uv_sphere_32x16.obj"), mail, 0.08), {});
-  expect_even_mail("cube (2 x 1 x 0.5)", quilt_artist_base(blender("cube.obj"), mail, 0.08), {});
+                   quilt_artist_base(blender("uv_sphere_32x16.obj"), mail, 0.08), sphere);
+  expect_even_mail("cube (2 x 1 x 0.5)", quilt_artist_base(blender("cube.obj"), mail, 0.08),
+                   sphere);
   // Missed by a little (README): the ico sphere's 99th percentile (1.31, its 12 sharp
   // vertices), the cylinder's (1.36: its caps are fans of 32 thin triangles with a sharp rim),
   // the torus's median aspect (1.10, with no cone left), the ico sphere's density (110.04%:
   // 106.2% when the small rings round its four cones were even copies that collided and were
   // removed, 96.8% of rings linked against 99.9% now).
   Keep ico;
+  ico.share = 0.975;
   ico.size_p99 = 1.35;
   ico.density_hi = 1.105;
   expect_even_mail("ico sphere", quilt_artist_base(blender("ico_sphere.obj"), mail, 0.08), ico);
   Keep cylinder;
+  cylinder.share = 0.975;
   cylinder.size_p99 = 1.4;
   expect_even_mail("cylinder", quilt_artist_base(blender("cylinder.obj"), mail, 0.08), cylinder);
   Keep torus;
