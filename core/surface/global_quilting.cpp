@@ -778,6 +778,14 @@ std::vector<LatticeCopy> thread_piece_copies(const GlobalParameterization& gp,
   return copies;
 }
 
+// #singular vertices by 3: where the layout's cones are on the base.
+MatrixX3d cone_positions(const GlobalParameterization& gp, const TriMesh& base) {
+  MatrixX3d cones(gp.num_singular, 3);
+  for (Eigen::Index v = 0, i = 0; v < base.V.rows(); ++v)
+    if (gp.singular[static_cast<size_t>(v)]) cones.row(i++) = base.V.row(v);
+  return cones;
+}
+
 // Why a lattice copy of a thread piece is left out, if it is (place_threads).
 enum ThreadPieceOutcome : char { kPiecePlaced, kPieceOff, kPieceDistorted, kPieceNearCone };
 
@@ -796,11 +804,10 @@ class ThreadPiecePlacer {
         shell_height_(shell_height),
         N_(N),
         differential_(layout_differential(gp, job.base)),
+        cones_(cone_positions(gp, job.base)),
         limits_(options) {
     basis_.col(0) = sym.a;
     basis_.col(1) = sym.b;
-    for (int v = 0; v < job.base.num_vertices(); ++v)
-      if (gp.singular[static_cast<size_t>(v)]) cones_.push_back(job.base.V.row(v).transpose());
     limits_.max_element_scale = limits_.max_element_aspect = limits_.max_element_variation =
         kThreadShapeLimit;
     limits_.small_element_scale = 0;  // a thread piece bends with its neighbours or is left out
@@ -831,8 +838,8 @@ class ThreadPiecePlacer {
                      .transpose();
     // One thread spacing: the distance between a thread and its next copy alongside.
     const double clearance = std::abs(basis_.determinant()) / piece.period.norm();
-    for (const Vector3d& cone : cones_)
-      if (((X.rowwise() - cone.transpose()).rowwise().norm().array() < clearance).any())
+    for (Eigen::Index c = 0; c < cones_.rows(); ++c)
+      if (((X.rowwise() - cones_.row(c)).rowwise().norm().array() < clearance).any())
         return kPieceNearCone;
     return kPiecePlaced;
   }
@@ -846,7 +853,7 @@ class ThreadPiecePlacer {
   const MatrixX3d& N_;
   const Eigen::MatrixXd differential_;
   Eigen::Matrix2d basis_;
-  std::vector<Vector3d> cones_;
+  const MatrixX3d cones_;  // cone_positions
   SurfaceQuiltingOptions::Global limits_;
 };
 
@@ -1228,10 +1235,7 @@ SurfaceQuilt quilt_prepared_global(SurfaceJob& job, const PreparedSwatch& swatch
   const GlobalParameterization gp =
       global_layout(job, symmetry, options.global, anchor, gstats, times, progress);
   gstats.singular_vertices = gp.num_singular;
-  gstats.cones.resize(gp.num_singular, 3);
-  for (Eigen::Index v = 0, i = 0; v < job.base.V.rows(); ++v)
-    if (gp.singular[static_cast<size_t>(v)] && i < gstats.cones.rows())
-      gstats.cones.row(i++) = job.base.V.row(v);
+  gstats.cones = cone_positions(gp, job.base);
   gstats.cut_edges = gp.num_cut_edges;
   const Vector2d lo = plane_origin(gp, symmetry, anchor, gstats);
   const Vector2d hi = gp.wedge_uv.colwise().maxCoeff().transpose();
