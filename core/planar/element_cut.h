@@ -31,7 +31,9 @@ struct ElementCut {
 // Faces sharing a non-manifold edge are all linked pairwise.
 //   V              #V by 3 vertex positions (one element)
 //   F              #F by 3 vertex indices
-//   dist_to_other  #V: Dist(v_i, C_other), distance from each vertex to the other element (>= 0)
+//   dist_to_other  #V: Dist(v_i, C_other), distance from each vertex to the other element (>= 0);
+//                  only read at the vertices of faces not labelled Keep (edges between two Keep
+//                  faces are never cut)
 //   hard           #F per-face labels
 // A Keep face adjacent to a Remove face is allowed: their shared dual edge is then cut.
 // Returns all-false / all-true masks when no face is Keep / Remove (in labelled components).

@@ -55,8 +55,10 @@ std::vector<int> dual_depth(const MatrixX3i& TT, const std::vector<int>& seeds) 
 // the half of a ring lying over the new patch). The paper marks the faces around vertices whose
 // partner face lies at the rim of the matched area; on closed tubes that rim can fall between
 // two vertex rings and be missed, while the far end of the covered band is always defined.
-std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery& query_in,
-                                    const OverlapRegion& region, double cover) {
+//   TT  out's face adjacency (face_adjacency)
+std::vector<CutLabel> output_labels(const Element& out, const MatrixX3i& TT,
+                                    const ClosestPointQuery& query_in, const OverlapRegion& region,
+                                    double cover) {
   const int nf = static_cast<int>(out.F.rows());
   std::vector<CutLabel> hard(nf, CutLabel::Free);
   std::vector<int> source;
@@ -75,7 +77,6 @@ std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery&
       covered[f] = query_in.closest(centroid(out, f), cover).face >= 0;
     }
   }
-  const MatrixX3i TT = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
   const std::vector<int> depth = dual_depth(TT, source);
   int deepest = -1;
   for (int f = 0; f < nf; ++f)
@@ -92,12 +93,12 @@ std::vector<CutLabel> output_labels(const Element& out, const ClosestPointQuery&
 // on a kept output face is removed (the output already has it), one lying on a removed output
 // face is kept (it replaces it) except within two rings of the output's seam, where the min-cut
 // closes the loop; faces outside the overlapping region are always kept.
-std::vector<CutLabel> swatch_labels(const Element& in, const Element& out,
+//   TT_out  out's face adjacency (face_adjacency)
+std::vector<CutLabel> swatch_labels(const Element& in, const MatrixX3i& TT_out,
                                     const std::vector<bool>& keep_out,
                                     const ClosestPointQuery& query_out, const OverlapRegion& region,
                                     double cover) {
   const int nf = static_cast<int>(in.F.rows());
-  const MatrixX3i TT_out = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
   // Output faces within two rings of the output's cut are "near the seam".
   std::vector<int> seam;
   for (int f = 0; f < TT_out.rows(); ++f)
@@ -126,6 +127,25 @@ std::vector<CutLabel> swatch_labels(const Element& in, const Element& out,
     // there, so the two kept parts meet with a small gap and never overlap.
   }
   return hard;
+}
+
+// Dist(v, C_other) of Eq. (7) at the vertices of e's faces not labelled Keep, 0 elsewhere: the
+// cut reads no other (element_graph_cut), and most of an output thread is Keep.
+Eigen::VectorXd distances_off_keep(const Element& e, const std::vector<CutLabel>& labels,
+                                   const ClosestPointQuery& other) {
+  std::vector<char> needed(e.V.rows(), 0);
+  for (int f = 0; f < e.F.rows(); ++f)
+    if (labels[f] != CutLabel::Keep)
+      for (int k = 0; k < 3; ++k) needed[e.F(f, k)] = 1;
+  std::vector<int> vertices;
+  for (int v = 0; v < e.V.rows(); ++v)
+    if (needed[v]) vertices.push_back(v);
+  MatrixX3d points(vertices.size(), 3);
+  for (size_t i = 0; i < vertices.size(); ++i) points.row(i) = e.V.row(vertices[i]);
+  const std::vector<ClosestPointHit> hits = other.closest(points);
+  Eigen::VectorXd dist = Eigen::VectorXd::Zero(e.V.rows());
+  for (size_t i = 0; i < vertices.size(); ++i) dist(vertices[i]) = hits[i].distance;
+  return dist;
 }
 
 // The faces of e that `keep` marks; `vertices`: e's vertex each of the part's is.
@@ -207,9 +227,10 @@ StitchFailure seam_failure(const TriMesh& stitched, const Element& out, const El
 
 // Why the deformed merged element is refused (None when it is kept): it must stay within the
 // space of its two parents (a wrongly paired seam drags vertices far away) and must not pass
-// through itself.
+// through itself. Pairs of the output element's faces that the stitch left where they were
+// (`kept_out`, #F flags) are not tested against each other: the output held them so already.
 StitchFailure merged_failure(const Element& result, const Element& out, const Element& in,
-                             double mean_edge_length) {
+                             const std::vector<char>& kept_out, double mean_edge_length) {
   const double slack = 2.0 * mean_edge_length;
   const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
   const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
@@ -217,9 +238,9 @@ StitchFailure merged_failure(const Element& result, const Element& out, const El
       result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
       result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
     return StitchFailure::Distorted;
-  IntersectionOptions all_pairs;
-  all_pairs.between_components_only = false;
-  if (!intersecting_face_pairs(result.V, result.F, all_pairs).empty())
+  std::vector<char> changed(kept_out.size());
+  for (size_t f = 0; f < kept_out.size(); ++f) changed[f] = !kept_out[f];
+  if (!intersecting_face_pairs_touching(result.V, result.F, changed).empty())
     return StitchFailure::SelfIntersecting;
   return StitchFailure::None;
 }
@@ -238,21 +259,17 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   const double cover = options.cover_distance * mean_edge_length;
   const EmbreeDevice shared = device ? *device : EmbreeDevice();
   const ClosestPointQuery query_out(shared, out.V, out.F), query_in(shared, in.V, in.F);
-  Eigen::VectorXd dist_out(out.V.rows()), dist_in(in.V.rows());
-  {
-    const std::vector<ClosestPointHit> to_in = query_in.closest(out.V);
-    for (int v = 0; v < out.V.rows(); ++v) dist_out(v) = to_in[v].distance;
-    const std::vector<ClosestPointHit> to_out = query_out.closest(in.V);
-    for (int v = 0; v < in.V.rows(); ++v) dist_in(v) = to_out[v].distance;
-  }
   // Eq. (7) weights are in absolute units; scale distances by the edge length so the cut
   // behaves the same whatever the swatch's units.
   const double unit = mean_edge_length > 0 ? mean_edge_length : 1.0;
-  const MatrixX3d out_V = out.V / unit, in_V = in.V / unit;
+  const MatrixX3i TT_out = face_adjacency(edge_topology(out.F, static_cast<int>(out.V.rows())));
+  const std::vector<CutLabel> labels_out = output_labels(out, TT_out, query_in, region, cover);
   const std::vector<bool> keep_out = graph_cut_keep_faces(
-      out_V, out.F, dist_out / unit, output_labels(out, query_in, region, cover));
+      out.V / unit, out.F, distances_off_keep(out, labels_out, query_in) / unit, labels_out);
+  const std::vector<CutLabel> labels_in =
+      swatch_labels(in, TT_out, keep_out, query_out, region, cover);
   const std::vector<bool> keep_in = graph_cut_keep_faces(
-      in_V, in.F, dist_in / unit, swatch_labels(in, out, keep_out, query_out, region, cover));
+      in.V / unit, in.F, distances_off_keep(in, labels_in, query_out) / unit, labels_in);
   std::vector<int> from_out, from_in;
   const TriMesh a = kept_part(out, keep_out, from_out), b = kept_part(in, keep_in, from_in);
   if (a.F.rows() == 0 || b.F.rows() == 0) return fail(StitchFailure::EmptyCut);
@@ -274,12 +291,19 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;
-  std::vector<LinearConstraint> constraints = stitched->constraints;
-  const std::vector<LinearConstraint> anchors = anchor_far_vertices(
-      stitched->mesh.V, stitched->mesh.F, constraints, options.deformation_rings);
-  constraints.insert(constraints.end(), anchors.begin(), anchors.end());
-  result.V = deform_element(stitched->mesh.V, stitched->mesh.F, constraints, deformation);
+  LocalDeformation deformed =
+      deform_locally(stitched->mesh.V, stitched->mesh.F, stitched->constraints,
+                     options.deformation_rings, options.solve_margin, deformation);
+  result.V = std::move(deformed.V);
   result.F = stitched->mesh.F;
+  // The output element's faces the deformation did not reach are as the output held them.
+  std::vector<char> kept_out(result.F.rows(), 0);
+  for (int f = 0; f < result.F.rows(); ++f) {
+    bool from_out = !deformed.moved_faces[f];
+    for (int k = 0; k < 3; ++k)
+      from_out = from_out && stitched->origin[result.F(f, k)] < a.num_vertices();
+    kept_out[f] = from_out;
+  }
   result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
   // The stitched vertices are the kept parts' (section 2.7 adds none), some of B's welded.
   std::vector<int> parts_vertex = from_out;
@@ -289,7 +313,7 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
     (v < a.num_vertices() ? from_out_kept : from_in_kept).push_back(parts_vertex[v]);
   carry_sources({{&out, &from_out_kept}, {&in, &from_in_kept}}, result);
   result.update();
-  if (const StitchFailure why = merged_failure(result, out, in, mean_edge_length);
+  if (const StitchFailure why = merged_failure(result, out, in, kept_out, mean_edge_length);
       why != StitchFailure::None)
     return fail(why);
   return result;

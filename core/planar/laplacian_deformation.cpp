@@ -312,6 +312,13 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
       tbb::blocked_range<size_t>(0, jobs.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t j = range.begin(); j != range.end(); ++j) {
           try {
+            if (jobs[j].local_rings >= 0) {
+              results[j] =
+                  deform_locally(*jobs[j].V, *jobs[j].F, jobs[j].constraints, jobs[j].local_rings,
+                                 jobs[j].local_margin, options, topologies)
+                      .V;
+              continue;
+            }
             std::shared_ptr<const LaplacianTopology> known =
                 topologies ? topologies->find(*jobs[j].F, static_cast<int>(jobs[j].V->rows()))
                            : nullptr;
@@ -334,10 +341,11 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
 
 namespace mq {
 
-std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const MatrixX3i& F,
-                                                  const std::vector<LinearConstraint>& constraints,
-                                                  int rings) {
-  const int nv = static_cast<int>(V.rows());
+namespace {
+
+// Hops (1-ring edges) from the vertices the constraints involve; -1 where none reaches.
+std::vector<int> constraint_depth(const MatrixX3i& F, int nv,
+                                  const std::vector<LinearConstraint>& constraints) {
   const Adjacency adj = vertex_adjacency(F, nv);
   std::vector<int> depth(nv, -1), queue;
   for (const LinearConstraint& c : constraints)
@@ -356,10 +364,89 @@ std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const Matr
         queue.push_back(*w);
       }
   }
+  return depth;
+}
+
+}  // namespace
+
+std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const MatrixX3i& F,
+                                                  const std::vector<LinearConstraint>& constraints,
+                                                  int rings) {
+  const std::vector<int> depth = constraint_depth(F, static_cast<int>(V.rows()), constraints);
   std::vector<LinearConstraint> anchors;
-  for (int v = 0; v < nv; ++v)
+  for (int v = 0; v < V.rows(); ++v)
     if (depth[v] > rings) anchors.push_back(LinearConstraint::point(v, V.row(v).transpose()));
   return anchors;
+}
+
+LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
+                                const std::vector<LinearConstraint>& constraints, int rings,
+                                int margin, const DeformationOptions& options,
+                                const LaplacianTopologyCache* topologies) {
+  MQ_CHECK(rings >= 0 && margin >= 0, InvalidInput, "local deformation: rings (", rings,
+           ") and margin (", margin, ") must be >= 0");
+  const int nv = static_cast<int>(V.rows());
+  const std::vector<int> depth = constraint_depth(F, nv, constraints);
+  const int reach = rings + margin;
+  // Wholly within reach (a compact element): the whole solve, as anchor_far_vertices and
+  // deform_element give it, with a cached topology when there is one.
+  if (std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; })) {
+    std::vector<LinearConstraint> all = constraints;
+    for (int v = 0; v < nv; ++v)
+      if (depth[v] > rings) all.push_back(LinearConstraint::point(v, V.row(v).transpose()));
+    std::shared_ptr<const LaplacianTopology> known = topologies ? topologies->find(F, nv) : nullptr;
+    LocalDeformation whole{known ? LaplacianDeformer(std::move(known), V, options).solve(all)
+                                 : deform_element(V, F, all, options),
+                           std::vector<char>(F.rows(), 1)};
+    return whole;
+  }
+  // The faces within reach, and their vertices renumbered.
+  std::vector<int> local(nv, -1), global;
+  std::vector<int> faces;
+  for (int f = 0; f < F.rows(); ++f) {
+    bool near = true;
+    for (int k = 0; k < 3; ++k) near = near && depth[F(f, k)] >= 0 && depth[F(f, k)] <= reach;
+    if (!near) continue;
+    faces.push_back(f);
+    for (int k = 0; k < 3; ++k)
+      if (local[F(f, k)] < 0) {
+        local[F(f, k)] = static_cast<int>(global.size());
+        global.push_back(F(f, k));
+      }
+  }
+  std::vector<LinearConstraint> cs;
+  cs.reserve(constraints.size() + global.size());
+  for (LinearConstraint c : constraints) {
+    for (int k = 0; k < 3; ++k) {
+      if (c.vertices[k] < 0) continue;
+      MQ_CHECK(c.vertices[k] < nv, InvalidInput, "local deformation: constraint vertex ",
+               c.vertices[k], " out of range [0, ", nv, ")");
+      c.vertices[k] = local[c.vertices[k]];
+      // A constrained vertex in no face within reach (an isolated vertex): solve it all.
+      if (c.vertices[k] < 0) {
+        std::vector<LinearConstraint> all = constraints;
+        const std::vector<LinearConstraint> anchors = anchor_far_vertices(V, F, constraints, rings);
+        all.insert(all.end(), anchors.begin(), anchors.end());
+        return {deform_element(V, F, all, options), std::vector<char>(F.rows(), 1)};
+      }
+    }
+    cs.push_back(c);
+  }
+  MatrixX3d localV(global.size(), 3);
+  for (size_t i = 0; i < global.size(); ++i) {
+    localV.row(i) = V.row(global[i]);
+    if (depth[global[i]] > rings)
+      cs.push_back(LinearConstraint::point(static_cast<int>(i), V.row(global[i]).transpose()));
+  }
+  MatrixX3i localF(faces.size(), 3);
+  for (size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) localF(i, k) = local[F(faces[i], k)];
+  const MatrixX3d solved = deform_element(localV, localF, cs, options);
+  LocalDeformation result{V, std::vector<char>(F.rows(), 0)};
+  for (size_t i = 0; i < global.size(); ++i) result.V.row(global[i]) = solved.row(i);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) result.moved_faces[f] |= local[F(f, k)] >= 0;
+  return result;
 }
 
 }  // namespace mq

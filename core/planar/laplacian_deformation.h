@@ -127,11 +127,16 @@ struct DeformationJob {
   const MatrixX3d* V = nullptr;
   const MatrixX3i* F = nullptr;
   std::vector<LinearConstraint> constraints;
+  // >= 0: solved by deform_locally with these rings and margin (the constraints without
+  // anchors), for an element too long to solve whole; -1: by deform_element.
+  int local_rings = -1;
+  int local_margin = 0;
 };
 
 // Deforms independent elements in parallel with oneTBB (the per-element loop of section 2.6).
-// Result j is exactly deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options),
-// whatever the thread count; jobs whose faces are in `topologies` (optional) reuse them.
+// Result j is exactly deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options)
+// (deform_locally's V for a local job), whatever the thread count; jobs whose faces are in
+// `topologies` (optional) reuse them.
 // Throws InvalidInput for a null V or F, and otherwise the exception of the lowest-index
 // failing job.
 std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
@@ -150,5 +155,25 @@ namespace mq {
 std::vector<LinearConstraint> anchor_far_vertices(const MatrixX3d& V, const MatrixX3i& F,
                                                   const std::vector<LinearConstraint>& constraints,
                                                   int rings);
+
+// A deformation kept local and solved where it acts.
+struct LocalDeformation {
+  MatrixX3d V;                    // #V by 3 new positions
+  std::vector<char> moved_faces;  // #F flags: a vertex of the face was solved for
+};
+
+// Eq. (5) with anchor_far_vertices' anchors (`rings`), solved only over the faces whose vertices
+// all lie within rings + margin hops of the constrained vertices: the vertices farther out keep
+// their positions exactly, where the whole solve would move them by a fraction of the
+// deformation that decays ring by ring past the anchors. The cost is then that of the
+// neighbourhood of the constraints, not of the element (a long thread stitched at one end).
+//   V  #V by 3, F  #F by 3; constraints as for LaplacianDeformer::solve, on V's indices
+// Throws InvalidInput for rings or margin < 0 and as LaplacianDeformer::solve.
+// An element wholly within reach is solved whole, exactly as deform_element with those anchors
+// (reusing its topology from `topologies`, optional, when held there).
+LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
+                                const std::vector<LinearConstraint>& constraints, int rings,
+                                int margin, const DeformationOptions& options = {},
+                                const LaplacianTopologyCache* topologies = nullptr);
 
 }  // namespace mq

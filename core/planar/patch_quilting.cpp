@@ -1,7 +1,10 @@
 #include "core/planar/patch_quilting.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <optional>
 
@@ -146,8 +149,10 @@ void deform_related(Patch& patch, const PreparedSwatch& swatch, const SwatchQuer
   };
   std::vector<DeformationJob> jobs;
   std::vector<std::pair<bool, int>> owners;  // (is output, index)
+  // Output elements (a thread grown over many patches) are solved near their constraints only.
   for (auto& [k, cs] : out_constraints) {
-    jobs.push_back({&patch.frame[k].V, &patch.frame[k].F, anchored(patch.frame[k], std::move(cs))});
+    jobs.push_back({&patch.frame[k].V, &patch.frame[k].F, std::move(cs),
+                    options.merging.deformation_rings, options.merging.solve_margin});
     owners.emplace_back(true, k);
   }
   for (auto& [i, cs] : in_constraints) {
@@ -187,7 +192,38 @@ class PatchMerger {
         options_(options),
         mean_edge_(mean_edge),
         counts_(counts),
-        busy_(patch.frame.size(), 0) {}
+        busy_(patch.frame.size(), 0),
+        outcomes_(patch.moved.size()) {}
+
+  // What stitch() decides from the two elements alone (coincidence, the cut-and-stitch) depends
+  // on nothing merge() changes, so it is worked out beforehand for every admissible swatch
+  // element with one partner crossing the overlap, in parallel; merge() then commits the
+  // outcomes in order, as before. A pair merge() reaches otherwise (a partner removed on the
+  // way) is worked out when reached.
+  void prepare(const std::function<bool(const Element&)>& admissible) {
+    std::vector<int> candidates;
+    for (size_t i = 0; i < patch_.moved.size(); ++i) {
+      int crossing = -1, count = 0;
+      for (const int k : patch_.partners[i])
+        if (!patch_.frame_inside[k]) {
+          crossing = k;
+          ++count;
+        }
+      if (count == 1 && !inside(patch_.moved[i], region_) && admissible(patch_.moved[i]))
+        candidates.push_back(static_cast<int>(i));
+      outcomes_[i].k = count == 1 ? crossing : -1;
+    }
+    tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t c) {
+      const int i = candidates[c];
+      StitchOutcome& o = outcomes_[i];
+      try {
+        o = outcome(patch_.moved[i], o.k);
+      } catch (...) {
+        o.error = std::current_exception();
+      }
+      o.ready = true;
+    });
+  }
 
   // Merges swatch element i; false when it could not enter as it would intersect the output.
   bool merge(size_t i) {
@@ -211,11 +247,38 @@ class PatchMerger {
       ++counts_.dropped;
       return true;
     }
-    stitch(in, crossing[0], replaced_ids);
+    stitch(i, crossing[0], replaced_ids);
     return true;
   }
 
  private:
+  struct StitchOutcome {
+    int k = -1;  // the crossing partner (local index) it is for
+    bool ready = false;
+    bool same = false;  // the same element placed twice: the output's is kept
+    std::optional<Element> joined;
+    StitchFailure why = StitchFailure::None;
+    std::exception_ptr error;
+  };
+
+  // stitch()'s decision for swatch element `in` and its crossing partner k.
+  StitchOutcome outcome(const Element& in, int k) const {
+    StitchOutcome o;
+    o.k = k;
+    o.ready = true;
+    // Output elements take their deformed shape once they are merged with a partner.
+    const auto it = patch_.deformed_out.find(k);
+    const Element& base = it == patch_.deformed_out.end() ? patch_.frame[k] : it->second;
+    // The same element placed twice (nearly identical, or mostly the same footprint, as for two
+    // apples slightly apart): keep the output one rather than stitching two halves.
+    o.same = elements_coincide(base, in, options_.coincidence_tolerance * mean_edge_,
+                               &queries_.embree) ||
+             footprint_overlap(base, in, mean_edge_) >= options_.same_element_overlap;
+    if (!o.same)
+      o.joined = cut_and_stitch(base, in, region_, mean_edge_, options_, &o.why, &queries_.embree);
+    return o;
+  }
+
   // Adds `in` in place of the output elements `ids` (none: a plain addition) if it fits.
   bool replace(const Element& in, const std::vector<int>& ids) {
     if (!fits(output_, in, ids)) {
@@ -230,24 +293,19 @@ class PatchMerger {
       counts_.replaced += static_cast<int>(ids.size());
     return true;
   }
-  // Joins `in` with its crossing partner k (local index), whose place it takes with the
-  // partners in `replaced_ids`; or keeps the output's element.
-  void stitch(const Element& in, int k, const std::vector<int>& replaced_ids) {
-    // Output elements take their deformed shape once they are merged with a partner.
-    const auto it = patch_.deformed_out.find(k);
-    const Element& base = it == patch_.deformed_out.end() ? patch_.frame[k] : it->second;
-    // The same element placed twice (nearly identical, or mostly the same footprint, as for two
-    // apples slightly apart): keep the output one rather than stitching two halves.
-    if (elements_coincide(base, in, options_.coincidence_tolerance * mean_edge_,
-                          &queries_.embree) ||
-        footprint_overlap(base, in, mean_edge_) >= options_.same_element_overlap) {
+  // Joins swatch element i with its crossing partner k (local index), whose place it takes
+  // with the partners in `replaced_ids`; or keeps the output's element.
+  void stitch(size_t i, int k, const std::vector<int>& replaced_ids) {
+    StitchOutcome o = outcomes_[i].ready && outcomes_[i].k == k ? std::move(outcomes_[i])
+                                                                : outcome(patch_.moved[i], k);
+    if (o.error) std::rethrow_exception(o.error);
+    if (o.same) {
       ++counts_.matched;
       busy_[k] = 1;
       return;
     }
-    StitchFailure why = StitchFailure::None;
-    std::optional<Element> joined =
-        cut_and_stitch(base, in, region_, mean_edge_, options_, &why, &queries_.embree);
+    std::optional<Element>& joined = o.joined;
+    const StitchFailure why = o.why;
     std::vector<int> ignore = replaced_ids;
     ignore.push_back(patch_.near[k]);
     if (joined && fits(output_, *joined, ignore)) {
@@ -268,7 +326,8 @@ class PatchMerger {
   const MergeOptions& options_;
   const double mean_edge_;
   PatchCounts& counts_;
-  std::vector<char> busy_;  // per local index: already merged with a swatch element
+  std::vector<char> busy_;               // per local index: already merged with a swatch element
+  std::vector<StitchOutcome> outcomes_;  // per swatch element
 };
 
 }  // namespace
@@ -319,6 +378,7 @@ void quilt_patch(PatchOutput& output, const PreparedSwatch& swatch, const Swatch
   ScopedStageTimer timer(times, Stage::Merging);
   PatchMerger merger(output, patch, region, queries, options.merging, swatch.mean_edge_length,
                      counts);
+  merger.prepare(admissible);
   for (size_t i = 0; i < patch.moved.size(); ++i) {
     const bool entered = admissible(patch.moved[i]) && merger.merge(i);
     if (!entered && rejected) rejected->push_back(static_cast<int>(i));

@@ -57,6 +57,40 @@ TEST(ElementCut, CutFollowsTheCheapestRingOfEq7) {
   }
 }
 
+// The network leaves out the edges between two Keep faces: the distances at vertices that only
+// Keep faces use are not read, and Free faces bounded by Keep faces are still reached (kept).
+TEST(ElementCut, KeepFacesAwayFromTheCutChangeNothing) {
+  TubeCase c;
+  Eigen::VectorXd d(c.mesh.num_vertices());
+  for (int v = 0; v < c.mesh.num_vertices(); ++v) d(v) = 0.5 * std::abs(c.mesh.V(v, 0) - 1.7);
+  const ElementCut cut = element_graph_cut(c.mesh.V, c.mesh.F, d, c.hard);
+  std::vector<char> off_keep(c.mesh.num_vertices(), 0);
+  for (int f = 0; f < c.mesh.num_faces(); ++f)
+    if (c.hard[f] != CutLabel::Keep)
+      for (int k = 0; k < 3; ++k) off_keep[c.mesh.F(f, k)] = 1;
+  Eigen::VectorXd far = d;
+  int changed = 0;
+  for (int v = 0; v < c.mesh.num_vertices(); ++v)
+    if (!off_keep[v]) {
+      far(v) = 1e3 + v;
+      ++changed;
+    }
+  ASSERT_GT(changed, 100);
+  const ElementCut same = element_graph_cut(c.mesh.V, c.mesh.F, far, c.hard);
+  EXPECT_EQ(same.keep, cut.keep);
+  EXPECT_EQ(same.flow, cut.flow);
+  // Keep also over 1.3 < x < 1.5: the Free band 1 < x < 1.3 lies between Keep faces only.
+  std::vector<CutLabel> banded = c.hard;
+  for (int f = 0; f < c.mesh.num_faces(); ++f) {
+    const double x = test::face_centroid(c.mesh, f).x();
+    if (x > 1.3 && x < 1.5) banded[f] = CutLabel::Keep;
+  }
+  const ElementCut b = element_graph_cut(c.mesh.V, c.mesh.F, d, banded);
+  for (int f = 0; f < c.mesh.num_faces(); ++f)
+    EXPECT_EQ(b.keep[f], test::face_centroid(c.mesh, f).x() < 1.7) << f;
+  EXPECT_NEAR(b.flow, cut.flow, 1e-12 * cut.flow);
+}
+
 TEST(ElementCut, CutStaysInsideTheLowDistanceBand) {
   TubeCase c;
   // Flat low band over [1.35, 1.65]: every cut edge must lie in it.

@@ -11,6 +11,7 @@
 #include "core/mesh/mesh_io.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/planar/laplacian_deformation.h"
+#include "tests/core/planar/cut_fixtures.h"
 #include "tests/test_support.h"
 
 namespace mq {
@@ -282,6 +283,44 @@ TEST(LaplacianDeformation, LocalPullOnRealElements) {
   ASSERT_EQ(rings.size(), 1u);
   EXPECT_TRUE(topology_report(rings[0]).closed());
   check_local_pull(rings[0], 17);
+}
+
+// A long thread pulled at one end: the local solve agrees with the whole one within 1e-5 of an
+// edge (the whole solve's motion decays about 14x every two rings past the anchors), leaves
+// every vertex beyond rings + margin exactly in place and solves a fraction of the faces.
+TEST(LaplacianDeformation, LocalSolveMatchesTheWholeSolve) {
+  const TriMesh thread = test::tube(0.0, 20.0, 200, 12, 0.3, 0.0, true);
+  const double edge = 0.1;
+  std::vector<LinearConstraint> pull;
+  for (int v = 0; v < thread.num_vertices(); ++v)
+    if (std::abs(thread.V(v, 0) - 1.0) < 1e-9)
+      pull.push_back(
+          LinearConstraint::point(v, thread.V.row(v).transpose() + Vector3d(0.05, 0.2, 0.0)));
+  ASSERT_EQ(pull.size(), 12u);
+  std::vector<LinearConstraint> anchored = pull;
+  const std::vector<LinearConstraint> anchors = anchor_far_vertices(thread.V, thread.F, pull, 8);
+  anchored.insert(anchored.end(), anchors.begin(), anchors.end());
+  const MatrixX3d whole = deform_element(thread.V, thread.F, anchored);
+  const LocalDeformation local = deform_locally(thread.V, thread.F, pull, 8, 8);
+  double largest = 0, motion = 0;
+  for (int v = 0; v < thread.num_vertices(); ++v) {
+    largest = std::max(largest, (whole.row(v) - local.V.row(v)).norm());
+    motion = std::max(motion, (local.V.row(v) - thread.V.row(v)).norm());
+    // The pull is at x = 1; 16 rings (1.6) on, nothing moves.
+    if (thread.V(v, 0) > 2.65) {
+      EXPECT_EQ(local.V.row(v), thread.V.row(v)) << v;
+    }
+  }
+  EXPECT_GT(motion, 0.1);
+  EXPECT_LT(largest, 1e-5 * edge);
+  int moved = 0;
+  for (const char m : local.moved_faces) moved += m;
+  EXPECT_GT(moved, 0);
+  EXPECT_LT(moved, thread.num_faces() / 5);
+  // A margin of 0 differs more, but stays a local pull.
+  const LocalDeformation tight = deform_locally(thread.V, thread.F, pull, 8, 0);
+  EXPECT_GT((tight.V - whole).cwiseAbs().maxCoeff(), largest);
+  EXPECT_THROW(deform_locally(thread.V, thread.F, pull, -1, 8), InvalidInput);
 }
 
 TEST(LaplacianDeformation, BarycentricUnitWeightEqualsPointForm) {
