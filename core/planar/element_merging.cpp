@@ -238,9 +238,32 @@ StitchFailure merged_failure(const Element& result, const Element& out, const El
       result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
       result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
     return StitchFailure::Distorted;
-  std::vector<char> changed(kept_out.size());
-  for (size_t f = 0; f < kept_out.size(); ++f) changed[f] = !kept_out[f];
-  if (!intersecting_face_pairs_touching(result.V, result.F, changed).empty())
+  // A face meeting a changed one has its box within the changed faces' box: only those take
+  // part (shared vertices stay shared in the extracted mesh, so neighbours are not reported).
+  const auto face_box = [&](int f) {
+    BoundingBox box;
+    for (int k = 0; k < 3; ++k) box.extend(result.V.row(result.F(f, k)).transpose());
+    return box;
+  };
+  BoundingBox changed_box;
+  for (int f = 0; f < result.F.rows(); ++f)
+    if (!kept_out[f]) {
+      const BoundingBox b = face_box(f);
+      changed_box.extend(b.min);
+      changed_box.extend(b.max);
+    }
+  std::vector<int> faces;
+  std::vector<char> changed;
+  for (int f = 0; f < result.F.rows(); ++f) {
+    const BoundingBox b = face_box(f);
+    if (!kept_out[f] || ((b.min.array() <= changed_box.max.array()).all() &&
+                         (changed_box.min.array() <= b.max.array()).all())) {
+      faces.push_back(f);
+      changed.push_back(!kept_out[f]);
+    }
+  }
+  const TriMesh near = extract_faces(result.mesh(), faces);
+  if (!intersecting_face_pairs_touching(near.V, near.F, changed).empty())
     return StitchFailure::SelfIntersecting;
   return StitchFailure::None;
 }
