@@ -388,13 +388,14 @@ LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
   const int nv = static_cast<int>(V.rows());
   const std::vector<int> depth = constraint_depth(F, nv, constraints);
   const int reach = rings + margin;
-  // Wholly within reach (a compact element): the whole solve, as anchor_far_vertices and
-  // deform_element give it, with a cached topology when there is one.
-  if (std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; })) {
+  // Wholly within reach (a compact element), or with a cached topology (a swatch element as
+  // placed, whose cached solve costs less than a local one analysed afresh): the whole solve,
+  // as anchor_far_vertices and deform_element give it.
+  std::shared_ptr<const LaplacianTopology> known = topologies ? topologies->find(F, nv) : nullptr;
+  if (known || std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; })) {
     std::vector<LinearConstraint> all = constraints;
     for (int v = 0; v < nv; ++v)
       if (depth[v] > rings) all.push_back(LinearConstraint::point(v, V.row(v).transpose()));
-    std::shared_ptr<const LaplacianTopology> known = topologies ? topologies->find(F, nv) : nullptr;
     LocalDeformation whole{known ? LaplacianDeformer(std::move(known), V, options).solve(all)
                                  : deform_element(V, F, all, options),
                            std::vector<char>(F.rows(), 1)};

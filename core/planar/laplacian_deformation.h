@@ -169,8 +169,8 @@ struct LocalDeformation {
 // neighbourhood of the constraints, not of the element (a long thread stitched at one end).
 //   V  #V by 3, F  #F by 3; constraints as for LaplacianDeformer::solve, on V's indices
 // Throws InvalidInput for rings or margin < 0 and as LaplacianDeformer::solve.
-// An element wholly within reach is solved whole, exactly as deform_element with those anchors
-// (reusing its topology from `topologies`, optional, when held there).
+// An element wholly within reach, or whose topology `topologies` (optional) holds, is solved
+// whole, exactly as deform_element with those anchors (with the held topology).
 LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
                                 const std::vector<LinearConstraint>& constraints, int rings,
                                 int margin, const DeformationOptions& options = {},
