@@ -45,6 +45,7 @@ void write_preparation(JsonWriter& j, const SurfaceQuiltingStats& s) {
   j.value("base_faces", s.base_faces)
       .value("welded_vertices", s.welded_vertices)
       .value("duplicate_faces", s.duplicate_faces)
+      .value("sheet_back_faces", s.sheet_back_faces)
       .value("flipped_components", s.flipped_components)
       .value("fin_faces", s.fin_faces)
       .value("fin_area_share", s.fin_area_share)
@@ -609,6 +610,11 @@ void print_surface_summary(const SurfaceRequest& r, const SurfaceInputs& in,
         "base: %d faces in fins (pieces sticking out at non-manifold edges, %.2g%% of the "
         "area) were left out: the texture covers the surface they stand on\n",
         stats.fin_faces, 100.0 * stats.fin_area_share);
+  if (stats.sheet_back_faces > 0)
+    std::printf(
+        "base: two-sided (each face listed again facing the other way, enclosing nothing): its "
+        "%d backs were left out, the texture grows on the side listed first\n",
+        stats.sheet_back_faces);
   if (stats.non_manifold_edges > 0)
     std::printf(
         "base: %d non-manifold edges (three or more faces meeting) are borders: the "

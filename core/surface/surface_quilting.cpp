@@ -92,6 +92,48 @@ TriMesh without_duplicate_faces(const TriMesh& mesh, std::vector<int>& input_fac
   return out;
 }
 
+// The mesh without the backs of a two-sided sheet: a base whose every face is listed again
+// facing the other way encloses nothing, and a shell grown from both sides of it passes through
+// itself (a square listed with both orientations placed no element, the message blaming the
+// scale). The first listed of each pair stays. A base with faces that have no back keeps all
+// its pairs: the wicker chair's 35 (above) lie in components that are two-sided throughout,
+// and without their backs the patches' parameterisation meets non-manifold borders there.
+// input_face is composed with the change.
+//   mesh  without repeated faces (without_duplicate_faces), so a face has at most one back
+TriMesh without_sheet_backs(const TriMesh& mesh, std::vector<int>& input_face, int* removed) {
+  *removed = 0;
+  const int nf = static_cast<int>(mesh.F.rows());
+  // Key: the face's vertices sorted, then the face: a face and its back are neighbours.
+  std::vector<std::array<int, 4>> sorted(static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f) {
+    std::array<int, 3> v = {mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
+    std::sort(v.begin(), v.end());
+    sorted[static_cast<size_t>(f)] = {v[0], v[1], v[2], f};
+  }
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<int> back(static_cast<size_t>(nf), -1);
+  for (size_t i = 1; i < sorted.size(); ++i)
+    if (std::equal(sorted[i].begin(), sorted[i].begin() + 3, sorted[i - 1].begin())) {
+      back[static_cast<size_t>(sorted[i][3])] = sorted[i - 1][3];
+      back[static_cast<size_t>(sorted[i - 1][3])] = sorted[i][3];
+    }
+  if (nf == 0 || std::count(back.begin(), back.end(), -1) > 0) return mesh;
+  std::vector<int> kept;
+  for (int f = 0; f < nf; ++f)
+    if (back[static_cast<size_t>(f)] > f) kept.push_back(f);
+  *removed = nf - static_cast<int>(kept.size());
+  TriMesh out;
+  out.V = mesh.V;
+  out.F.resize(static_cast<Eigen::Index>(kept.size()), 3);
+  std::vector<int> composed(kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    out.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(kept[i]);
+    composed[i] = input_face[static_cast<size_t>(kept[i])];
+  }
+  input_face = std::move(composed);
+  return out;
+}
+
 // The mesh without its fins (core/mesh/fins.h): a piece sticking out of the surface at
 // non-manifold edges cut the layout there on every side and took elements into it (issue 28,
 // item 7: an ico sphere with a fin on every 7th edge, 88% covered after 13 s and a message
@@ -237,6 +279,7 @@ std::vector<int> clean_base(const TriMesh& base_in, const SurfaceQuiltingOptions
   job.cleaned = weld_vertices(base_in, &stats.welded_vertices, &job.input_vertex);
   std::vector<int> input_face;  // job.cleaned's faces -> base_in's
   job.cleaned = without_duplicate_faces(job.cleaned, input_face, &stats.duplicate_faces);
+  job.cleaned = without_sheet_backs(job.cleaned, input_face, &stats.sheet_back_faces);
   job.cleaned = without_fins(job.cleaned, input_face, job.input_vertex, stats);
   // The shell grows along the normal: components turned inside out would hide the texture
   // inside the object.

@@ -214,6 +214,8 @@ struct SurfaceQuiltingStats {
   int base_faces = 0;          // after refinement
   int welded_vertices = 0;     // base vertices merged with another at the same position
   int duplicate_faces = 0;     // base faces that repeated another, removed
+  int sheet_back_faces = 0;    // backs of a two-sided base (every face listed again facing the
+                               // other way: nothing enclosed), removed
   int flipped_components = 0;  // base components turned to face outward (orient_outward)
   int fin_faces = 0;           // base faces in fins (core/mesh/fins.h), left out
   double fin_area_share = 0;   // their share of the base's area

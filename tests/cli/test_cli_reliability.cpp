@@ -143,6 +143,41 @@ TEST_F(Reliability, NoGeometryIsAnErrorNotAnEmptyFile) {
     fs::remove(dir_ + "/o.ply");
     fs::remove(dir_ + "/s.json");
   }
+  // Every face listed again facing the other way (a two-sided sheet, enclosing nothing): the
+  // backs go, counted and said, and the result is the grid's. It placed no element before,
+  // blaming the scale.
+  std::string backs;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int a = 3 * j + i, b = a + 1, c = a + 4, d = a + 3;
+      backs += "3 " + std::to_string(a) + " " + std::to_string(c) + " " + std::to_string(b) + "\n";
+      backs += "3 " + std::to_string(a) + " " + std::to_string(d) + " " + std::to_string(c) + "\n";
+    }
+  spit(dir_ + "/backs.off", grid_off(backs, 8));
+  {
+    const CliRun r =
+        meshquilt(dir_, "surface --base backs.off --swatch sw.obj -o o.ply --stats s.json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("base: two-sided (each face listed again facing the other way"),
+              std::string::npos)
+        << r.out;
+    EXPECT_TRUE(slurp(dir_ + "/o.ply") == slurp(dir_ + "/ref.ply"));
+    EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "sheet_back_faces"), "8");
+    EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "duplicate_faces"), "0");
+    fs::remove(dir_ + "/o.ply");
+    fs::remove(dir_ + "/s.json");
+  }
+  // One face with its back inside a one-sided grid (the wicker chair has 35) stays.
+  spit(dir_ + "/one_back.off", grid_off("3 0 4 1\n", 1));
+  {
+    const CliRun r =
+        meshquilt(dir_,
+                  "surface --base one_back.off --swatch sw.obj -o o.ply --stats s.json --quiet "
+                  "--min-coverage 0");
+    EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "sheet_back_faces"), "0") << r.err;
+    fs::remove(dir_ + "/o.ply");
+    fs::remove(dir_ + "/s.json");
+  }
   fs::remove(dir_ + "/ref.ply");
   spit(dir_ + "/degenerate.off", grid_off("3 4 4 8\n", 1));
   expect_refused("surface --base degenerate.off --swatch sw.obj -o o.obj", "repeats a vertex");
