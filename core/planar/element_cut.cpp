@@ -121,24 +121,21 @@ ElementCut element_graph_cut(const MatrixX3d& V, const MatrixX3i& F,
   // cut and the network leaves it out, with the SOURCE link of a Keep face that borders no other
   // kind (such a face is kept, as it is reachable from SOURCE): an output thread stitched at one
   // end is mostly Keep, and the network is then the size of the overlap, not of the thread.
+  const int source = nf, sink = nf + 1;
+  ArcList arcs;
+  arcs.ends.reserve(2 * edges.size() + 2 * static_cast<std::size_t>(nf));
+  arcs.properties.reserve(arcs.ends.capacity());
   std::vector<char> in_network(nf, 0);
   double total = 1.0;
   for (const DualEdge& e : edges) {
     if (hard[e.f] == CutLabel::Keep && hard[e.g] == CutLabel::Keep) continue;
+    arcs.add_pair(e.f, e.g, e.weight, e.weight);
     total += e.weight;
     in_network[e.f] = in_network[e.g] = 1;
   }
   // "Infinite" terminal links: larger than any finite cut, so never cut, yet finite so that
   // the solver's arithmetic stays exact (inf - inf would give NaN).
   const double infinite = 2.0 * total;
-
-  const int source = nf, sink = nf + 1;
-  ArcList arcs;
-  arcs.ends.reserve(2 * edges.size() + 2 * static_cast<std::size_t>(nf));
-  arcs.properties.reserve(arcs.ends.capacity());
-  for (const DualEdge& e : edges)
-    if (hard[e.f] != CutLabel::Keep || hard[e.g] != CutLabel::Keep)
-      arcs.add_pair(e.f, e.g, e.weight, e.weight);
   for (int f = 0; f < nf; ++f) {
     if (hard[f] == CutLabel::Keep && in_network[f]) arcs.add_pair(source, f, infinite, 0.0);
     if (hard[f] == CutLabel::Remove) arcs.add_pair(f, sink, infinite, 0.0);

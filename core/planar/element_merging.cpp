@@ -227,10 +227,10 @@ StitchFailure seam_failure(const TriMesh& stitched, const Element& out, const El
 
 // Why the deformed merged element is refused (None when it is kept): it must stay within the
 // space of its two parents (a wrongly paired seam drags vertices far away) and must not pass
-// through itself. Pairs of the output element's faces that the stitch left where they were
-// (`kept_out`, #F flags) are not tested against each other: the output held them so already.
+// through itself. Only pairs holding a face that `changed` marks (#F flags: not one of the
+// output element's faces left where it was) are tested: the output held the others so already.
 StitchFailure merged_failure(const Element& result, const Element& out, const Element& in,
-                             const std::vector<char>& kept_out, double mean_edge_length) {
+                             const std::vector<char>& changed, double mean_edge_length) {
   const double slack = 2.0 * mean_edge_length;
   const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
   const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
@@ -247,23 +247,23 @@ StitchFailure merged_failure(const Element& result, const Element& out, const El
   };
   BoundingBox changed_box;
   for (int f = 0; f < result.F.rows(); ++f)
-    if (!kept_out[f]) {
+    if (changed[f]) {
       const BoundingBox b = face_box(f);
       changed_box.extend(b.min);
       changed_box.extend(b.max);
     }
   std::vector<int> faces;
-  std::vector<char> changed;
+  std::vector<char> near_changed;
   for (int f = 0; f < result.F.rows(); ++f) {
     const BoundingBox b = face_box(f);
-    if (!kept_out[f] || ((b.min.array() <= changed_box.max.array()).all() &&
-                         (changed_box.min.array() <= b.max.array()).all())) {
+    if (changed[f] || ((b.min.array() <= changed_box.max.array()).all() &&
+                       (changed_box.min.array() <= b.max.array()).all())) {
       faces.push_back(f);
-      changed.push_back(!kept_out[f]);
+      near_changed.push_back(changed[f]);
     }
   }
   const TriMesh near = extract_faces(result.mesh(), faces);
-  if (!intersecting_face_pairs_touching(near.V, near.F, changed).empty())
+  if (!intersecting_face_pairs_touching(near.V, near.F, near_changed).empty())
     return StitchFailure::SelfIntersecting;
   return StitchFailure::None;
 }
@@ -319,14 +319,10 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
                      options.deformation_rings, options.solve_margin, deformation);
   result.V = std::move(deformed.V);
   result.F = stitched->mesh.F;
-  // The output element's faces the deformation did not reach are as the output held them.
-  std::vector<char> kept_out(result.F.rows(), 0);
-  for (int f = 0; f < result.F.rows(); ++f) {
-    bool from_out = !deformed.moved_faces[f];
-    for (int k = 0; k < 3; ++k)
-      from_out = from_out && stitched->origin[result.F(f, k)] < a.num_vertices();
-    kept_out[f] = from_out;
-  }
+  // Changed: a face the deformation reached, or not all of whose corners are the output's.
+  std::vector<char>& changed = deformed.moved_faces;
+  for (int f = 0; f < result.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) changed[f] |= stitched->origin[result.F(f, k)] >= a.num_vertices();
   result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
   // The stitched vertices are the kept parts' (section 2.7 adds none), some of B's welded.
   std::vector<int> parts_vertex = from_out;
@@ -336,7 +332,7 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
     (v < a.num_vertices() ? from_out_kept : from_in_kept).push_back(parts_vertex[v]);
   carry_sources({{&out, &from_out_kept}, {&in, &from_in_kept}}, result);
   result.update();
-  if (const StitchFailure why = merged_failure(result, out, in, kept_out, mean_edge_length);
+  if (const StitchFailure why = merged_failure(result, out, in, changed, mean_edge_length);
       why != StitchFailure::None)
     return fail(why);
   return result;

@@ -300,6 +300,20 @@ MatrixX3d deform_element(const MatrixX3d& V, const MatrixX3i& F,
   return LaplacianDeformer(V, F, options).solve(constraints);
 }
 
+namespace {
+
+// deform_element, with the element's topology from `topologies` (optional) when held there.
+MatrixX3d solve_whole(const MatrixX3d& V, const MatrixX3i& F,
+                      const std::vector<LinearConstraint>& constraints,
+                      const DeformationOptions& options, const LaplacianTopologyCache* topologies) {
+  std::shared_ptr<const LaplacianTopology> known =
+      topologies ? topologies->find(F, static_cast<int>(V.rows())) : nullptr;
+  return known ? LaplacianDeformer(std::move(known), V, options).solve(constraints)
+               : deform_element(V, F, constraints, options);
+}
+
+}  // namespace
+
 std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
                                        const DeformationOptions& options,
                                        const LaplacianTopologyCache* topologies) {
@@ -312,20 +326,12 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
       tbb::blocked_range<size_t>(0, jobs.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t j = range.begin(); j != range.end(); ++j) {
           try {
-            if (jobs[j].local_rings >= 0) {
-              results[j] =
-                  deform_locally(*jobs[j].V, *jobs[j].F, jobs[j].constraints, jobs[j].local_rings,
-                                 jobs[j].local_margin, options, topologies)
-                      .V;
-              continue;
-            }
-            std::shared_ptr<const LaplacianTopology> known =
-                topologies ? topologies->find(*jobs[j].F, static_cast<int>(jobs[j].V->rows()))
-                           : nullptr;
-            results[j] = known
-                             ? LaplacianDeformer(std::move(known), *jobs[j].V, options)
-                                   .solve(jobs[j].constraints)
-                             : deform_element(*jobs[j].V, *jobs[j].F, jobs[j].constraints, options);
+            const DeformationJob& job = jobs[j];
+            results[j] = job.local_rings >= 0
+                             ? deform_locally(*job.V, *job.F, job.constraints, job.local_rings,
+                                              job.local_margin, options, topologies)
+                                   .V
+                             : solve_whole(*job.V, *job.F, job.constraints, options, topologies);
           } catch (...) {
             errors[j] = std::current_exception();
           }
@@ -388,19 +394,19 @@ LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
   const int nv = static_cast<int>(V.rows());
   const std::vector<int> depth = constraint_depth(F, nv, constraints);
   const int reach = rings + margin;
-  // Wholly within reach (a compact element), or with a cached topology (a swatch element as
-  // placed, whose cached solve costs less than a local one analysed afresh): the whole solve,
-  // as anchor_far_vertices and deform_element give it.
-  std::shared_ptr<const LaplacianTopology> known = topologies ? topologies->find(F, nv) : nullptr;
-  if (known || std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; })) {
+  // The whole solve, as anchor_far_vertices and deform_element give it.
+  const auto whole = [&] {
     std::vector<LinearConstraint> all = constraints;
     for (int v = 0; v < nv; ++v)
       if (depth[v] > rings) all.push_back(LinearConstraint::point(v, V.row(v).transpose()));
-    LocalDeformation whole{known ? LaplacianDeformer(std::move(known), V, options).solve(all)
-                                 : deform_element(V, F, all, options),
-                           std::vector<char>(F.rows(), 1)};
-    return whole;
-  }
+    return LocalDeformation{solve_whole(V, F, all, options, topologies),
+                            std::vector<char>(F.rows(), 1)};
+  };
+  // Wholly within reach (a compact element), or with a cached topology (a swatch element as
+  // placed, whose cached solve costs less than a local one analysed afresh): solved whole.
+  if ((topologies && topologies->find(F, nv)) ||
+      std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; }))
+    return whole();
   // The faces within reach, and their vertices renumbered.
   std::vector<int> local(nv, -1), global;
   std::vector<int> faces;
@@ -423,13 +429,8 @@ LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
       MQ_CHECK(c.vertices[k] < nv, InvalidInput, "local deformation: constraint vertex ",
                c.vertices[k], " out of range [0, ", nv, ")");
       c.vertices[k] = local[c.vertices[k]];
-      // A constrained vertex in no face within reach (an isolated vertex): solve it all.
-      if (c.vertices[k] < 0) {
-        std::vector<LinearConstraint> all = constraints;
-        const std::vector<LinearConstraint> anchors = anchor_far_vertices(V, F, constraints, rings);
-        all.insert(all.end(), anchors.begin(), anchors.end());
-        return {deform_element(V, F, all, options), std::vector<char>(F.rows(), 1)};
-      }
+      // A constrained vertex in no face within reach (an isolated one, or reach 0): solved whole.
+      if (c.vertices[k] < 0) return whole();
     }
     cs.push_back(c);
   }

@@ -201,7 +201,7 @@ class PatchMerger {
   // outcomes in order, as before. A pair merge() reaches otherwise (a partner removed on the
   // way) is worked out when reached.
   void prepare(const std::function<bool(const Element&)>& admissible) {
-    std::vector<int> candidates;
+    std::vector<std::pair<int, int>> candidates;  // (swatch element, its crossing partner)
     for (size_t i = 0; i < patch_.moved.size(); ++i) {
       int crossing = -1, count = 0;
       for (const int k : patch_.partners[i])
@@ -210,18 +210,17 @@ class PatchMerger {
           ++count;
         }
       if (count == 1 && !inside(patch_.moved[i], region_) && admissible(patch_.moved[i]))
-        candidates.push_back(static_cast<int>(i));
-      outcomes_[i].k = count == 1 ? crossing : -1;
+        candidates.emplace_back(static_cast<int>(i), crossing);
     }
     tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t c) {
-      const int i = candidates[c];
+      const auto [i, k] = candidates[c];
       StitchOutcome& o = outcomes_[i];
       try {
-        o = outcome(patch_.moved[i], o.k);
+        o = outcome(patch_.moved[i], k);
       } catch (...) {
+        o.k = k;
         o.error = std::current_exception();
       }
-      o.ready = true;
     });
   }
 
@@ -253,8 +252,7 @@ class PatchMerger {
 
  private:
   struct StitchOutcome {
-    int k = -1;  // the crossing partner (local index) it is for
-    bool ready = false;
+    int k = -1;         // the crossing partner (local index) it is for; -1: not worked out
     bool same = false;  // the same element placed twice: the output's is kept
     std::optional<Element> joined;
     StitchFailure why = StitchFailure::None;
@@ -265,7 +263,6 @@ class PatchMerger {
   StitchOutcome outcome(const Element& in, int k) const {
     StitchOutcome o;
     o.k = k;
-    o.ready = true;
     // Output elements take their deformed shape once they are merged with a partner.
     const auto it = patch_.deformed_out.find(k);
     const Element& base = it == patch_.deformed_out.end() ? patch_.frame[k] : it->second;
@@ -296,8 +293,7 @@ class PatchMerger {
   // Joins swatch element i with its crossing partner k (local index), whose place it takes
   // with the partners in `replaced_ids`; or keeps the output's element.
   void stitch(size_t i, int k, const std::vector<int>& replaced_ids) {
-    StitchOutcome o = outcomes_[i].ready && outcomes_[i].k == k ? std::move(outcomes_[i])
-                                                                : outcome(patch_.moved[i], k);
+    StitchOutcome o = outcomes_[i].k == k ? std::move(outcomes_[i]) : outcome(patch_.moved[i], k);
     if (o.error) std::rethrow_exception(o.error);
     if (o.same) {
       ++counts_.matched;

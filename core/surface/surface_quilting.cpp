@@ -59,6 +59,16 @@ void validate_base(const TriMesh& base) {
            "the base mesh has no area (its faces are flat to lines or points)");
 }
 
+// The mesh with only the given faces, in that order, and all its vertices as they are.
+TriMesh with_faces(const TriMesh& mesh, const std::vector<int>& faces) {
+  TriMesh out;
+  out.V = mesh.V;
+  out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i)
+    out.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(faces[i]);
+  return out;
+}
+
 // The mesh without faces that repeat an earlier one (the same three vertices in the same
 // orientation); input_face[f] is the face of `mesh` that face f of the result is. A base listed
 // twice over gave an empty result (issue 14): the first of each is kept. The same triangle
@@ -84,12 +94,7 @@ TriMesh without_duplicate_faces(const TriMesh& mesh, std::vector<int>& input_fac
     if (keep[static_cast<size_t>(f)]) input_face.push_back(f);
   *removed = mesh.F.rows() - static_cast<int>(input_face.size());
   if (*removed == 0) return mesh;
-  TriMesh out;
-  out.V = mesh.V;
-  out.F.resize(static_cast<Eigen::Index>(input_face.size()), 3);
-  for (size_t i = 0; i < input_face.size(); ++i)
-    out.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(input_face[i]);
-  return out;
+  return with_faces(mesh, input_face);
 }
 
 // The mesh without the backs of a two-sided sheet: a base whose every face is listed again
@@ -122,16 +127,10 @@ TriMesh without_sheet_backs(const TriMesh& mesh, std::vector<int>& input_face, i
   for (int f = 0; f < nf; ++f)
     if (back[static_cast<size_t>(f)] > f) kept.push_back(f);
   *removed = nf - static_cast<int>(kept.size());
-  TriMesh out;
-  out.V = mesh.V;
-  out.F.resize(static_cast<Eigen::Index>(kept.size()), 3);
   std::vector<int> composed(kept.size());
-  for (size_t i = 0; i < kept.size(); ++i) {
-    out.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(kept[i]);
-    composed[i] = input_face[static_cast<size_t>(kept[i])];
-  }
+  for (size_t i = 0; i < kept.size(); ++i) composed[i] = input_face[static_cast<size_t>(kept[i])];
   input_face = std::move(composed);
-  return out;
+  return with_faces(mesh, kept);
 }
 
 // The mesh without its fins (core/mesh/fins.h): a piece sticking out of the surface at
