@@ -227,10 +227,11 @@ StitchFailure seam_failure(const TriMesh& stitched, const Element& out, const El
 
 // Why the deformed merged element is refused (None when it is kept): it must stay within the
 // space of its two parents (a wrongly paired seam drags vertices far away) and must not pass
-// through itself. Only pairs holding a face that `changed` marks (#F flags: not one of the
-// output element's faces left where it was) are tested: the output held the others so already.
+// through itself. The whole element is tested: on a surface the output's own element may already
+// pass through itself (the sphere's weave by patches: 5 -> 10 elements removed as
+// self-intersecting when only the changed faces were tested).
 StitchFailure merged_failure(const Element& result, const Element& out, const Element& in,
-                             const std::vector<char>& changed, double mean_edge_length) {
+                             double mean_edge_length) {
   const double slack = 2.0 * mean_edge_length;
   const Vector2d lo = out.lo.cwiseMin(in.lo).array() - slack;
   const Vector2d hi = out.hi.cwiseMax(in.hi).array() + slack;
@@ -238,32 +239,9 @@ StitchFailure merged_failure(const Element& result, const Element& out, const El
       result.z_lo < std::min(out.z_lo, in.z_lo) - slack ||
       result.z_hi > std::max(out.z_hi, in.z_hi) + slack)
     return StitchFailure::Distorted;
-  // A face meeting a changed one has its box within the changed faces' box: only those take
-  // part (shared vertices stay shared in the extracted mesh, so neighbours are not reported).
-  const auto face_box = [&](int f) {
-    BoundingBox box;
-    for (int k = 0; k < 3; ++k) box.extend(result.V.row(result.F(f, k)).transpose());
-    return box;
-  };
-  BoundingBox changed_box;
-  for (int f = 0; f < result.F.rows(); ++f)
-    if (changed[f]) {
-      const BoundingBox b = face_box(f);
-      changed_box.extend(b.min);
-      changed_box.extend(b.max);
-    }
-  std::vector<int> faces;
-  std::vector<char> near_changed;
-  for (int f = 0; f < result.F.rows(); ++f) {
-    const BoundingBox b = face_box(f);
-    if (changed[f] || ((b.min.array() <= changed_box.max.array()).all() &&
-                       (changed_box.min.array() <= b.max.array()).all())) {
-      faces.push_back(f);
-      near_changed.push_back(changed[f]);
-    }
-  }
-  const TriMesh near = extract_faces(result.mesh(), faces);
-  if (!intersecting_face_pairs_touching(near.V, near.F, near_changed).empty())
+  IntersectionOptions all_pairs;
+  all_pairs.between_components_only = false;
+  if (!intersecting_face_pairs(result.V, result.F, all_pairs).empty())
     return StitchFailure::SelfIntersecting;
   return StitchFailure::None;
 }
@@ -314,15 +292,10 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
   DeformationOptions deformation;
   deformation.mu = options.mu;
   Element result;
-  LocalDeformation deformed =
-      deform_locally(stitched->mesh.V, stitched->mesh.F, stitched->constraints,
-                     options.deformation_rings, options.solve_margin, deformation);
-  result.V = std::move(deformed.V);
+  result.V = deform_locally(stitched->mesh.V, stitched->mesh.F, stitched->constraints,
+                            options.deformation_rings, options.solve_margin, deformation)
+                 .V;
   result.F = stitched->mesh.F;
-  // Changed: a face the deformation reached, or not all of whose corners are the output's.
-  std::vector<char>& changed = deformed.moved_faces;
-  for (int f = 0; f < result.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) changed[f] |= stitched->origin[result.F(f, k)] >= a.num_vertices();
   result.kind = out.kind;  // partners are the same element placed twice (section 2.7)
   // The stitched vertices are the kept parts' (section 2.7 adds none), some of B's welded.
   std::vector<int> parts_vertex = from_out;
@@ -332,7 +305,7 @@ std::optional<Element> cut_and_stitch(const Element& out, const Element& in,
     (v < a.num_vertices() ? from_out_kept : from_in_kept).push_back(parts_vertex[v]);
   carry_sources({{&out, &from_out_kept}, {&in, &from_in_kept}}, result);
   result.update();
-  if (const StitchFailure why = merged_failure(result, out, in, changed, mean_edge_length);
+  if (const StitchFailure why = merged_failure(result, out, in, mean_edge_length);
       why != StitchFailure::None)
     return fail(why);
   return result;
