@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -56,10 +57,35 @@ bool thp_on_request() {
 
 }  // namespace
 
+bool reports_free_pages(const std::string& features) {
+  constexpr size_t kReportingBit = 5;
+  return features.size() > kReportingBit && features[kReportingBit] == '1';
+}
+
+// Such a guest hands its free blocks of 2 MiB and more back to the host, and a huge page is
+// taken from exactly those, so zeroing it faults every 4 KiB of it in on the host. Measured on such
+// a VM (Firecracker, 2 cores): the armor job 16.0-17.1 s on huge pages against 12.1-12.4 s without,
+// the kernel's clear_page 34% of samples against under 1%.
+bool host_reclaims_free_pages() {
+#if defined(__linux__)
+  std::error_code error;
+  for (const auto& device :
+       std::filesystem::directory_iterator("/sys/bus/virtio/drivers/virtio_balloon", error)) {
+    if (device.path().filename().string().rfind("virtio", 0) != 0) continue;
+    std::ifstream in(device.path() / "features");
+    std::string bits;
+    if (in >> bits && reports_free_pages(bits)) return true;
+  }
+#endif
+  return false;
+}
+
 void restart_with_huge_pages(char** argv) {
   if (!glibc_with_tunable() || sanitized()) return;
   const char* choice = std::getenv("MESHQUILT_HUGE_PAGES");
   if (choice != nullptr && std::strcmp(choice, "0") == 0) return;
+  const bool asked = choice != nullptr && std::strcmp(choice, "1") == 0;
+  if (!asked && host_reclaims_free_pages()) return;
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (contains(tunables, kTunable)) return;                      // set already, by us or the user
   if (contains(std::getenv("LD_PRELOAD"), "vgpreload")) return;  // valgrind follows no exec

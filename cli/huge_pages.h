@@ -1,6 +1,8 @@
 // Transparent huge pages for the large arrays of a run (issue 27).
 #pragma once
 
+#include <string>
+
 namespace mq::cli {
 
 // Restarts this process (same pid, arguments and environment) with glibc's malloc asked to back
@@ -12,8 +14,18 @@ namespace mq::cli {
 // hence the restart (about 10 ms). Measured (farm-bench, 4 pairs, 2 cores): the armor job 0.78x
 // wall time, the ivy wall 0.91x, Spot 0.88x; most of the page faults of the output's large
 // arrays go, peak memory 1-5% higher. Returns only when no restart was made (or exec failed);
-// call first in main, before any thread or file exists.
+// call first in main, before any thread or file exists. Not on a virtual machine whose balloon
+// reports free pages to the host (reports_free_pages): there the huge pages are the memory the
+// host took back, and faulting them in made the armor job 1.35x slower; MESHQUILT_HUGE_PAGES=1
+// asks for them all the same.
 void restart_with_huge_pages(char** argv);
+
+// Whether a virtio balloon's features string (one '0' or '1' per feature bit, bit 0 first, as in
+// /sys/bus/virtio/devices/*/features) offers free page reporting (bit 5).
+bool reports_free_pages(const std::string& features);
+
+// Whether a virtio balloon of this machine reports free pages (reads sysfs; false off Linux).
+bool host_reclaims_free_pages();
 
 // Whether this process runs with the tunable above (for --stats).
 bool huge_pages_on();

@@ -31,7 +31,9 @@ constexpr const char* kUsage =
     "\n"
     "environment: MESHQUILT_HUGE_PAGES=0 keeps the engine off transparent huge pages (on\n"
     "  where the kernel gives them on request: about 10-20% faster on large jobs, peak memory\n"
-    "  a few percent higher; --stats says which in memory.huge_pages).\n"
+    "  a few percent higher; off on a virtual machine whose balloon reports free pages to the\n"
+    "  host, where they were 1.1-1.5x slower; =1 asks for them there too; --stats says which\n"
+    "  in memory.huge_pages).\n"
     "\n";
 
 struct Command {
