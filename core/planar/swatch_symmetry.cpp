@@ -21,8 +21,13 @@ struct Sample {
 // Mean Eq. (1) cost of the sample mapped by x -> sign * x + t (xy; normals alike) against the
 // swatch, over the points that land where the swatch is whole (at least a margin inside its
 // footprint); infinity when fewer than min_points do.
+// entries (optional, one per sample point, -1 = none): each point's face at a nearby shift,
+// which starts its search (SwatchFaceTree::min_face_cost's hint: the same minimum, found
+// faster), replaced by the face found here. A compass step moves t by a fraction of a cell, so
+// most points keep their face.
 double mean_cost(const SwatchFaceTree& faces, const Sample& s, double sign, const Vector2d& t,
-                 const Vector2d& size, double margin, double lambda, size_t min_points) {
+                 const Vector2d& size, double margin, double lambda, size_t min_points,
+                 std::vector<int>* entries = nullptr) {
   std::vector<double> costs;
   costs.reserve(s.p.size());
   for (size_t i = 0; i < s.p.size(); ++i) {
@@ -30,7 +35,12 @@ double mean_cost(const SwatchFaceTree& faces, const Sample& s, double sign, cons
     if (q.x() < margin || q.y() < margin || q.x() > size.x() - margin || q.y() > size.y() - margin)
       continue;
     const Vector3d n(sign * s.n[i].x(), sign * s.n[i].y(), s.n[i].z());
-    costs.push_back(faces.min_face_cost(q, n, lambda));
+    if (entries) {
+      int& entry = (*entries)[i];
+      costs.push_back(faces.min_face_cost(q, n, lambda, &entry, kInf, entry));
+    } else {
+      costs.push_back(faces.min_face_cost(q, n, lambda));
+    }
   }
   if (costs.size() < min_points) return std::numeric_limits<double>::infinity();
   // The better half: a shifted point that lands where the sheet has run out (beyond its last
@@ -44,19 +54,23 @@ double mean_cost(const SwatchFaceTree& faces, const Sample& s, double sign, cons
   return sum / static_cast<double>(keep);
 }
 
-// Compass search from t down to a step of `finest`.
+// Compass search from t down to a step of `finest`. Each trial starts its points' searches at
+// the faces they had at t (mean_cost's entries): the same costs, so the same path.
 Vector2d refine(const SwatchFaceTree& faces, const Sample& s, double sign, Vector2d t,
                 const Vector2d& size, double margin, double lambda, size_t min_points, double step,
                 double finest, double& cost) {
-  cost = mean_cost(faces, s, sign, t, size, margin, lambda, min_points);
+  std::vector<int> at_t(s.p.size(), -1), trial;
+  cost = mean_cost(faces, s, sign, t, size, margin, lambda, min_points, &at_t);
   while (step >= finest) {
     bool moved = false;
     const Vector2d moves[4] = {{step, 0}, {-step, 0}, {0, step}, {0, -step}};
     for (const Vector2d& m : moves) {
-      const double c = mean_cost(faces, s, sign, t + m, size, margin, lambda, min_points);
+      trial = at_t;
+      const double c = mean_cost(faces, s, sign, t + m, size, margin, lambda, min_points, &trial);
       if (c < cost * (1 - 1e-12)) {
         cost = c;
         t += m;
+        at_t.swap(trial);
         moved = true;
         break;
       }
@@ -192,11 +206,17 @@ class SymmetrySearch {
     const int ny = static_cast<int>(std::floor((to.y() - from.y()) / grid_step)) + 1;
     if (nx <= 0 || ny <= 0) return {};
     std::vector<double> costs(static_cast<size_t>(nx) * ny);
-    tbb::parallel_for(0, nx * ny, [&](int k) {
-      const Vector2d t = from + grid_step * Vector2d(k % nx, k / nx);
-      costs[static_cast<size_t>(k)] = (sign > 0 && t.norm() < 0.5 * cell_)
-                                          ? std::numeric_limits<double>::infinity()
-                                          : cost(sign, t);
+    // A row at a time, each shift's searches started at the faces of the one before it.
+    tbb::parallel_for(0, ny, [&](int y) {
+      std::vector<int> entries(sample_.p.size(), -1);
+      for (int x = 0; x < nx; ++x) {
+        const Vector2d t = from + grid_step * Vector2d(x, y);
+        costs[static_cast<size_t>(y) * nx + x] =
+            (sign > 0 && t.norm() < 0.5 * cell_)
+                ? std::numeric_limits<double>::infinity()
+                : mean_cost(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_,
+                            &entries);
+      }
     });
     std::vector<int> seeds;
     for (int k = 0; k < nx * ny; ++k) {

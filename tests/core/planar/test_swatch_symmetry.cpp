@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 
@@ -66,6 +67,33 @@ TEST(SwatchSymmetry, FourInOneSheetHasItsLatticeAndAHalfTurn) {
     const Vector2d axes = axis_periods(d.swatch, tree, matching_cell_size(d.swatch));
     EXPECT_NEAR(axes.x(), 2.5, 1e-4);
     EXPECT_NEAR(axes.y(), 1.25, 1e-4);
+  }
+}
+
+// The grid's shifts are searched a row at a time, each starting its face searches where the
+// shift before it ended, and the compass steps where the last accepted one ended (hints that
+// change how fast, not what is found): the symmetry must be bitwise the same on 1 and 2 threads.
+TEST(SwatchSymmetry, BitwiseTheSameOnOneAndTwoThreads) {
+  ChainMailOptions o;
+  o.rows = 2;
+  o.cols = 4;
+  o.ring_segments = 16;
+  o.wire_segments = 4;
+  WeaveOptions w;
+  w.threads_x = w.threads_y = 4;
+  for (const TriMesh& mesh : {chainmail_4in1(o), plain_weave(w)}) {
+    const PreparedSwatch swatch = prepare_swatch(mesh);
+    const SwatchFaceTree tree(swatch.mesh.V, swatch.mesh.F);
+    SwatchSymmetry by[2];
+    for (const int threads : {1, 2})
+      tbb::task_arena(threads).execute([&] {
+        by[threads - 1] = detect_swatch_symmetry(swatch, tree, matching_cell_size(swatch));
+      });
+    ASSERT_TRUE(by[0].periodic);
+    EXPECT_EQ(by[0].a, by[1].a);
+    EXPECT_EQ(by[0].b, by[1].b);
+    EXPECT_EQ(by[0].half_turn, by[1].half_turn);
+    EXPECT_EQ(by[0].c, by[1].c);
   }
 }
 
