@@ -302,12 +302,17 @@ MatrixX3d deform_element(const MatrixX3d& V, const MatrixX3i& F,
 
 namespace {
 
-// deform_element, with the element's topology from `topologies` (optional) when held there.
+// The element's topology when `topologies` (optional) holds it, else nullptr.
+std::shared_ptr<const LaplacianTopology> cached_topology(const MatrixX3i& F, int num_vertices,
+                                                         const LaplacianTopologyCache* topologies) {
+  return topologies ? topologies->find(F, num_vertices) : nullptr;
+}
+
+// deform_element, on the topology `known` when given (cached_topology).
 MatrixX3d solve_whole(const MatrixX3d& V, const MatrixX3i& F,
                       const std::vector<LinearConstraint>& constraints,
-                      const DeformationOptions& options, const LaplacianTopologyCache* topologies) {
-  std::shared_ptr<const LaplacianTopology> known =
-      topologies ? topologies->find(F, static_cast<int>(V.rows())) : nullptr;
+                      const DeformationOptions& options,
+                      std::shared_ptr<const LaplacianTopology> known) {
   return known ? LaplacianDeformer(std::move(known), V, options).solve(constraints)
                : deform_element(V, F, constraints, options);
 }
@@ -331,7 +336,9 @@ std::vector<MatrixX3d> deform_elements(const std::vector<DeformationJob>& jobs,
                              ? deform_locally(*job.V, *job.F, job.constraints, job.local_rings,
                                               job.local_margin, options, topologies)
                                    .V
-                             : solve_whole(*job.V, *job.F, job.constraints, options, topologies);
+                             : solve_whole(*job.V, *job.F, job.constraints, options,
+                                           cached_topology(*job.F, static_cast<int>(job.V->rows()),
+                                                           topologies));
           } catch (...) {
             errors[j] = std::current_exception();
           }
@@ -394,18 +401,17 @@ LocalDeformation deform_locally(const MatrixX3d& V, const MatrixX3i& F,
   const int nv = static_cast<int>(V.rows());
   const std::vector<int> depth = constraint_depth(F, nv, constraints);
   const int reach = rings + margin;
+  const std::shared_ptr<const LaplacianTopology> known = cached_topology(F, nv, topologies);
   // The whole solve, as anchor_far_vertices and deform_element give it.
   const auto whole = [&] {
     std::vector<LinearConstraint> all = constraints;
     for (int v = 0; v < nv; ++v)
       if (depth[v] > rings) all.push_back(LinearConstraint::point(v, V.row(v).transpose()));
-    return LocalDeformation{solve_whole(V, F, all, options, topologies),
-                            std::vector<char>(F.rows(), 1)};
+    return LocalDeformation{solve_whole(V, F, all, options, known), std::vector<char>(F.rows(), 1)};
   };
   // Wholly within reach (a compact element), or with a cached topology (a swatch element as
   // placed, whose cached solve costs less than a local one analysed afresh): solved whole.
-  if ((topologies && topologies->find(F, nv)) ||
-      std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; }))
+  if (known || std::none_of(depth.begin(), depth.end(), [&](int d) { return d > reach; }))
     return whole();
   // The faces within reach, and their vertices renumbered.
   std::vector<int> local(nv, -1), global;

@@ -167,8 +167,8 @@ class SymmetrySearch {
   }
 
  private:
-  double cost(double sign, const Vector2d& t) const {
-    return mean_cost(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_);
+  double cost(double sign, const Vector2d& t, std::vector<int>* entries = nullptr) const {
+    return mean_cost(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_, entries);
   }
   Vector2d refined(double sign, const Vector2d& t, double step, double& c) const {
     return refine(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_, step,
@@ -211,11 +211,9 @@ class SymmetrySearch {
       std::vector<int> entries(sample_.p.size(), -1);
       for (int x = 0; x < nx; ++x) {
         const Vector2d t = from + grid_step * Vector2d(x, y);
-        costs[static_cast<size_t>(y) * nx + x] =
-            (sign > 0 && t.norm() < 0.5 * cell_)
-                ? std::numeric_limits<double>::infinity()
-                : mean_cost(faces_, sample_, sign, t, size_, margin_, lambda_, min_points_,
-                            &entries);
+        costs[static_cast<size_t>(y) * nx + x] = (sign > 0 && t.norm() < 0.5 * cell_)
+                                                     ? std::numeric_limits<double>::infinity()
+                                                     : cost(sign, t, &entries);
       }
     });
     std::vector<int> seeds;

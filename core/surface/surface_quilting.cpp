@@ -122,7 +122,7 @@ TriMesh without_sheet_backs(const TriMesh& mesh, std::vector<int>& input_face, i
       back[static_cast<size_t>(sorted[i][3])] = sorted[i - 1][3];
       back[static_cast<size_t>(sorted[i - 1][3])] = sorted[i][3];
     }
-  if (nf == 0 || std::count(back.begin(), back.end(), -1) > 0) return mesh;
+  if (nf == 0 || std::find(back.begin(), back.end(), -1) != back.end()) return mesh;
   std::vector<int> kept;
   for (int f = 0; f < nf; ++f)
     if (back[static_cast<size_t>(f)] > f) kept.push_back(f);
