@@ -269,6 +269,29 @@ TEST(MeshIntersections, RealWeaveSwatchThreadsAreNotFolded) {
   EXPECT_TRUE(self_intersecting_components(weave.V, weave.F).empty());
 }
 
+// A mesh of one component is tested without labels (the fold repair's per-ring test): the same
+// verdicts as when the ring is one of several.
+TEST(MeshIntersections, OneFoldedRingIsFoundAloneAndAmongOthers) {
+  ChainMailOptions o;
+  o.rows = 1;
+  o.cols = 1;
+  const TriMesh ring = chainmail_4in1(o);
+  TriMesh folded = ring;
+  // The wire's vertices on one side of the ring pushed through to the other side.
+  for (Eigen::Index v = 0; v < folded.V.rows(); ++v)
+    if (folded.V(v, 0) > 0.8) folded.V(v, 0) -= 1.8;
+  TriMesh far = ring;
+  far.V.col(1).array() += 10;
+  EXPECT_TRUE(self_intersecting_components(ring.V, ring.F).empty());
+  EXPECT_EQ(self_intersecting_components(folded.V, folded.F), std::vector<int>{0});
+  TriMesh two = folded;
+  append_mesh(two, far);
+  EXPECT_EQ(self_intersecting_components(two.V, two.F), std::vector<int>{0});
+  two = far;
+  append_mesh(two, folded);
+  EXPECT_EQ(self_intersecting_components(two.V, two.F), std::vector<int>{1});
+}
+
 TEST(MeshIntersections, BadInputThrows) {
   MatrixX3d V(3, 3);
   V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
