@@ -230,7 +230,8 @@ BoxSum candidate_boxes(const MatrixX3d& V, const MatrixX3i& F, const std::vector
   return all;
 }
 
-FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int>* label) {
+FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int>* label,
+                   const std::vector<char>* active) {
   const int nf = static_cast<int>(F.rows());
   FaceGrid grid;
   std::vector<FaceBox>& box = grid.box;
@@ -280,14 +281,29 @@ FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int
       for (int j = c.c0[1]; j <= c.c1[1]; ++j)
         for (int i = c.c0[0]; i <= c.c1[0]; ++i) visit(grid.cell_index(i, j, k));
   };
-  for (int f = 0; f < nf; ++f) each_cell(f, [&](int c) { ++offsets[static_cast<size_t>(c) + 1]; });
+  // With an active set only the active faces and the faces that share a cell with one: no other
+  // pair has an active face (a shell update moves a few dozen of 356k faces).
+  std::vector<char> take;
+  if (active) {
+    take.assign(static_cast<size_t>(nf), 0);
+    std::vector<char> near(static_cast<size_t>(num_cells), 0);
+    for (int f = 0; f < nf; ++f)
+      if ((*active)[static_cast<size_t>(f)])
+        each_cell(f, [&](int c) { near[static_cast<size_t>(c)] = 1; });
+    for (int f = 0; f < nf; ++f)
+      each_cell(f, [&](int c) { take[static_cast<size_t>(f)] |= near[static_cast<size_t>(c)]; });
+  }
+  const auto taken = [&](int f) { return !active || take[static_cast<size_t>(f)]; };
+  for (int f = 0; f < nf; ++f)
+    if (taken(f)) each_cell(f, [&](int c) { ++offsets[static_cast<size_t>(c) + 1]; });
   for (int c = 0; c < num_cells; ++c) offsets[c + 1] += offsets[c];
   grid.members.resize(static_cast<size_t>(offsets.back()));
   // offsets[c] serves as bucket c's cursor, and ends at bucket c + 1's start: shifted back after.
   for (int f = 0; f < nf; ++f)
-    each_cell(f, [&](int c) {
-      grid.members[static_cast<size_t>(offsets[static_cast<size_t>(c)]++)] = f;
-    });
+    if (taken(f))
+      each_cell(f, [&](int c) {
+        grid.members[static_cast<size_t>(offsets[static_cast<size_t>(c)]++)] = f;
+      });
   for (int c = num_cells; c > 0; --c) offsets[c] = offsets[c - 1];
   offsets[0] = 0;
   return grid;
@@ -364,7 +380,7 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
   std::vector<std::pair<int, int>> result =
-      pairs_by_cell(V, F, face_grid(V, F, label), label != nullptr, same_label, active);
+      pairs_by_cell(V, F, face_grid(V, F, label, active), label != nullptr, same_label, active);
   if (stop_at_first && result.size() > 1) result.resize(1);
   return result;
 }
