@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/mesh/mesh_io.h"
+#include "core/planar/swatch_generators.h"
 
 namespace {
 
@@ -41,6 +42,25 @@ mq::WriteOptions options_for(int format) {
   o.binary = format != 3;
   return o;
 }
+
+// An output as `surface` writes it: a chain mail sheet of 24 x 24 rings (664k faces) as OBJ with
+// element groups, materials and corner normals.
+void BM_WriteQuilt(benchmark::State& state) {
+  mq::ChainMailOptions c;
+  c.rows = 24;
+  c.cols = 24;
+  const mq::TriMesh mesh = mq::chainmail_4in1(c);
+  const std::string path = bench_path(0);
+  mq::WriteOptions o;
+  o.write_normals = true;
+  o.write_elements = true;
+  for (auto _ : state) mq::write_mesh(path, mesh, o);
+  state.counters["faces"] = mesh.num_faces();
+  state.counters["MB"] = std::filesystem::file_size(path) / 1e6;
+  std::filesystem::remove(path);
+  std::filesystem::remove(std::filesystem::path(path).replace_extension(".mtl"));
+}
+BENCHMARK(BM_WriteQuilt)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteMesh(benchmark::State& state) {
   const int format = static_cast<int>(state.range(0));

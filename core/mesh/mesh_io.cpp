@@ -970,7 +970,10 @@ std::vector<int> obj_face_order(const TriMesh& m, const ElementLabels* labels,
       const int e = labels->face_element[static_cast<size_t>(f)];
       return groups == ElementGroups::Element ? e : labels->element_kind[static_cast<size_t>(e)];
     };
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+    const auto by_key = [&](int a, int b) { return key(a) < key(b); };
+    // Outputs come element after element: already in order, a check instead of a sort.
+    if (!std::is_sorted(order.begin(), order.end(), by_key))
+      std::stable_sort(order.begin(), order.end(), by_key);
   }
   return order;
 }

@@ -2,7 +2,9 @@
 #include <tbb/global_control.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/common/errors.h"
 #include "core/mesh/corner_normals.h"
@@ -64,6 +66,68 @@ TEST(CornerNormals, ManyVerticesAreNumberedInVertexOrderWhateverTheThreads) {
   }
   EXPECT_TRUE(one.N == c.N);
   EXPECT_TRUE(one.FN == c.FN);
+}
+
+// The rule written out plainly (each corner sums, in face order, the area-weighted normals of
+// the faces around its vertex within the crease angle of its own face), against which the
+// smooth-fan shortcut must give bitwise the same normals: a bumpy sheet, where some fans are
+// smooth and some are not at every angle tried.
+TEST(CornerNormals, SmoothFanShortcutGivesTheRuleBitwise) {
+  const int n = 40;
+  TriMesh m;
+  m.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      m.V.row(j * (n + 1) + i) << i, j, 0.9 * std::sin(1.3 * i) * std::cos(0.7 * j * j);
+  m.F.resize(2 * n * n, 3);
+  for (int j = 0, f = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      m.F.row(f++) << a, a + 1, a + n + 2;
+      m.F.row(f++) << a, a + n + 2, a + n + 1;
+    }
+  MatrixX3d W(m.num_faces(), 3), U(m.num_faces(), 3);
+  for (int f = 0; f < m.num_faces(); ++f) {
+    const Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    const Vector3d w = (b - a).cross(c - a);
+    W.row(f) = w.transpose();
+    U.row(f) = (w / w.norm()).transpose();
+  }
+  std::vector<std::vector<int>> around(static_cast<size_t>(m.V.rows()));
+  for (int f = 0; f < m.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) around[static_cast<size_t>(m.F(f, k))].push_back(f);
+  for (const double degrees : {0.0, 5.0, 30.0, 60.0, 120.0, 179.0, 180.0}) {
+    const CornerNormals c = corner_normals(m.V, m.F, degrees);
+    const double min_cos = degrees >= 180 ? -2.0 : std::cos(degrees * M_PI / 180.0);
+    int smooth = 0;
+    for (int v = 0; v < m.V.rows(); ++v) {
+      std::vector<Vector3d> distinct;
+      for (const int f : around[static_cast<size_t>(v)]) {
+        Vector3d sum = Vector3d::Zero(), all = Vector3d::Zero();
+        for (const int g : around[static_cast<size_t>(v)]) {
+          all += W.row(g).transpose();
+          if (U.row(f).dot(U.row(g)) >= min_cos) sum += W.row(g).transpose();
+        }
+        // Not even its own face (a unit normal's dot with itself rounds under 1 at 0 degrees):
+        // the vertex's normal.
+        if (!(sum.norm() > 0)) sum = all;
+        const Vector3d expected = sum.normalized();
+        int k = 0;
+        while (m.F(f, k) != v) ++k;
+        ASSERT_TRUE(c.N.row(c.FN(f, k)).transpose() == expected)
+            << degrees << " degrees, vertex " << v << ", face " << f;
+        if (std::find(distinct.begin(), distinct.end(), expected) == distinct.end())
+          distinct.push_back(expected);
+      }
+      smooth += distinct.size() == 1;
+    }
+    // Both kinds of fan occur up to 120 degrees (at 179 and 180 every fan of this sheet is
+    // smooth).
+    EXPECT_GT(smooth, 0) << degrees;
+    if (degrees > 0 && degrees <= 120) {
+      EXPECT_LT(smooth, m.V.rows()) << degrees;
+    }
+  }
 }
 
 TEST(CornerNormals, CreaseAngleDecidesAndBadInputIsRefused) {
