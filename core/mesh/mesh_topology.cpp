@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
 
 #include "core/common/errors.h"
@@ -164,22 +165,32 @@ TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces,
   TriMesh out;
   out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
   const size_t corners = 3 * faces.size();
-  if (8 * corners >= static_cast<size_t>(mesh.V.rows())) {
-    // A large share of the mesh: a table over all its vertices.
-    std::vector<int> new_index(static_cast<size_t>(mesh.V.rows()), -1);
+  // The vertices' index range: one element of an output (its vertices consecutive) spans about
+  // a sixth of its corners.
+  int lo = std::numeric_limits<int>::max(), hi = -1;
+  for (const int f : faces)
+    for (int k = 0; k < 3; ++k) {
+      lo = std::min(lo, mesh.F(f, k));
+      hi = std::max(hi, mesh.F(f, k));
+    }
+  const size_t span = hi < lo ? 0 : static_cast<size_t>(hi - lo) + 1;
+  if (8 * corners >= span) {
+    // A large share of the range: a table over it (numbered by first use, as below).
+    std::vector<int> new_index(span, -1);
     for (size_t i = 0; i < faces.size(); ++i)
       for (int k = 0; k < 3; ++k) {
         const int v = mesh.F(faces[i], k);
-        if (new_index[static_cast<size_t>(v)] < 0) {
-          new_index[static_cast<size_t>(v)] = static_cast<int>(old_index.size());
+        int& id = new_index[static_cast<size_t>(v - lo)];
+        if (id < 0) {
+          id = static_cast<int>(old_index.size());
           old_index.push_back(v);
         }
-        out.F(static_cast<Eigen::Index>(i), k) = new_index[static_cast<size_t>(v)];
+        out.F(static_cast<Eigen::Index>(i), k) = id;
       }
   } else {
-    // A small part (one element of a layer of thousands): the corners sorted by vertex, so the
-    // cost follows the part and not the mesh (a table per element made placing and measuring
-    // every element of a layer quadratic). Same numbering: by first use.
+    // A small part scattered over the mesh: the corners sorted by vertex, so the cost follows
+    // the part and not the mesh (a table over the whole mesh per element made placing and
+    // measuring every element of a layer quadratic). Same numbering: by first use.
     std::vector<std::pair<int, int>> use(corners);  // (vertex, corner)
     for (size_t i = 0; i < faces.size(); ++i)
       for (int k = 0; k < 3; ++k)

@@ -84,7 +84,7 @@ TEST(MeshTopology, ExtractingASmallPartNumbersAsTheTableDoes) {
       if (std::find(first_use.begin(), first_use.end(), grid.F(f, k)) == first_use.end())
         first_use.push_back(grid.F(f, k));
   std::vector<int> map;
-  const TriMesh part = extract_faces(grid, small, &map);  // 21 corners: the sorted path
+  const TriMesh part = extract_faces(grid, small, &map);  // 21 corners far apart: sorted
   EXPECT_EQ(map, first_use);
   ASSERT_EQ(part.num_faces(), static_cast<int>(small.size()));
   for (size_t i = 0; i < small.size(); ++i)
@@ -94,6 +94,22 @@ TEST(MeshTopology, ExtractingASmallPartNumbersAsTheTableDoes) {
       EXPECT_EQ(part.V.row(part.F(static_cast<Eigen::Index>(i), k)),
                 grid.V.row(grid.F(small[i], k)));
     }
+  // A small part whose vertices lie close in index (one element of an output) takes a table
+  // over their range: the same numbering rule.
+  const std::vector<int> close = {4001, 4000, 3998, 4003, 3999};
+  std::vector<int> close_first_use;
+  for (const int f : close)
+    for (int k = 0; k < 3; ++k)
+      if (std::find(close_first_use.begin(), close_first_use.end(), grid.F(f, k)) ==
+          close_first_use.end())
+        close_first_use.push_back(grid.F(f, k));
+  std::vector<int> close_map;
+  const TriMesh c = extract_faces(grid, close, &close_map);
+  EXPECT_EQ(close_map, close_first_use);
+  for (size_t i = 0; i < close.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(close_map[static_cast<size_t>(c.F(static_cast<Eigen::Index>(i), k))],
+                grid.F(close[i], k));
   // Half of the mesh takes the table: the same numbering rule.
   std::vector<int> half;
   for (int f = 7199; f >= 3600; --f) half.push_back(f);
