@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -318,16 +319,19 @@ FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int
 // Pairs (f, g), f < g, in ascending order, whatever the threads.
 std::vector<std::pair<int, int>> pairs_by_cell(const MatrixX3d& V, const MatrixX3i& F,
                                                const FaceGrid& grid, bool labelled, bool same_label,
-                                               const std::vector<char>* active) {
+                                               const std::vector<char>* active,
+                                               bool stop_at_first) {
   const int num_cells = grid.n[0] * grid.n[1] * grid.n[2];
   constexpr int kCells = 4096;
   const int blocks = (num_cells + kCells - 1) / kCells;
   std::vector<std::vector<std::pair<int, int>>> found(static_cast<size_t>(blocks));
+  std::atomic<bool> any{false};  // with stop_at_first: a pair found, every block stops
   each_block(blocks, static_cast<int>(F.rows()), [&](int block) {
     std::vector<std::pair<int, int>>& out = found[static_cast<size_t>(block)];
     std::vector<FaceBox> local;
     std::vector<char> on;
     for (int c = block * kCells, end = std::min(num_cells, c + kCells); c < end; ++c) {
+      if (stop_at_first && any.load(std::memory_order_relaxed)) return;
       const int* const face = grid.members.data() + grid.offsets[static_cast<size_t>(c)];
       const auto n = static_cast<size_t>(grid.offsets[static_cast<size_t>(c) + 1] -
                                          grid.offsets[static_cast<size_t>(c)]);
@@ -356,8 +360,13 @@ std::vector<std::pair<int, int>> pairs_by_cell(const MatrixX3d& V, const MatrixX
               std::max(a.c0[2], b.c0[2]) != k)
             continue;
           if (on[x] ? faces_intersect(V, F, face[x], face[y])
-                    : faces_intersect(V, F, face[y], face[x]))
+                    : faces_intersect(V, F, face[y], face[x])) {
             out.emplace_back(face[x], face[y]);
+            if (stop_at_first) {
+              any.store(true, std::memory_order_relaxed);
+              return;
+            }
+          }
         }
       }
     }
@@ -379,8 +388,8 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(V.allFinite(), InvalidInput, "intersection test: vertex positions are not finite");
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
-  std::vector<std::pair<int, int>> result =
-      pairs_by_cell(V, F, face_grid(V, F, label, active), label != nullptr, same_label, active);
+  std::vector<std::pair<int, int>> result = pairs_by_cell(
+      V, F, face_grid(V, F, label, active), label != nullptr, same_label, active, stop_at_first);
   if (stop_at_first && result.size() > 1) result.resize(1);
   return result;
 }
@@ -463,6 +472,22 @@ std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3
   std::sort(result.begin(), result.end());
   result.erase(std::unique(result.begin(), result.end()), result.end());
   return result;
+}
+
+bool self_intersects(const MatrixX3d& V, const MatrixX3i& F, std::pair<int, int>* witness) {
+  MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
+           "intersection test: face index out of range [0, ", V.rows(), ")");
+  if (witness) {
+    const auto [f, g] = *witness;
+    if (0 <= f && f < g && g < F.rows() && faces_intersect(V, F, f, g)) return true;
+  }
+  std::vector<int> component;
+  const bool one = connected_components(F, static_cast<int>(V.rows()), component) == 1;
+  const std::vector<std::pair<int, int>> pairs =
+      find_pairs(V, F, one ? nullptr : &component, true, !one);
+  if (pairs.empty()) return false;
+  if (witness) *witness = pairs.front();
+  return true;
 }
 
 bool meshes_intersect(const TriMesh& A, const TriMesh& B) {

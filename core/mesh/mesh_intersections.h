@@ -60,6 +60,14 @@ std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3
 // fold, a tube pressed through itself). Ascending. Throws like intersecting_face_pairs.
 std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F);
 
+// Whether any component intersects itself (!self_intersecting_components(V, F).empty()), found
+// with an early stop. witness (optional): a pair (f, g), f < g, that intersected in an earlier
+// shape of the same faces F is tested first, so a shape that changes little is judged by one
+// triangle test (the fold repair's blends towards the flat shape); receives the pair found.
+// Throws like intersecting_face_pairs.
+bool self_intersects(const MatrixX3d& V, const MatrixX3i& F,
+                     std::pair<int, int>* witness = nullptr);
+
 // Does any triangle of A intersect any triangle of B? Throws like intersecting_face_pairs.
 bool meshes_intersect(const TriMesh& A, const TriMesh& B);
 

@@ -62,7 +62,7 @@ std::vector<char> try_layout_versions(const SurfaceQuilt& quilt,
     TriMesh m;
     m.V = A.middleRows(alternative_first[k], n);
     m.F = quilt.elements[k].F;
-    if (!self_intersecting_components(m.V, m.F).empty()) continue;
+    if (self_intersects(m.V, m.F)) continue;
     const BoundingBox b = box_of(m.V);
     if (!clears_neighbours(quilt, first, V, drop, grid, k, m, b)) continue;
     V.middleRows(first[k], n) = m.V;

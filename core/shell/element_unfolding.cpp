@@ -20,14 +20,15 @@ bool blend_towards_flat(const MatrixX3d& placed, const MatrixX3d& flat,
 }
 
 MatrixX3d unfold_element(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
-                         const SignedHeight* ground, const PlacementCheckOptions& check) {
+                         const SignedHeight* ground, const PlacementCheckOptions& check,
+                         std::pair<int, int> fold) {
   const std::vector<Eigen::Index> whole = {0, placed.rows()};
   MatrixX3d best, first;
   bool any = false;
   const bool out_of_base = blend_towards_flat(
       placed, flat, {0.95, 0.9, 0.75, 0.5, 0.25, 0.0}, [&](MatrixX3d& blend, double keep) {
         // The fitted flat shape (keep 0) is whole by construction.
-        if (keep > 0 && !self_intersecting_components(blend, F).empty()) return false;
+        if (keep > 0 && self_intersects(blend, F, &fold)) return false;
         if (!any) {
           first = blend;
           any = true;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "core/mesh/mesh.h"
@@ -27,8 +28,11 @@ bool blend_towards_flat(const MatrixX3d& placed, const MatrixX3d& flat,
 // job 226 of 276, 160 with the blends) is returned. Failing that, the first without a
 // self-intersection (the caller lifts it out of the base).
 //   F  the element's faces; check  the placement check's options (used with `ground`)
+//   fold  a pair of F's faces, f < g, that intersect in `placed`, if known ({-1, -1} if not):
+//         tried first on each blend (mesh_intersections' self_intersects)
 // Throws like self_intersecting_components.
 MatrixX3d unfold_element(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
-                         const SignedHeight* ground, const PlacementCheckOptions& check);
+                         const SignedHeight* ground, const PlacementCheckOptions& check,
+                         std::pair<int, int> fold = {-1, -1});
 
 }  // namespace mq

@@ -470,16 +470,24 @@ void QuiltEmbedder::repair_folds() {
   if (!known_disjoint_) find_pairs_once();
   // Folded: a pair within the element, or for an element moved since the pairs were found (kept
   // on the unoptimised map), its own test.
+  // With a pair of its faces that intersect (in the element's own face numbers), which the
+  // unfolding tries first on each blend.
   std::vector<char> folded_now(ne_, 0);
-  for (const auto& [f, g] : pairs_)
-    if (element_of_[f] == element_of_[g] && !stale_[static_cast<size_t>(element_of_[f])])
-      folded_now[static_cast<size_t>(element_of_[f])] = 1;
+  std::vector<std::pair<int, int>> fold(ne_, {-1, -1});
+  std::vector<int> first_face(ne_, -1);
+  for (int f = static_cast<int>(element_of_.size()) - 1; f >= 0; --f)
+    first_face[static_cast<size_t>(element_of_[static_cast<size_t>(f)])] = f;
+  for (const auto& [f, g] : pairs_) {
+    const auto k = static_cast<size_t>(element_of_[f]);
+    if (element_of_[f] != element_of_[g] || stale_[k] || folded_now[k]) continue;
+    folded_now[k] = 1;
+    fold[k] = {f - first_face[k], g - first_face[k]};
+  }
   tbb::parallel_for(size_t{0}, ne_, [&](size_t k) {
     if (stale_[k])
-      folded_now[k] = !self_intersecting_components(
-                           MatrixX3d(all_.V.middleRows(first_[k], first_[k + 1] - first_[k])),
-                           quilt_.elements[k].F)
-                           .empty();
+      folded_now[k] =
+          self_intersects(MatrixX3d(all_.V.middleRows(first_[k], first_[k + 1] - first_[k])),
+                          quilt_.elements[k].F, &fold[k]);
   });
   tbb::parallel_for(size_t{0}, ne_, [&](size_t k) {
     const SurfaceElement& e = quilt_.elements[k];
@@ -488,8 +496,9 @@ void QuiltEmbedder::repair_folds() {
       folded_now[k] = 0;  // left as it is
       return;
     }
-    all_.V.middleRows(v0, ev) = unfold_element(all_.V.middleRows(v0, ev), e.flat, e.F,
-                                               base_height_ ? &*base_height_ : nullptr, check_);
+    all_.V.middleRows(v0, ev) =
+        unfold_element(all_.V.middleRows(v0, ev), e.flat, e.F,
+                       base_height_ ? &*base_height_ : nullptr, check_, fold[k]);
   });
   for (size_t k = 0; k < ne_; ++k) {
     stats_.rigid_repairs += folded_now[k];

@@ -97,10 +97,11 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
             const PlacementCheckOptions& check, const RingUnbendingOptions& options,
             double reference, UnbendCandidate& c) {
   const std::vector<Eigen::Index> whole = {0, placed.rows()};
+  std::pair<int, int> fold{-1, -1};  // the last blend's folded pair, tried first on the next
   blend_towards_flat(placed, flat, options.keep, [&](MatrixX3d& blend, double) {
     std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
     if (!loop || ring_fold(*loop) - reference > options.target_fold) return false;
-    if (!self_intersecting_components(blend, F).empty()) return false;
+    if (self_intersects(blend, F, &fold)) return false;
     // A ring hung straighter over a convex edge dips into the base beside it: lifted out whole
     // (its links are checked after).
     if (ground && check_element_heights(*ground, blend, whole, check)[0].below > 0) {

@@ -1575,8 +1575,7 @@ class VinePlacement {
       // Whole on the base, clear of everything placed, and not folded through itself
       // (bent over a box's edge, the displacement can fold a leaf).
       if (!whole || placed_.intersects(p.position, p.element.F) >= 0 ||
-          (!on_one_face(job_.refinement, p.element) &&
-           !self_intersecting_components(p.position, p.element.F).empty()) ||
+          (!on_one_face(job_.refinement, p.element) && self_intersects(p.position, p.element.F)) ||
           dips_under_base(p.position))
         continue;
       add(p);

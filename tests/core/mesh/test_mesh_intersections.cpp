@@ -290,6 +290,19 @@ TEST(MeshIntersections, OneFoldedRingIsFoundAloneAndAmongOthers) {
   two = far;
   append_mesh(two, folded);
   EXPECT_EQ(self_intersecting_components(two.V, two.F), std::vector<int>{1});
+  // self_intersects gives the same verdicts, and a pair that intersects as its witness; a
+  // witness that no longer intersects (the ring unfolded again) does not decide.
+  EXPECT_TRUE(self_intersects(two.V, two.F));
+  EXPECT_FALSE(self_intersects(ring.V, ring.F));
+  std::pair<int, int> witness{-1, -1};
+  ASSERT_TRUE(self_intersects(folded.V, folded.F, &witness));
+  ASSERT_LT(witness.first, witness.second);
+  IntersectionOptions all;
+  all.between_components_only = false;
+  const auto pairs = intersecting_face_pairs(folded.V, folded.F, all);
+  EXPECT_NE(std::find(pairs.begin(), pairs.end(), witness), pairs.end());
+  EXPECT_TRUE(self_intersects(folded.V, folded.F, &witness));
+  EXPECT_FALSE(self_intersects(ring.V, ring.F, &witness));
 }
 
 TEST(MeshIntersections, BadInputThrows) {
