@@ -11,26 +11,27 @@
 
 namespace mq {
 namespace {
-constexpr long kMaxValence = 256;
-}  // namespace
 
-namespace {
+constexpr long kMaxValence = 256;
+
+// The cosine bound of smooth_fan for a crease cosine min_cos: half the crease angle less a
+// margin far above rounding (then no pairwise dot of the exact test can fall under min_cos);
+// above 1 (no fan passes) when that leaves nothing, -1 (every fan) at 180 degrees.
+double half_crease_cos(double min_cos) {
+  if (min_cos <= -1) return -1;
+  const double half = 0.5 * std::acos(std::min(1.0, min_cos)) - 1e-6;
+  return half > 0 ? std::cos(half) : 2;
+}
 
 // Whether every two faces around a vertex ([b, e) into U's rows) are within the crease angle, so
-// that each corner's normal takes them all: checked against their mean direction, each face
-// within half the angle of it (less a margin far above rounding: then no pairwise dot of the
-// exact test below can fall under min_cos). Linear instead of quadratic in the valence; most
-// vertices of a smooth output pass (the armor's 1.4M).
+// that each corner's normal takes them all: checked against their summed normal `all`, each face
+// within half the angle of it (min_half_cos, half_crease_cos). Linear instead of quadratic in the
+// valence; most vertices of a smooth output pass (the armor's 1.4M).
 bool smooth_fan(const MatrixX3d& U, const int* b, const int* e, const Vector3d& all,
-                double min_cos) {
-  if (e - b > kMaxValence) return false;
-  if (min_cos <= -1) return true;  // 180 degrees: every face is taken
+                double min_half_cos) {
   const double len = all.norm();
-  if (!(len > 0) || !(min_cos > -1)) return false;
+  if (e - b > kMaxValence || !(len > 0)) return false;
   const Vector3d m = all / len;
-  const double half = 0.5 * std::acos(std::min(1.0, min_cos)) - 1e-6;
-  if (!(half > 0)) return false;
-  const double min_half_cos = std::cos(half);
   for (const int* g = b; g != e; ++g) {
     const Vector3d u = U.row(*g).transpose();
     if (!(u.squaredNorm() > 0) || u.dot(m) < min_half_cos) return false;
@@ -69,6 +70,7 @@ CornerNormals corner_normals(const MatrixX3d& V, const MatrixX3i& F, double crea
   }
   // 180 degrees must take every face, even exactly opposite ones.
   const double min_cos = crease_degrees >= 180 ? -2.0 : std::cos(crease_degrees * M_PI / 180.0);
+  const double min_half_cos = half_crease_cos(min_cos);
   // Per vertex its distinct corner normals, appended to its block's list in vertex order (one
   // list per block of vertices, not a vector per vertex: a million small allocations were most
   // of the time for the armor's 1.4M vertices); FN holds local numbers first.
@@ -85,9 +87,9 @@ CornerNormals corner_normals(const MatrixX3d& V, const MatrixX3i& F, double crea
       Vector3d all = Vector3d::Zero();
       for (const int* g = b; g != e; ++g) all += W.row(*g).transpose();
       const size_t mine = list.size();  // v's normals are list[mine..]
-      if (smooth_fan(U, b, e, all, min_cos)) {
+      if (smooth_fan(U, b, e, all, min_half_cos)) {
         // Every corner's sum below takes every face, in the same order: `all`, one normal.
-        list.push_back(all.norm() > 0 ? Vector3d(all.normalized()) : Vector3d::UnitZ());
+        list.push_back(all.normalized());
         for (const int* f = b; f != e; ++f)
           for (int k = 0; k < 3; ++k)
             if (F(*f, k) == v) FN(*f, k) = 0;

@@ -458,16 +458,26 @@ std::vector<std::pair<int, int>> intersecting_face_pairs_touching(const MatrixX3
   return find_pairs(V, F, &label, false, same_label, &active);
 }
 
-std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {
+namespace {
+
+// The intersecting pairs of faces of one component (component: receives each face's).
+std::vector<std::pair<int, int>> pairs_within_components(const MatrixX3d& V, const MatrixX3i& F,
+                                                         bool stop_at_first,
+                                                         std::vector<int>& component) {
   MQ_CHECK(F.rows() == 0 || (F.minCoeff() >= 0 && F.maxCoeff() < V.rows()), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
-  std::vector<int> component;
-  const int num_components = connected_components(F, static_cast<int>(V.rows()), component);
   // One component (an element tested on its own, as the fold repair does): every pair is within
-  // it, without the per-cell search for the label's faces.
-  const bool one = num_components == 1;
+  // it, without comparing labels.
+  const bool one = connected_components(F, static_cast<int>(V.rows()), component) == 1;
+  return find_pairs(V, F, one ? nullptr : &component, stop_at_first, !one);
+}
+
+}  // namespace
+
+std::vector<int> self_intersecting_components(const MatrixX3d& V, const MatrixX3i& F) {
+  std::vector<int> component;
   std::vector<int> result;
-  for (const auto& [f, g] : find_pairs(V, F, one ? nullptr : &component, false, !one))
+  for (const auto& [f, g] : pairs_within_components(V, F, false, component))
     result.push_back(component[f]);
   std::sort(result.begin(), result.end());
   result.erase(std::unique(result.begin(), result.end()), result.end());
@@ -482,9 +492,7 @@ bool self_intersects(const MatrixX3d& V, const MatrixX3i& F, std::pair<int, int>
     if (0 <= f && f < g && g < F.rows() && faces_intersect(V, F, f, g)) return true;
   }
   std::vector<int> component;
-  const bool one = connected_components(F, static_cast<int>(V.rows()), component) == 1;
-  const std::vector<std::pair<int, int>> pairs =
-      find_pairs(V, F, one ? nullptr : &component, true, !one);
+  const std::vector<std::pair<int, int>> pairs = pairs_within_components(V, F, true, component);
   if (pairs.empty()) return false;
   if (witness) *witness = pairs.front();
   return true;

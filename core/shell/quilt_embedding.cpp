@@ -469,14 +469,13 @@ void QuiltEmbedder::repair_folds() {
   ScopedStage stage(stats_.times, progress_, Stage::FoldRepair);
   if (!known_disjoint_) find_pairs_once();
   // Folded: a pair within the element, or for an element moved since the pairs were found (kept
-  // on the unoptimised map), its own test.
-  // With a pair of its faces that intersect (in the element's own face numbers), which the
-  // unfolding tries first on each blend.
+  // on the unoptimised map), its own test; with the pair (in the element's own face numbers),
+  // which the unfolding tries first on each blend.
   std::vector<char> folded_now(ne_, 0);
   std::vector<std::pair<int, int>> fold(ne_, {-1, -1});
-  std::vector<int> first_face(ne_, -1);
-  for (int f = static_cast<int>(element_of_.size()) - 1; f >= 0; --f)
-    first_face[static_cast<size_t>(element_of_[static_cast<size_t>(f)])] = f;
+  std::vector<int> first_face(ne_ + 1, 0);  // all_.F holds the elements' faces in order
+  for (size_t k = 0; k < ne_; ++k)
+    first_face[k + 1] = first_face[k] + static_cast<int>(quilt_.elements[k].F.rows());
   for (const auto& [f, g] : pairs_) {
     const auto k = static_cast<size_t>(element_of_[f]);
     if (element_of_[f] != element_of_[g] || stale_[k] || folded_now[k]) continue;
