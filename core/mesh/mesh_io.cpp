@@ -21,6 +21,7 @@
 #include "core/common/errors.h"
 #include "core/mesh/atomic_file.h"
 #include "core/mesh/corner_normals.h"
+#include "core/mesh/decimal_format.h"
 #include "core/mesh/element_kinds.h"
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/gltf_writer.h"
@@ -878,11 +879,7 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
 // Writing
 
 inline char* put_double(char* out, double v, int precision) {
-  // 17 significant digits already round-trip; more only adds noise.
-  const auto r = precision <= 0 ? std::to_chars(out, out + 32, v)
-                                : std::to_chars(out, out + 32, v, std::chars_format::general,
-                                                std::min(precision, 17));
-  return r.ptr;
+  return format_decimal(out, v, precision);
 }
 inline char* put_int(char* out, long long v) { return std::to_chars(out, out + 24, v).ptr; }
 
