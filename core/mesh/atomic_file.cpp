@@ -244,11 +244,22 @@ void AtomicOutputFile::commit() {
 void AtomicOutputFile::flush() {
   write_raw(buffer_.data(), used_);
   used_ = 0;
+#ifdef __linux__
+  // Each full chunk handed to the kernel starts its write-back now, so that it overlaps the
+  // making of the next chunks and commit()'s fsync waits only for the tail (ivy wall: fsync
+  // 0.3 s of the 0.9 s writing 2M faces). A hint: fsync still decides, and reports errors.
+  if (written_ - started_ >= kChunk && std::fflush(file_) == 0) {
+    ::sync_file_range(::fileno(file_), static_cast<off64_t>(started_),
+                      static_cast<off64_t>(written_ - started_), SYNC_FILE_RANGE_WRITE);
+    started_ = written_;
+  }
+#endif
 }
 
 void AtomicOutputFile::write_raw(const char* s, size_t n) {
   if (n > 0 && std::fwrite(s, 1, n, file_) != n)
     MQ_THROW(Error, path_, ": cannot write: ", std::strerror(errno));
+  written_ += n;
 }
 
 void write_file_atomically(const std::string& path, std::string_view bytes) {

@@ -45,6 +45,8 @@ class AtomicOutputFile {
   std::FILE* file_ = nullptr;
   std::vector<char> buffer_;
   size_t used_ = 0;
+  size_t written_ = 0;  // bytes handed to the file
+  size_t started_ = 0;  // of them, those whose write-back was started
   bool committed_ = false;
   int slot_ = -1;  // in the signal handler's list of temporaries
 };
