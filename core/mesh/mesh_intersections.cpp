@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "core/common/errors.h"
+#include "core/mesh/flat_stars.h"
 #include "core/mesh/geometry_measures.h"
 #include "core/mesh/mesh_topology.h"
 
@@ -119,7 +120,10 @@ bool segment_triangle_intersect(const Vector3d& p, const Vector3d& q, const Vect
 }
 
 // Face pair test with combinatorial sharing taken into account (see IntersectionOptions).
-bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
+// flat (optional, #V): flat_stars' verdicts; two faces sharing only a vertex whose star is flat
+// meet only there.
+bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g,
+                     const std::vector<char>* flat = nullptr) {
   std::array<int, 3> shared_f{}, shared_g{};
   int num_shared = 0;
   for (int i = 0; i < 3; ++i)
@@ -148,7 +152,8 @@ bool faces_intersect(const MatrixX3d& V, const MatrixX3i& F, int f, int g) {
     return orient2d(u2, v2, project(P(f, a), k)) * orient2d(u2, v2, project(P(g, b), k)) > 0;
   }
   // One shared vertex s: the (convex) intersection contains s, and it contains more iff the
-  // edge opposite s of one face meets the other face.
+  // edge opposite s of one face meets the other face; never when s's star is flat.
+  if (flat && (*flat)[static_cast<size_t>(F(f, shared_f[0]))]) return false;
   const int fa = (shared_f[0] + 1) % 3, fb = (shared_f[0] + 2) % 3;
   const int ga = (shared_g[0] + 1) % 3, gb = (shared_g[0] + 2) % 3;
   return segment_triangle_intersect(P(f, fa), P(f, fb), P(g, 0), P(g, 1), P(g, 2)) ||
@@ -319,8 +324,8 @@ FaceGrid face_grid(const MatrixX3d& V, const MatrixX3i& F, const std::vector<int
 // Pairs (f, g), f < g, in ascending order, whatever the threads.
 std::vector<std::pair<int, int>> pairs_by_cell(const MatrixX3d& V, const MatrixX3i& F,
                                                const FaceGrid& grid, bool labelled, bool same_label,
-                                               const std::vector<char>* active,
-                                               bool stop_at_first) {
+                                               const std::vector<char>* active, bool stop_at_first,
+                                               const std::vector<char>* flat) {
   const int num_cells = grid.n[0] * grid.n[1] * grid.n[2];
   constexpr int kCells = 4096;
   const int blocks = (num_cells + kCells - 1) / kCells;
@@ -359,8 +364,8 @@ std::vector<std::pair<int, int>> pairs_by_cell(const MatrixX3d& V, const MatrixX
           if (std::max(a.c0[0], b.c0[0]) != i || std::max(a.c0[1], b.c0[1]) != j ||
               std::max(a.c0[2], b.c0[2]) != k)
             continue;
-          if (on[x] ? faces_intersect(V, F, face[x], face[y])
-                    : faces_intersect(V, F, face[y], face[x])) {
+          if (on[x] ? faces_intersect(V, F, face[x], face[y], flat)
+                    : faces_intersect(V, F, face[y], face[x], flat)) {
             out.emplace_back(face[x], face[y]);
             if (stop_at_first) {
               any.store(true, std::memory_order_relaxed);
@@ -388,8 +393,26 @@ std::vector<std::pair<int, int>> find_pairs(const MatrixX3d& V, const MatrixX3i&
   MQ_CHECK(V.allFinite(), InvalidInput, "intersection test: vertex positions are not finite");
   MQ_CHECK(F.minCoeff() >= 0 && F.maxCoeff() < V.rows(), InvalidInput,
            "intersection test: face index out of range [0, ", V.rows(), ")");
-  std::vector<std::pair<int, int>> result = pairs_by_cell(
-      V, F, face_grid(V, F, label, active), label != nullptr, same_label, active, stop_at_first);
+  // Faces sharing a vertex are tested only when the labels let faces of one component meet;
+  // with an active set every pair has an active face, whose vertex any shared one is. A few
+  // active faces have too few such pairs to pay for the stars' pass over the faces.
+  std::vector<char> flat;
+  const auto num_active =
+      active ? std::count_if(active->begin(), active->end(), [](char a) { return a != 0; })
+             : static_cast<std::ptrdiff_t>(F.rows());
+  if ((!label || same_label) && 8 * num_active >= F.rows()) {
+    std::vector<char> needed;
+    if (active) {
+      needed.assign(static_cast<size_t>(V.rows()), 0);
+      for (Eigen::Index f = 0; f < F.rows(); ++f)
+        if ((*active)[static_cast<size_t>(f)])
+          for (int k = 0; k < 3; ++k) needed[static_cast<size_t>(F(f, k))] = 1;
+    }
+    flat = flat_stars(V, F, active ? &needed : nullptr);
+  }
+  std::vector<std::pair<int, int>> result =
+      pairs_by_cell(V, F, face_grid(V, F, label, active), label != nullptr, same_label, active,
+                    stop_at_first, flat.empty() ? nullptr : &flat);
   if (stop_at_first && result.size() > 1) result.resize(1);
   return result;
 }
