@@ -68,7 +68,9 @@ TEST(FlatStars, BordersOfAFlatSheetAreJudgedConservatively) {
                         (std::abs(y) < 1e-12 || std::abs(y - 1) < 1e-12);
     // Interior and edge vertices (a half turn) are flat; a corner's gap of 270 or 90 degrees is
     // left to the exact test or judged flat, never wrongly.
-    if (!corner) EXPECT_TRUE(flat[static_cast<size_t>(v)]) << v;
+    if (!corner) {
+      EXPECT_TRUE(flat[static_cast<size_t>(v)]) << v;
+    }
   }
 }
 
@@ -136,7 +138,9 @@ TEST(FlatStars, FlatFansNeverCrossAndTheIntersectionTestAgreesEitherWay) {
         if (shared == 1 && meet_beyond_centre(m, f, g)) crossing.emplace_back(f, g);
       }
     crossing_fans += !crossing.empty();
-    if (flat) EXPECT_TRUE(crossing.empty()) << "trial " << trial;
+    if (flat) {
+      EXPECT_TRUE(crossing.empty()) << "trial " << trial;
+    }
     // Pairs sharing an edge are the library's alone (coplanar fold-overs); compare the rest.
     IntersectionOptions all;
     all.between_components_only = false;
