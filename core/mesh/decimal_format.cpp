@@ -57,12 +57,12 @@ char* format_decimal(char* out, double v, int precision) {
   if (m >= static_cast<std::uint64_t>(kPow10[precision])) return exact(out, v, precision);
   // The digits of m, precision of them (m >= 10^(precision - 1) since a >= 10^e).
   char digits[24];
-  int i = precision;
-  for (; i >= 2; i -= 2) {
-    std::memcpy(digits + i - 2, kPairs + 2 * (m % 100), 2);
+  int left = precision;  // digits not yet written, from the right
+  for (; left >= 2; left -= 2) {
+    std::memcpy(digits + left - 2, kPairs + 2 * (m % 100), 2);
     m /= 100;
   }
-  if (i == 1) digits[0] = static_cast<char>('0' + m);
+  if (left == 1) digits[0] = static_cast<char>('0' + m);
   int last = precision;  // one past the last digit kept: trailing zeros after the point go
   const int integer_digits = e >= 0 ? e + 1 : 0;
   while (last > integer_digits && digits[last - 1] == '0') --last;

@@ -10,6 +10,10 @@ namespace mq {
 
 namespace {
 
+constexpr double kMinSector = 1e-3;  // radians
+constexpr double kMinCosine = 0.1;   // faces within about 84 degrees of the mean normal
+constexpr int kMaxStar = 64;
+
 // One face of a star: the corners after the centre in the face's order, a then b.
 struct Wedge {
   int a, b;
@@ -69,18 +73,16 @@ bool flat_star(const MatrixX3d& V, int c, const Wedge* w, int k) {
   const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return a.x() * b.y() - a.y() * b.x();
   };
+  // Each wedge has one successor and one predecessor at most: the walk visits none twice.
   const Eigen::Vector2d u0 = planar(w[start].a);
-  Eigen::Vector2d last = u0;
+  Eigen::Vector2d last;
   int visited = 0, containing = 0;
-  for (int i = start;;) {
+  for (int i = start; visited == 0 || (i >= 0 && i != start); i = next[static_cast<size_t>(i)]) {
     const Eigen::Vector2d ua = planar(w[i].a), ub = planar(w[i].b);
     if (!(cross(ua, ub) >= min_sine * ua.norm() * ub.norm())) return false;
     if (cross(ua, u0) >= 0 && cross(u0, ub) > 0) ++containing;
     last = ub;
     ++visited;
-    i = next[static_cast<size_t>(i)];
-    if (i < 0 || i == start) break;
-    if (visited > k) return false;
   }
   if (visited != k || containing != 1) return false;
   if (cycle) return true;

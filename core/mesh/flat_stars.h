@@ -13,18 +13,14 @@ namespace mq {
 // Per vertex, 1 when its faces form one fan (a cycle round it, or a chain for a vertex on a
 // border, each face joined to the next by an edge through the vertex, consistently oriented)
 // that projects one-to-one onto the plane normal to the fan's mean normal: every face's sector
-// at the vertex turns the same way by at least kMinSector radians, every face within
-// acos(kMinCosine) of the mean normal, the sectors round the vertex once (a chain with a gap of
-// kMinSector). 0 otherwise, and for vertices of no face or of more than kMaxStar faces. Margins
-// make the verdict hold for the floating-point face test too.
+// at the vertex turns the same way by at least 1e-3 radians, every face within about 84 degrees
+// of the mean normal, the sectors round the vertex once (a chain with a gap of 1e-3). 0
+// otherwise, and for vertices of no face or of more than 64 faces. Margins make the verdict
+// hold for the floating-point face test too.
 //   V #V by 3 finite, F #F by 3 indices into V
 //   needed (optional, #V): only these vertices are judged (the others 0)
 // Throws nothing (V and F are the caller's, checked there).
 std::vector<char> flat_stars(const MatrixX3d& V, const MatrixX3i& F,
                              const std::vector<char>* needed = nullptr);
-
-constexpr double kMinSector = 1e-3;  // radians
-constexpr double kMinCosine = 0.1;   // faces within about 84 degrees of the mean normal
-constexpr int kMaxStar = 64;
 
 }  // namespace mq

@@ -878,9 +878,6 @@ TriMesh read_ply(const std::string& path, const std::string& data) {
 // ---------------------------------------------------------------------------------------------
 // Writing
 
-inline char* put_double(char* out, double v, int precision) {
-  return format_decimal(out, v, precision);
-}
 inline char* put_int(char* out, long long v) { return std::to_chars(out, out + 24, v).ptr; }
 
 // Writes " x y z" (or "x y z" when !leading_space).
@@ -888,7 +885,7 @@ inline char* put_row(char* out, const MatrixX3d& M, Eigen::Index i, int precisio
                      bool leading_space = true) {
   for (int k = 0; k < 3; ++k) {
     if (k > 0 || leading_space) *out++ = ' ';
-    out = put_double(out, M(i, k), precision);
+    out = format_decimal(out, M(i, k), precision);
   }
   return out;
 }
