@@ -226,7 +226,7 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
 void declare_surface_options(CommandLine& cl) {
   cl.option("base", "FILE", "base mesh (OBJ, PLY or OFF)");
   cl.option("swatch", "FILE", "swatch mesh; its smallest bounding-box side is the shell height");
-  cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb)");
+  cl.option("output", "FILE", "output mesh (.obj, .ply, .off or .glb; not needed with --estimate)");
   cl.option("scale", "S", "swatch's longer side as a fraction of the base's bounding-box diagonal",
             "0.1");
   cl.option("element-size", "L",
@@ -320,7 +320,8 @@ struct SurfaceRequest {
 SurfaceRequest parse_surface_request(const CommandLine& cl) {
   if (!cl.has("base")) throw UsageError("--base FILE is required");
   if (!cl.has("swatch")) throw UsageError("--swatch FILE is required");
-  if (!cl.has("output")) throw UsageError("-o OUT is required");
+  // --estimate writes nothing, so it needs no output name.
+  if (!cl.has("output") && !cl.has("estimate")) throw UsageError("-o OUT is required");
   if (cl.has("field") + cl.has("field-file") + cl.has("keys") > 1)
     throw UsageError("give at most one of --field, --field-file and --keys");
   SurfaceRequest r;
@@ -330,8 +331,9 @@ SurfaceRequest parse_surface_request(const CommandLine& cl) {
   std::vector<std::string> outputs, inputs{cl.get("base"), cl.get("swatch"), cl.get("field-file"),
                                            cl.get("keys"), cl.get("mask")};
   for (const SwatchFrame& f : r.frames) inputs.push_back(f.swatch);
-  for (const std::string& out :
-       r.frames.empty() ? std::vector<std::string>{r.out_path} : std::vector<std::string>{}) {
+  for (const std::string& out : r.frames.empty() && !r.out_path.empty()
+                                    ? std::vector<std::string>{r.out_path}
+                                    : std::vector<std::string>{}) {
     mesh_format_from_path(out);
     for (const std::string& file : output_files(out, r.write_options)) outputs.push_back(file);
   }
