@@ -10,6 +10,7 @@
 #include "core/mesh/embree_device.h"
 #include "core/mesh/mesh_topology.h"
 #include "core/planar/patch_quilting.h"
+#include "core/planar/swatch_density.h"
 #include "core/planar/swatch_symmetry.h"
 #include "core/planar/synthesis_grid.h"
 
@@ -95,8 +96,8 @@ void check_against_swatch(const PreparedSwatch& s, const PlanarQuiltingOptions& 
   // Output size estimate, to refuse jobs that cannot fit before any work.
   const double faces = estimated_plane_faces(s, o.length, o.width);
   MQ_CHECK(faces <= o.max_faces, InvalidInput, "a ", o.length, " x ", o.width,
-           " layer of this swatch would have about ", faces, " faces, more than the limit of ",
-           o.max_faces, " (--max-faces); choose a smaller size");
+           " layer of this swatch would have about ", std::round(faces),
+           " faces, more than the limit of ", o.max_faces, " (--max-faces); choose a smaller size");
 }
 
 // The grid cell (section 2.3): given or matching_cell_size's. The grid and the swatch in cells
@@ -302,9 +303,8 @@ void PlanarQuiltingOptions::validate() const {
 }
 
 double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width) {
-  const double sx = swatch.size.x(), sy = swatch.size.y();
-  return static_cast<double>(swatch.mesh.F.rows()) * std::max(length, sx) * std::max(width, sy) /
-         (sx * sy);
+  return swatch_face_density(swatch) * std::max(length, swatch.size.x()) *
+         std::max(width, swatch.size.y());
 }
 
 double matching_cell_size(const PreparedSwatch& s) {

@@ -40,8 +40,9 @@ struct PlanarQuiltingOptions {
   void validate() const;
 };
 
-// Estimated faces of a length x width layer of the swatch: whole swatch copies, so a strip
-// thinner than the swatch still costs a swatch's width.
+// Estimated faces of a length x width layer of the swatch: its pattern's faces per area
+// (swatch_face_density) over the layer, at least a swatch wide and long (a strip thinner than
+// the swatch still costs a swatch's width).
 double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width);
 
 struct PlanarQuiltingStats {

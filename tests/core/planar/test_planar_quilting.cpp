@@ -73,6 +73,8 @@ TEST(PlanarQuilting, ChainMailKeepsItsLinksAndDensity) {
     EXPECT_GE(cmp.density_ratio, 0.95);
     EXPECT_LE(cmp.density_ratio, 1.05);
     EXPECT_EQ(r.isolated_rings, 0);
+    // The size check's estimate (--max-faces): within 10% of the faces made.
+    EXPECT_NEAR(estimated_plane_faces(prepare_swatch(swatch), 16, 16) / out.num_faces(), 1.0, 0.1);
   }
 }
 
