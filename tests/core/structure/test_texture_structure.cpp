@@ -515,6 +515,30 @@ TEST(TextureStructure, ThreadsHaveTwoEndsAndBreaksAreCounted) {
   EXPECT_EQ(apples.rings, 0);
 }
 
+// Studs (12-face boxes 0.3 x 0.3 x 0.1, as tiles or scales are made) are compact: the edge path
+// between a box's far corners zigzags to 0.7 (the box spans 0.44), over four times the width a
+// tube of the box's area and that length would have, so they counted as threads (a surface job
+// warned of threads cut short). A bar as long as the swatch stays long.
+TEST(TextureStructure, CoarseBoxesAreCompactAndBarsLong) {
+  const Eigen::Matrix3d stud = Vector3d(0.3, 0.3, 0.1).asDiagonal();
+  TriMesh studs;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      const TriMesh box = moved(test::unit_cube(), stud, Vector3d(i, j, 0));
+      if (studs.empty())
+        studs = box;
+      else
+        append_mesh(studs, box);
+    }
+  const StructureReport r = measure_structure(studs);
+  EXPECT_EQ(r.long_elements, 0);
+  EXPECT_EQ(r.compact_elements, 25);
+  const Eigen::Matrix3d bar = Vector3d(8, 0.3, 0.1).asDiagonal();
+  TriMesh bars = moved(test::unit_cube(), bar, Vector3d::Zero());
+  append_mesh(bars, moved(test::unit_cube(), bar, Vector3d(0, 1, 0)));
+  EXPECT_EQ(measure_structure(bars).long_elements, 2);
+}
+
 // Vines in swatch-sized pieces measure 1 swatch vine; a section three times as long with three
 // times the leaves measures about 3, at the swatch's leaves per length; one of its leaves
 // taken away shows in that ratio.
