@@ -42,7 +42,7 @@ struct PlanarQuiltingOptions {
 
 // Estimated faces of a length x width layer of the swatch: its pattern's faces per area
 // (swatch_face_density) over the layer, at least a swatch wide and long (a strip thinner than
-// the swatch still costs a swatch's width).
+// the swatch still costs a swatch's width), threads with the part that runs past the border.
 double estimated_plane_faces(const PreparedSwatch& swatch, double length, double width);
 
 struct PlanarQuiltingStats {

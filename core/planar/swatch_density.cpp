@@ -70,27 +70,28 @@ bool hull_count(const std::vector<Vector2d>& centre, const std::vector<double>& 
 
 }  // namespace
 
-double swatch_face_density(const PreparedSwatch& swatch) {
+SwatchFaceDensity swatch_face_density(const PreparedSwatch& swatch) {
   const double sx = swatch.size.x(), sy = swatch.size.y();
   std::vector<Vector2d> centre;
   std::vector<double> faces;
-  double other_faces = 0;
+  SwatchFaceDensity d;
   for (const Element& e : swatch.elements) {
     const Vector2d side = e.hi - e.lo;
+    const auto n = static_cast<double>(e.F.rows());
     if (side.x() <= kCompactShare * sx && side.y() <= kCompactShare * sy) {
       centre.push_back((e.lo + e.hi) / 2);
-      faces.push_back(static_cast<double>(e.F.rows()));
+      faces.push_back(n);
     } else {
-      other_faces += static_cast<double>(e.F.rows());
+      (side.x() / sx >= side.y() / sy ? d.along_x : d.along_y) += n / (sx * sy);
     }
   }
   double weighted = 0, area = 0;
-  if (!hull_count(centre, faces, 1e-6 * std::max(sx, sy), weighted, area)) {
-    for (double f : faces) other_faces += f;
-    weighted = 0;
-    area = 1;
+  if (hull_count(centre, faces, 1e-6 * std::max(sx, sy), weighted, area)) {
+    d.compact = weighted / area;
+  } else {
+    for (double f : faces) d.compact += f / (sx * sy);
   }
-  return weighted / area + other_faces / (sx * sy);
+  return d;
 }
 
 }  // namespace mq

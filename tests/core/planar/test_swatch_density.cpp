@@ -49,14 +49,16 @@ TEST(SwatchDensity, SquareLatticeIsExactWhateverTheOverhang) {
     for (const auto& [rows, cols] : {std::pair{3, 3}, std::pair{4, 6}, std::pair{7, 5}}) {
       const PreparedSwatch s = prepare_swatch(box_lattice(rows, cols, 1.0, 1.0, 0.0, side));
       SCOPED_TRACE(testing::Message() << rows << " x " << cols << ", side " << side);
-      EXPECT_NEAR(swatch_face_density(s), 12.0, 1e-9);
+      const SwatchFaceDensity d = swatch_face_density(s);
+      EXPECT_NEAR(d.compact, 12.0, 1e-9);
+      EXPECT_EQ(d.along_x + d.along_y, 0.0);
     }
 }
 
 TEST(SwatchDensity, ShiftedRowsAndRectangularCells) {
   // Rows shifted by half a cell (a centred lattice, as 4-in-1 chain mail): area per box p * q.
   const PreparedSwatch s = prepare_swatch(box_lattice(5, 6, 1.5, 0.8, 0.75, 0.5));
-  EXPECT_NEAR(swatch_face_density(s), 12.0 / (1.5 * 0.8), 1e-9);
+  EXPECT_NEAR(swatch_face_density(s).compact, 12.0 / (1.5 * 0.8), 1e-9);
 }
 
 TEST(SwatchDensity, TwoKindsOfElementOnOneLattice) {
@@ -67,22 +69,28 @@ TEST(SwatchDensity, TwoKindsOfElementOnOneLattice) {
     for (int c = 0; c < 4; ++c) add_box(m, Vector3d(c + 0.6, r + 0.6, 0), 0.2, 0.2, 0.1);
   const PreparedSwatch s = prepare_swatch(m);
   // The hull holds 4 x 4 cells: 16 of each kind, counted exactly; the density is 24 per cell.
-  EXPECT_NEAR(swatch_face_density(s), 24.0, 1e-9);
+  EXPECT_NEAR(swatch_face_density(s).compact, 24.0, 1e-9);
 }
 
 TEST(SwatchDensity, ThreadsAndLoneElementsCountOverTheSwatchBox) {
-  // Threads run the swatch's length: no lattice of centres, so faces over the box.
+  // Threads run the swatch's length: no lattice of centres, faces over the box, by direction.
   TriMesh threads = empty_mesh();
   for (int i = 0; i < 4; ++i) add_box(threads, Vector3d(0, i * 1.0, 0), 8.0, 0.3, 0.1);
-  const PreparedSwatch t = prepare_swatch(threads);
-  EXPECT_NEAR(swatch_face_density(t), 48.0 / (8.0 * 3.3), 1e-9);
-  // One element, or centres in a row (no area): the same rule.
+  add_box(threads, Vector3d(2, -1, 0), 0.3, 5.0, 0.1);  // one across them, along y
+  const SwatchFaceDensity t = swatch_face_density(prepare_swatch(threads));
+  EXPECT_NEAR(t.along_x, 48.0 / (8.0 * 5.0), 1e-9);
+  EXPECT_NEAR(t.along_y, 12.0 / (8.0 * 5.0), 1e-9);
+  EXPECT_EQ(t.compact, 0.0);
+  // One element spans the swatch: over the box. Centres in a row (no area): compact, over it.
   TriMesh one = empty_mesh();
   add_box(one, Vector3d::Zero(), 1.0, 2.0, 0.1);
-  EXPECT_NEAR(swatch_face_density(prepare_swatch(one)), 12.0 / 2.0, 1e-9);
+  const SwatchFaceDensity o = swatch_face_density(prepare_swatch(one));
+  EXPECT_NEAR(o.compact + o.along_x + o.along_y, 12.0 / 2.0, 1e-9);
   TriMesh row = box_lattice(1, 5, 1.0, 1.0, 0.0, 0.5);
   add_box(row, Vector3d(5.5, 0, 0), 0.3, 2.0, 0.1);  // a bar the swatch's height: not compact
-  EXPECT_NEAR(swatch_face_density(prepare_swatch(row)), 72.0 / (5.8 * 2.0), 1e-9);
+  const SwatchFaceDensity r = swatch_face_density(prepare_swatch(row));
+  EXPECT_NEAR(r.compact, 60.0 / (5.8 * 2.0), 1e-9);
+  EXPECT_NEAR(r.along_y, 12.0 / (5.8 * 2.0), 1e-9);
 }
 
 }  // namespace
