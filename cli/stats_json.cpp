@@ -13,6 +13,7 @@ void write_element_counts(JsonWriter& j, const PatchCounts& c) {
       .value("matched", c.matched)
       .value("dropped", c.dropped)
       .value("stitch_fallbacks", c.stitch_fallbacks)
+      .value("pieces_beyond", c.pieces_beyond)
       .value("rejected_intersecting", c.rejected_intersecting);
 }
 

@@ -9,12 +9,23 @@
 #include <optional>
 
 #include "core/common/errors.h"
+#include "core/mesh/boundary_loops.h"
+#include "core/mesh/closest_point_query.h"
 #include "core/mesh/mesh_intersections.h"
+#include "core/mesh/mesh_topology.h"
 #include "core/planar/laplacian_deformation.h"
 
 namespace mq {
 
 namespace {
+
+// An element whose footprint is this many times longer than wide is a thread (a piece of it
+// is still one); a compact element cut in part is a broken ring or half an apple.
+constexpr double kThreadAspect = 4.0;
+// Pieces under this share of their thread's faces are not kept: two more ends for little
+// ground (with a tenth, the gallery's 20 x 20 weave had 88 interior ends and its median thread
+// fell to 1.47 swatch threads, under the structure check's 1.5).
+constexpr double kMinPieceShare = 0.5;
 
 bool boxes_overlap(const Element& a, const Element& b) {
   return a.lo.x() <= b.hi.x() && b.lo.x() <= a.hi.x() && a.lo.y() <= b.hi.y() &&
@@ -244,6 +255,10 @@ class PatchMerger {
     if (crossing.empty()) return replace(in, replaced_ids);
     if (crossing.size() != 1 || busy_[crossing[0]]) {
       ++counts_.dropped;
+      std::vector<int> ids;
+      ids.reserve(related.size());
+      for (const int k : related) ids.push_back(patch_.near[k]);
+      keep_beyond_partners(in, ids);
       return true;
     }
     stitch(i, crossing[0], replaced_ids);
@@ -312,7 +327,85 @@ class PatchMerger {
     } else {
       ++counts_.stitch_fallbacks;
       ++counts_.stitch_failures[static_cast<int>(joined ? StitchFailure::None : why)];
+      keep_beyond_partners(patch_.moved[i], {patch_.near[k]});
     }
+  }
+
+  // A thread whose stitch is refused (or whose partners are ambiguous) still runs over ground
+  // its partners do not reach, which on the plane no later patch is seeded on
+  // (MergeOptions::pieces_beyond): dropped whole, it left a stretch of the layer without that
+  // direction's threads (the wire job: three threads missing over four spacings). Its faces farther
+  // than a thread's width from every partner enter instead, each connected piece capped where it
+  // was cut, if it fits: two thread ends a little apart rather than a gap. Compact elements (rings,
+  // apples) never enter in part.
+  void keep_beyond_partners(const Element& in, const std::vector<int>& partners) {
+    if (!options_.pieces_beyond) return;
+    const Vector2d side = in.hi - in.lo;
+    if (!(side.maxCoeff() >= kThreadAspect * side.minCoeff())) return;
+    const double reach = side.minCoeff() + mean_edge_;
+    std::vector<char> covered(static_cast<size_t>(in.V.rows()), 0);
+    for (const int id : partners) {
+      if (!output_.alive(id)) continue;
+      const Element& p = output_.element(id);
+      const ClosestPointQuery query(queries_.embree, p.V, p.F);
+      const std::vector<ClosestPointHit> hits = query.closest(in.V, reach);
+      for (size_t v = 0; v < hits.size(); ++v) covered[v] |= hits[v].face >= 0 ? 1 : 0;
+    }
+    std::vector<int> beyond;
+    for (int f = 0; f < in.F.rows(); ++f)
+      if (!covered[static_cast<size_t>(in.F(f, 0))] && !covered[static_cast<size_t>(in.F(f, 1))] &&
+          !covered[static_cast<size_t>(in.F(f, 2))])
+        beyond.push_back(f);
+    if (beyond.empty() || beyond.size() == static_cast<size_t>(in.F.rows())) return;
+    const Element part = element_part(in, beyond);
+    std::vector<int> component;
+    const int pieces = connected_components(part.F, static_cast<int>(part.V.rows()), component);
+    for (int c = 0; c < pieces; ++c) {
+      std::vector<int> faces;
+      for (int f = 0; f < part.F.rows(); ++f)
+        if (component[static_cast<size_t>(f)] == c) faces.push_back(f);
+      if (static_cast<double>(faces.size()) < kMinPieceShare * static_cast<double>(in.F.rows()))
+        continue;
+      std::optional<Element> piece = capped(element_part(part, faces));
+      if (piece && fits(output_, *piece, {})) {
+        output_.add(std::move(*piece));
+        ++counts_.pieces_beyond;
+      }
+    }
+  }
+
+  // e with each boundary loop closed by a fan from the loop's centroid; none when its boundary
+  // is not a set of simple loops.
+  static std::optional<Element> capped(Element e) {
+    std::vector<std::vector<int>> loops;
+    try {
+      loops = boundary_loops(e.F, static_cast<int>(e.V.rows()));
+    } catch (const TopologyError&) {
+      return std::nullopt;
+    }
+    const bool sourced = !e.source_element.empty();
+    for (const std::vector<int>& loop : loops) {
+      const auto c = static_cast<int>(e.V.rows());
+      const auto m = static_cast<int>(loop.size());
+      Vector3d centre = Vector3d::Zero(), source = Vector3d::Zero();
+      for (const int v : loop) {
+        centre += e.V.row(v).transpose() / m;
+        if (sourced) source += e.source.row(v).transpose() / m;
+      }
+      e.V.conservativeResize(c + 1, 3);
+      e.V.row(c) = centre.transpose();
+      if (sourced) {
+        e.source.conservativeResize(c + 1, 3);
+        e.source.row(c) = source.transpose();
+        e.source_element.push_back(e.source_element[static_cast<size_t>(loop.front())]);
+      }
+      // The loop runs as in its faces: the cap runs each edge the other way.
+      const Eigen::Index f0 = e.F.rows();
+      e.F.conservativeResize(f0 + m, 3);
+      for (int i = 0; i < m; ++i) e.F.row(f0 + i) << c, loop[(i + 1) % m], loop[i];
+    }
+    e.update();
+    return e;
   }
 
   PatchOutput& output_;
@@ -342,6 +435,7 @@ void accumulate(PatchCounts& a, const PatchCounts& b) {
   a.matched += b.matched;
   a.dropped += b.dropped;
   a.stitch_fallbacks += b.stitch_fallbacks;
+  a.pieces_beyond += b.pieces_beyond;
   a.rejected_intersecting += b.rejected_intersecting;
   for (int k = 0; k < kStitchFailureKinds; ++k) a.stitch_failures[k] += b.stitch_failures[k];
 }

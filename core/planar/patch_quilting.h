@@ -56,6 +56,7 @@ struct PatchCounts {
   int matched = 0;                // partners that are the same element: output kept
   int dropped = 0;                // swatch elements inside the overlap or with ambiguous partners
   int stitch_fallbacks = 0;       // cut-and-stitch refused: output kept whole
+  int pieces_beyond = 0;          // of those, a thread's pieces beyond the overlap added, capped
   int rejected_intersecting = 0;  // candidates that would intersect existing elements
   std::array<int, kStitchFailureKinds> stitch_failures{};  // fallbacks by StitchFailure
 };

@@ -139,6 +139,7 @@ class PlaneQuilter {
     stats.grid_ny = grid_.ny();
     patch_options_.correspondence = options.correspondence;
     patch_options_.merging = options.merging;
+    patch_options_.merging.pieces_beyond = true;  // the grid marks whole patches (see there)
     patch_options_.deform = options.deform;
     in_domain_ = [this](const Element& e) {
       return e.hi.x() > domain_lo_.x() && e.lo.x() < domain_hi_.x() && e.hi.y() > domain_lo_.y() &&

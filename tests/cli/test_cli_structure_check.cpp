@@ -104,16 +104,18 @@ TEST_F(CliStructureCheck, WeaveByPatchesOnAPlaneIsFlaggedForThreadsCutAtSeams) {
 
 TEST_F(CliStructureCheck, PlaneFromASwatchOfTwoThreadsEachWayIsFlagged) {
   // Two threads each way leave the patches nothing to carry a thread on across their overlaps:
-  // every thread is cut where patches meet (measured: 1.00 swatch threads, 95 of 178 ends
-  // inside the layer); the 6 x 6 sample runs 2.09 swatch threads on the same layer.
+  // every thread is cut where patches meet (measured: 0.98 swatch threads; 1.00 before a thread
+  // whose stitch is refused entered in part); the 6 x 6 sample runs 2.09 swatch threads on the
+  // same layer.
   ASSERT_EQ(meshquilt(dir_, "swatch weave --rows 2 --cols 2 -o small.obj --quiet").status, 0);
   ASSERT_EQ(meshquilt(dir_, "swatch weave -o sample.obj --quiet").status, 0);
   const std::string job = "plane --size 12 12 -o o.ply --quiet --stats s.json --swatch ";
   const CliRun small = meshquilt(dir_, job + "small.obj");
   ASSERT_EQ(small.status, 0) << small.err;
-  EXPECT_NE(small.err.find("meshquilt plane: warning: the median thread runs 1.00 swatch threads"),
-            std::string::npos)
-      << small.err;
+  const std::string warning = "meshquilt plane: warning: the median thread runs ";
+  const size_t at = small.err.find(warning);
+  ASSERT_NE(at, std::string::npos) << small.err;
+  EXPECT_LT(std::stod(small.err.substr(at + warning.size())), 1.05) << small.err;
   EXPECT_EQ(json_value(slurp(dir_ + "/s.json"), "passed"), "false");
   const CliRun sample = meshquilt(dir_, job + "sample.obj");
   ASSERT_EQ(sample.status, 0) << sample.err;
