@@ -19,9 +19,6 @@ namespace mq {
 
 namespace {
 
-// An element whose footprint is this many times longer than wide is a thread (a piece of it
-// is still one); a compact element cut in part is a broken ring or half an apple.
-constexpr double kThreadAspect = 4.0;
 // Pieces under this share of their thread's faces are not kept: two more ends for little
 // ground (with a tenth, the gallery's 20 x 20 weave had 88 interior ends and its median thread
 // fell to 1.47 swatch threads, under the structure check's 1.5).
@@ -339,10 +336,9 @@ class PatchMerger {
   // was cut, if it fits: two thread ends a little apart rather than a gap. Compact elements (rings,
   // apples) never enter in part.
   void keep_beyond_partners(const Element& in, const std::vector<int>& partners) {
-    if (!options_.pieces_beyond) return;
-    const Vector2d side = in.hi - in.lo;
-    if (!(side.maxCoeff() >= kThreadAspect * side.minCoeff())) return;
-    const double reach = side.minCoeff() + mean_edge_;
+    // A compact element cut in part is a broken ring or half an apple.
+    if (!options_.pieces_beyond || !in.long_footprint()) return;
+    const double reach = (in.hi - in.lo).minCoeff() + mean_edge_;
     std::vector<char> covered(static_cast<size_t>(in.V.rows()), 0);
     for (const int id : partners) {
       if (!output_.alive(id)) continue;

@@ -29,6 +29,11 @@ struct Element {
   // Translates by t, keeping normals.
   void translate(const Vector3d& t);
   double footprint_diameter() const { return (hi - lo).norm(); }
+  // A footprint at least 4 times longer than wide: a thread or a vine, or a piece of one.
+  bool long_footprint() const {
+    const Vector2d side = hi - lo;
+    return side.maxCoeff() >= 4 * side.minCoeff();
+  }
   // The element as a plain mesh (V and F copied, no normals).
   TriMesh mesh() const {
     TriMesh m;

@@ -123,10 +123,9 @@ SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<in
     first.push_back(first.back() +
                     static_cast<Eigen::Index>(quilt.elements[static_cast<size_t>(k)].face.size()));
   if (quilt.stitched) find_parts(quilt, kept, source, first);
-  // Long swatch elements: footprints at least 4 times longer than wide (thread_tiling's measure).
+  // Long swatch elements (thread_tiling's measure).
   std::vector<char> long_element;
-  for (const Element& e : prepared.elements)
-    long_element.push_back((e.hi - e.lo).maxCoeff() >= 4 * (e.hi - e.lo).minCoeff());
+  for (const Element& e : prepared.elements) long_element.push_back(e.long_footprint());
   const bool any_long =
       std::find(long_element.begin(), long_element.end(), 1) != long_element.end();
   fade_ = quilt.stitched && any_long;

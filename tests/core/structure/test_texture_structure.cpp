@@ -523,13 +523,8 @@ TEST(TextureStructure, CoarseBoxesAreCompactAndBarsLong) {
   const Eigen::Matrix3d stud = Vector3d(0.3, 0.3, 0.1).asDiagonal();
   TriMesh studs;
   for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) {
-      const TriMesh box = moved(test::unit_cube(), stud, Vector3d(i, j, 0));
-      if (studs.empty())
-        studs = box;
-      else
-        append_mesh(studs, box);
-    }
+    for (int j = 0; j < 5; ++j)
+      append_mesh(studs, moved(test::unit_cube(), stud, Vector3d(i, j, 0)));
   const StructureReport r = measure_structure(studs);
   EXPECT_EQ(r.long_elements, 0);
   EXPECT_EQ(r.compact_elements, 25);
