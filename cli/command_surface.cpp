@@ -205,6 +205,7 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("limit_bytes", memory_limit_bytes)
       .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
       .value("huge_pages", huge_pages_on())
+      .value("freed_memory_kept", freed_memory_kept())
       .end_object()
       .value("swatch_coverage", swatch_cover)
       .value("min_coverage", min_coverage);

@@ -1,5 +1,6 @@
 #include "cli/huge_pages.h"
 
+#include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -9,6 +10,9 @@
 
 #if defined(__linux__)
 #include <unistd.h>
+#endif
+#if defined(__GLIBC__)
+#include <malloc.h>
 #endif
 
 namespace mq::cli {
@@ -111,5 +115,22 @@ bool huge_pages_on() {
   return glibc_with_tunable() && !sanitized() && contains(tunables, set.c_str()) &&
          !contains(tunables, off.c_str());
 }
+
+namespace {
+bool kept = false;
+}  // namespace
+
+bool keep_freed_memory() {
+#if defined(__GLIBC__)
+  if (sanitized()) return false;
+  const char* choice = std::getenv("MESHQUILT_KEEP_FREED");
+  if (choice != nullptr && std::strcmp(choice, "0") == 0) return false;
+  // Both succeed or the defaults stay (mallopt returns 0 on an invalid value only).
+  kept = ::mallopt(M_MMAP_MAX, 0) == 1 && ::mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1;
+#endif
+  return kept;
+}
+
+bool freed_memory_kept() { return kept; }
 
 }  // namespace mq::cli

@@ -30,4 +30,19 @@ bool host_reclaims_free_pages();
 // Whether this process runs with the tunable above (for --stats).
 bool huge_pages_on();
 
+// Keeps the blocks the run frees for its next allocations, unless MESHQUILT_KEEP_FREED is "0"
+// (issue 27): glibc's malloc maps every block over its threshold (at most 32 MiB) afresh and
+// unmaps it when freed, so each large array of a stage (the intersection test's face boxes,
+// 115 MB on the armor, made three times) faults its pages in and zeroes them again, and on a VM
+// a 4 KiB fault cost 19 us (2.87M boxes: 0.54 s; 0.01 s reused). With mmap off and no trimming,
+// large blocks come from the heap and go back to it. Paired runs (bench/results/paired_{new_keep_
+// freed,old_freed_unmapped}.json, 2 cores, no huge pages): the armor 0.81x the time, the bunny
+// 0.80x, the cup 0.76x, the ivy wall 0.87x; peak memory 1.03x, 1.02x, 0.99x and 1.10x (the
+// heap's free blocks do not always fit the next request). Same bytes. Returns whether it did
+// (glibc, no sanitizer: theirs replaces malloc). Call first in main.
+bool keep_freed_memory();
+
+// Whether keep_freed_memory did (for --stats).
+bool freed_memory_kept();
+
 }  // namespace mq::cli

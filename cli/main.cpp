@@ -33,7 +33,9 @@ constexpr const char* kUsage =
     "  where the kernel gives them on request: about 10-20% faster on large jobs, peak memory\n"
     "  a few percent higher; off on a virtual machine whose balloon reports free pages to the\n"
     "  host, where they were 1.1-1.5x slower; =1 asks for them there too; --stats says which\n"
-    "  in memory.huge_pages).\n"
+    "  in memory.huge_pages). MESHQUILT_KEEP_FREED=0 lets large freed blocks go back to the\n"
+    "  system at once (kept for the run's next arrays by default: fewer page faults, peak\n"
+    "  memory about 2% higher; memory.freed_memory_kept).\n"
     "\n";
 
 struct Command {
@@ -62,7 +64,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   mq::cli::restart_with_huge_pages(argv);  // returns when it does not restart
-  mq::install_temporary_file_cleanup();    // no .NAME.tmp-* left behind on SIGINT or SIGTERM
+  mq::cli::keep_freed_memory();
+  mq::install_temporary_file_cleanup();  // no .NAME.tmp-* left behind on SIGINT or SIGTERM
   for (const Command& c : kCommands) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
     try {

@@ -533,6 +533,23 @@ bool huge_pages_possible(bool asked = false) {
 #endif
 }
 
+// Whether the engine can keep freed blocks for its next arrays: glibc's malloc, no sanitizer.
+bool kept_possible() {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+  return false;
+#endif
+#endif
+#if defined(__GLIBC__)
+  return true;
+#else
+  return false;
+#endif
+}
+
 TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
   // The engine restarts itself once on huge pages where it can (--stats says so); the bytes must
   // not depend on it, and MESHQUILT_HUGE_PAGES=0 or the tunable set by the caller stop the restart.
@@ -555,6 +572,15 @@ TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
   const CliRun set = meshquilt(dir, job + " -o set/q.obj --stats set/q.json");
   unsetenv("GLIBC_TUNABLES");
   ASSERT_EQ(set.status, 0) << set.err;
+  // Freed blocks kept for the run's next arrays (cli/huge_pages.h keep_freed_memory), or not.
+  fs::create_directory(dir + "/unkept");
+  ASSERT_EQ(setenv("MESHQUILT_KEEP_FREED", "0", 1), 0);
+  const CliRun unkept = meshquilt(dir, job + " -o unkept/q.obj --stats unkept/q.json");
+  unsetenv("MESHQUILT_KEEP_FREED");
+  ASSERT_EQ(unkept.status, 0) << unkept.err;
+  EXPECT_EQ(json_value(slurp(dir + "/on/q.json"), "freed_memory_kept"),
+            kept_possible() ? "true" : "false");
+  EXPECT_EQ(json_value(slurp(dir + "/unkept/q.json"), "freed_memory_kept"), "false");
   EXPECT_EQ(json_value(slurp(dir + "/on/q.json"), "huge_pages"),
             huge_pages_possible() ? "true" : "false");
   EXPECT_EQ(json_value(slurp(dir + "/asked/q.json"), "huge_pages"),
@@ -566,6 +592,7 @@ TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
   EXPECT_TRUE(on == slurp(dir + "/off/q.obj"));
   EXPECT_TRUE(on == slurp(dir + "/set/q.obj"));
   EXPECT_TRUE(on == slurp(dir + "/asked/q.obj"));
+  EXPECT_TRUE(on == slurp(dir + "/unkept/q.obj"));
 }
 
 // The features string of /sys/bus/virtio/devices/*/features: bit 0 first; bit 5 is free page
