@@ -205,6 +205,8 @@ std::string stats_json(const SurfaceQuiltingStats& s, const QuiltEmbeddingStats&
       .value("limit_bytes", memory_limit_bytes)
       .value("peak_bytes", static_cast<double>(peak_memory_bytes()))
       .value("huge_pages", huge_pages_on())
+      .value("page_probe_small_us", page_probe().small_us)
+      .value("page_probe_huge_us", page_probe().huge_us)
       .value("freed_memory_kept", freed_memory_kept())
       .end_object()
       .value("swatch_coverage", swatch_cover)

@@ -1,14 +1,18 @@
 #include "cli/huge_pages.h"
 
+#include <algorithm>
+#include <chrono>
 #include <climits>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 
 #if defined(__linux__)
+#include <sys/mman.h>
 #include <unistd.h>
 #endif
 #if defined(__GLIBC__)
@@ -20,6 +24,8 @@ namespace mq::cli {
 namespace {
 
 constexpr const char* kTunable = "glibc.malloc.hugetlb";
+// The probe's figures, passed on to the restarted process for --stats.
+constexpr const char* kProbeVariable = "MESHQUILT_PAGE_PROBE";
 
 // Built with AddressSanitizer, ThreadSanitizer or MemorySanitizer (GCC's macro or clang's
 // feature test): their allocator replaces glibc's.
@@ -59,45 +65,80 @@ bool thp_on_request() {
   return modes.find("[madvise]") != std::string::npos;
 }
 
+// The figures of first_touch_probe, as measured in this process or passed on by the restart.
+PageProbe probe_figures;
+
+// Microseconds to fault in 2 MiB of fresh anonymous memory, one write per 4 KiB: on one huge
+// page (MADV_HUGEPAGE over an aligned block) or on small pages (MADV_NOHUGEPAGE); -1 when the
+// memory cannot be mapped.
+double first_touch_us(bool huge) {
+#if defined(__linux__)
+  constexpr size_t kHuge = size_t{2} << 20;
+  void* const raw =
+      ::mmap(nullptr, 2 * kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) return -1;
+  const auto address = reinterpret_cast<std::uintptr_t>(raw);
+  char* const block = static_cast<char*>(raw) + (kHuge - address % kHuge) % kHuge;
+  ::madvise(block, kHuge, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
+  const auto start = std::chrono::steady_clock::now();
+  volatile char* const touched = block;
+  for (size_t i = 0; i < kHuge; i += 4096) touched[i] = 1;
+  const double us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  ::munmap(raw, 2 * kHuge);
+  return us;
+#else
+  (void)huge;
+  return -1;
+#endif
+}
+
 }  // namespace
 
-bool reports_free_pages(const std::string& features) {
-  constexpr size_t kReportingBit = 5;
-  return features.size() > kReportingBit && features[kReportingBit] == '1';
+bool PageProbe::huge_pays() const { return huge_us >= 0 && small_us >= 0 && huge_us < small_us; }
+
+PageProbe first_touch_probe() {
+  PageProbe probe;
+  // Two rounds, alternating, the least of each: one slow fault (a timer tick, a migration)
+  // does not decide.
+  for (int round = 0; round < 2; ++round) {
+    const double huge = first_touch_us(true), small = first_touch_us(false);
+    if (huge < 0 || small < 0) return {};
+    probe.huge_us = round == 0 ? huge : std::min(probe.huge_us, huge);
+    probe.small_us = round == 0 ? small : std::min(probe.small_us, small);
+  }
+  return probe;
 }
 
-// Such a guest hands its free blocks of 2 MiB and more back to the host, and a huge page is
-// taken from exactly those, so zeroing it faults every 4 KiB of it in on the host. Measured on such
-// a VM (Firecracker, 2 cores): the armor job 16.0-17.1 s on huge pages against 12.1-12.4 s without,
-// the kernel's clear_page 34% of samples against under 1%.
-bool host_reclaims_free_pages() {
-#if defined(__linux__)
-  std::error_code error;
-  for (const auto& device :
-       std::filesystem::directory_iterator("/sys/bus/virtio/drivers/virtio_balloon", error)) {
-    if (device.path().filename().string().rfind("virtio", 0) != 0) continue;
-    std::ifstream in(device.path() / "features");
-    std::string bits;
-    if (in >> bits && reports_free_pages(bits)) return true;
-  }
-#endif
-  return false;
-}
+PageProbe page_probe() { return probe_figures; }
 
 void restart_with_huge_pages(char** argv) {
   if (!glibc_with_tunable() || sanitized()) return;
   const char* choice = std::getenv("MESHQUILT_HUGE_PAGES");
   if (choice != nullptr && std::strcmp(choice, "0") == 0) return;
   const bool asked = choice != nullptr && std::strcmp(choice, "1") == 0;
-  if (!asked && host_reclaims_free_pages()) return;
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  if (contains(tunables, kTunable)) return;                      // set already, by us or the user
+  if (contains(tunables, kTunable)) {  // set already, by us or the user
+    const char* passed = std::getenv(kProbeVariable);
+    if (passed != nullptr &&
+        std::sscanf(passed, "%lf,%lf", &probe_figures.small_us, &probe_figures.huge_us) != 2)
+      probe_figures = {};
+    return;
+  }
   if (contains(std::getenv("LD_PRELOAD"), "vgpreload")) return;  // valgrind follows no exec
   if (!thp_on_request()) return;
+  if (!asked) {
+    probe_figures = first_touch_probe();
+    if (!probe_figures.huge_pays()) return;
+  }
 #if defined(__linux__)
   std::string value = tunables != nullptr && *tunables != '\0' ? std::string(tunables) + ":" : "";
   value += std::string(kTunable) + "=1";
   if (::setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  char figures[64];
+  std::snprintf(figures, sizeof figures, "%.1f,%.1f", probe_figures.small_us,
+                probe_figures.huge_us);
+  ::setenv(kProbeVariable, figures, 1);
   ::execv("/proc/self/exe", argv);
   // Only on failure (no /proc): run on as started, without the tunable.
   if (tunables != nullptr)

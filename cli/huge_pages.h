@@ -5,27 +5,35 @@
 
 namespace mq::cli {
 
+// What faulting fresh memory in costs on this machine: microseconds for 2 MiB, one write per
+// 4 KiB, on one huge page and on small pages (the least of two rounds each; -1: not measured).
+struct PageProbe {
+  double small_us = -1, huge_us = -1;
+  bool huge_pays() const;  // both measured, the huge page faster
+};
+
+// Measures it (about 2 x 2 MiB twice: 20 ms where a small-page fault costs 19 us, under 2 ms
+// on most machines).
+PageProbe first_touch_probe();
+
+// The probe's figures for --stats: as this process measured them, or as passed on to the
+// restarted one; -1 when it did not run.
+PageProbe page_probe();
+
 // Restarts this process (same pid, arguments and environment) with glibc's malloc asked to back
 // its large blocks with transparent huge pages (GLIBC_TUNABLES glibc.malloc.hugetlb=1), when
 // that helps and is safe: glibc 2.35 or later, the kernel's THP mode "madvise" (with "always"
 // the pages are huge already, with "never" they cannot be), not built with a sanitizer (its
 // malloc ignores the tunable), not under valgrind, the tunable not set already (so at most one
-// restart), and MESHQUILT_HUGE_PAGES not "0". glibc reads tunables only when a process starts,
-// hence the restart (about 10 ms). Measured (farm-bench, 4 pairs, 2 cores): the armor job 0.78x
-// wall time, the ivy wall 0.91x, Spot 0.88x; most of the page faults of the output's large
-// arrays go, peak memory 1-5% higher. Returns only when no restart was made (or exec failed);
-// call first in main, before any thread or file exists. Not on a virtual machine whose balloon
-// reports free pages to the host (reports_free_pages): there the huge pages are the memory the
-// host took back, and faulting them in made the armor job 1.35x slower; MESHQUILT_HUGE_PAGES=1
-// asks for them all the same.
+// restart), MESHQUILT_HUGE_PAGES not "0", and first_touch_probe finding the huge page faster
+// (MESHQUILT_HUGE_PAGES=1 skips the probe). glibc reads tunables only when a process starts,
+// hence the restart (about 10 ms). Why a probe: on one VM (Firecracker, its balloon reporting free
+// pages to the host) huge pages made the armor job 1.3x slower, each huge page's zeroing faulting
+// every 4 KiB of it in on the host; on another of the same kind (a paravirtual kernel) small-page
+// faults cost 19 us and huge pages made it 1.15x faster. The reporting bit cannot tell them
+// apart; the cost of a fault can. Returns only when no restart was made (or exec failed); call
+// first in main, before any thread or file exists.
 void restart_with_huge_pages(char** argv);
-
-// Whether a virtio balloon's features string (one '0' or '1' per feature bit, bit 0 first, as in
-// /sys/bus/virtio/devices/*/features) offers free page reporting (bit 5).
-bool reports_free_pages(const std::string& features);
-
-// Whether a virtio balloon of this machine reports free pages (reads sysfs; false off Linux).
-bool host_reclaims_free_pages();
 
 // Whether this process runs with the tunable above (for --stats).
 bool huge_pages_on();

@@ -513,10 +513,9 @@ TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
 }
 
 // Whether this machine and build can run on transparent huge pages on request (cli/huge_pages.h):
-// glibc 2.35 or later, the kernel's THP mode "madvise", no sanitizer. By default also not on a VM
-// whose balloon reports free pages (asked = MESHQUILT_HUGE_PAGES=1 overrides that).
-bool huge_pages_possible(bool asked = false) {
-  if (!asked && mq::cli::host_reclaims_free_pages()) return false;
+// glibc 2.35 or later, the kernel's THP mode "madvise", no sanitizer. By default also only where
+// the start's probe found the huge page faster (MESHQUILT_HUGE_PAGES=1 skips the probe).
+bool huge_pages_possible() {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   return false;
 #elif defined(__has_feature)
@@ -581,10 +580,17 @@ TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
   EXPECT_EQ(json_value(slurp(dir + "/on/q.json"), "freed_memory_kept"),
             kept_possible() ? "true" : "false");
   EXPECT_EQ(json_value(slurp(dir + "/unkept/q.json"), "freed_memory_kept"), "false");
-  EXPECT_EQ(json_value(slurp(dir + "/on/q.json"), "huge_pages"),
-            huge_pages_possible() ? "true" : "false");
+  // The default run follows its own probe, whose figures --stats gives.
+  const std::string on_stats = slurp(dir + "/on/q.json");
+  mq::cli::PageProbe probe;
+  probe.small_us = std::stod(json_value(on_stats, "page_probe_small_us"));
+  probe.huge_us = std::stod(json_value(on_stats, "page_probe_huge_us"));
+  EXPECT_EQ(probe.small_us >= 0, huge_pages_possible()) << on_stats;
+  EXPECT_EQ(json_value(on_stats, "huge_pages"),
+            huge_pages_possible() && probe.huge_pays() ? "true" : "false");
   EXPECT_EQ(json_value(slurp(dir + "/asked/q.json"), "huge_pages"),
-            huge_pages_possible(true) ? "true" : "false");
+            huge_pages_possible() ? "true" : "false");
+  EXPECT_EQ(json_value(slurp(dir + "/asked/q.json"), "page_probe_small_us"), "-1");
   EXPECT_EQ(json_value(slurp(dir + "/off/q.json"), "huge_pages"), "false");
   EXPECT_EQ(json_value(slurp(dir + "/set/q.json"), "huge_pages"), "false");
   const std::string on = slurp(dir + "/on/q.obj");
@@ -595,14 +601,21 @@ TEST(Cli, SurfaceIsByteIdenticalOnHugePages) {
   EXPECT_TRUE(on == slurp(dir + "/unkept/q.obj"));
 }
 
-// The features string of /sys/bus/virtio/devices/*/features: bit 0 first; bit 5 is free page
-// reporting (a Firecracker balloon here read 0110010100...: stats, deflate on OOM, reporting).
-TEST(Cli, FreePageReportingIsReadFromBitFive) {
-  EXPECT_TRUE(mq::cli::reports_free_pages("0110010100000000"));
-  EXPECT_TRUE(mq::cli::reports_free_pages("000001"));
-  EXPECT_FALSE(mq::cli::reports_free_pages("0110000100000000"));
-  EXPECT_FALSE(mq::cli::reports_free_pages("11111"));  // too short to hold bit 5
-  EXPECT_FALSE(mq::cli::reports_free_pages(""));
+// The probe measures both page sizes (on Linux) and prefers the huge page only when it is faster.
+TEST(Cli, PageProbeMeasuresBothPageSizes) {
+  const mq::cli::PageProbe probe = mq::cli::first_touch_probe();
+#if defined(__linux__)
+  EXPECT_GT(probe.small_us, 0);
+  EXPECT_GT(probe.huge_us, 0);
+#endif
+  EXPECT_EQ(probe.huge_pays(),
+            probe.huge_us >= 0 && probe.small_us >= 0 && probe.huge_us < probe.small_us);
+  mq::cli::PageProbe unmeasured;
+  EXPECT_FALSE(unmeasured.huge_pays());
+  unmeasured.small_us = 100;
+  EXPECT_FALSE(unmeasured.huge_pays());
+  unmeasured.huge_us = 10;
+  EXPECT_TRUE(unmeasured.huge_pays());
 }
 
 }  // namespace
