@@ -166,6 +166,10 @@ bool keep_freed_memory() {
   if (sanitized()) return false;
   const char* choice = std::getenv("MESHQUILT_KEEP_FREED");
   if (choice != nullptr && std::strcmp(choice, "0") == 0) return false;
+  // On huge pages a fresh block's faults cost little (zeroing at memory speed), and keeping
+  // blocks would only raise the peak.
+  const bool asked = choice != nullptr && std::strcmp(choice, "1") == 0;
+  if (!asked && huge_pages_on()) return false;
   // Both succeed or the defaults stay (mallopt returns 0 on an invalid value only).
   kept = ::mallopt(M_MMAP_MAX, 0) == 1 && ::mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1;
 #endif

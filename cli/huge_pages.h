@@ -38,16 +38,19 @@ void restart_with_huge_pages(char** argv);
 // Whether this process runs with the tunable above (for --stats).
 bool huge_pages_on();
 
-// Keeps the blocks the run frees for its next allocations, unless MESHQUILT_KEEP_FREED is "0"
-// (issue 27): glibc's malloc maps every block over its threshold (at most 32 MiB) afresh and
-// unmaps it when freed, so each large array of a stage (the intersection test's face boxes,
-// 115 MB on the armor, made three times) faults its pages in and zeroes them again, and on a VM
-// a 4 KiB fault cost 19 us (2.87M boxes: 0.54 s; 0.01 s reused). With mmap off and no trimming,
-// large blocks come from the heap and go back to it. Paired runs (bench/results/paired_{new_keep_
-// freed,old_freed_unmapped}.json, 2 cores, no huge pages): the armor 0.81x the time, the bunny
-// 0.80x, the cup 0.76x, the ivy wall 0.87x; peak memory 1.03x, 1.02x, 0.99x and 1.10x (the
-// heap's free blocks do not always fit the next request). Same bytes. Returns whether it did
-// (glibc, no sanitizer: theirs replaces malloc). Call first in main.
+// Keeps the blocks the run frees for its next allocations when the run is not on huge pages
+// (MESHQUILT_KEEP_FREED=1: always; =0: never) (issue 27): glibc's malloc maps every block over
+// its threshold (at most 32 MiB) afresh and unmaps it when freed, so each large array of a stage
+// (the intersection test's face boxes, 115 MB on the armor, made three times) faults its pages
+// in and zeroes them again, and on a VM a 4 KiB fault cost 19 us (2.87M boxes: 0.54 s; 0.01 s
+// reused). With mmap off and no trimming, large blocks come from the heap and go back to it.
+// Paired runs on small pages (bench/results/paired_{new_keep_freed,old_freed_unmapped}.json,
+// 2 cores): the armor 0.81x the time, the bunny 0.80x, the cup 0.76x, the ivy wall 0.87x; peak
+// memory 1.03x, 1.02x, 0.99x and 1.10x (the heap's free blocks do not always fit the next
+// request). On huge pages a fault costs 0.05 ms per 2 MiB and keeping gained nothing measurable
+// (the armor 6.4-7.0 s either way) while the chair's peak rose 199 -> 225 MB: not kept there.
+// Same bytes. Returns whether it did (glibc, no sanitizer: theirs replaces malloc). Call in
+// main after restart_with_huge_pages.
 bool keep_freed_memory();
 
 // Whether keep_freed_memory did (for --stats).

@@ -33,9 +33,10 @@ constexpr const char* kUsage =
     "  where the kernel gives them on request and a probe at start finds a huge page faster to\n"
     "  fault in than small ones: 10-20% faster on large jobs, peak memory a few percent\n"
     "  higher; =1 asks for them without the probe; --stats says which in memory.huge_pages,\n"
-    "  and the probe's figures). MESHQUILT_KEEP_FREED=0 lets large freed blocks go back to the\n"
-    "  system at once (kept for the run's next arrays by default: fewer page faults, peak\n"
-    "  memory about 2% higher; memory.freed_memory_kept).\n"
+    "  and the probe's figures). Off huge pages, large freed blocks are kept for the run's next\n"
+    "  arrays (fewer page faults: 0.8x the time, peak memory 1.0-1.1x);\n"
+    "  MESHQUILT_KEEP_FREED=0 never keeps them, =1 also on huge pages\n"
+    "  (memory.freed_memory_kept).\n"
     "\n";
 
 struct Command {
