@@ -512,21 +512,30 @@ TEST(Cli, PlaneIsByteIdenticalAcrossThreadsAndDevices) {
   EXPECT_TRUE(t1 == slurp(dir + "/cl/q.obj")) << "--device cpu and opencl differ";
 }
 
-// Whether this machine and build can run on transparent huge pages on request (cli/huge_pages.h):
-// glibc 2.35 or later, the kernel's THP mode "madvise", no sanitizer. By default also only where
-// the start's probe found the huge page faster (MESHQUILT_HUGE_PAGES=1 skips the probe).
-bool huge_pages_possible() {
+// Built with a sanitizer: its allocator replaces glibc's malloc (no tunables, no mallopt).
+constexpr bool sanitized_build() {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return false;
+  return true;
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
     __has_feature(memory_sanitizer)
+  return true;
+#else
   return false;
 #endif
+#else
+  return false;
 #endif
+}
+
+// Whether this machine and build can run on transparent huge pages on request (cli/huge_pages.h):
+// glibc 2.35 or later, the kernel's THP mode "madvise", no sanitizer. A run that does not ask
+// for them (MESHQUILT_HUGE_PAGES=1) also needs its start's probe to find the huge page faster.
+bool huge_pages_possible() {
 #if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 35))
-  return slurp("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") !=
-         std::string::npos;
+  return !sanitized_build() &&
+         slurp("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") !=
+             std::string::npos;
 #else
   return false;
 #endif
@@ -534,16 +543,8 @@ bool huge_pages_possible() {
 
 // Whether the engine can keep freed blocks for its next arrays: glibc's malloc, no sanitizer.
 bool kept_possible() {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer)
-  return false;
-#endif
-#endif
 #if defined(__GLIBC__)
-  return true;
+  return !sanitized_build();
 #else
   return false;
 #endif
