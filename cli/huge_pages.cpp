@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 
 #if defined(__linux__)
@@ -58,6 +59,12 @@ bool contains(const char* text, const char* part) {
   return text != nullptr && std::strstr(text, part) != nullptr;
 }
 
+// Whether environment variable `name` is set to exactly `value`.
+bool env_is(const char* name, const char* value) {
+  const char* set = std::getenv(name);
+  return set != nullptr && std::strcmp(set, value) == 0;
+}
+
 // The kernel's THP mode is "madvise" (the selected one is in brackets).
 bool thp_on_request() {
   std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
@@ -67,6 +74,8 @@ bool thp_on_request() {
 
 // The figures of first_touch_probe, as measured in this process or passed on by the restart.
 PageProbe probe_figures;
+// Whether keep_freed_memory did.
+bool kept = false;
 
 // Microseconds to fault in 2 MiB of fresh anonymous memory, one write per 4 KiB: on one huge
 // page (MADV_HUGEPAGE over an aligned block) or on small pages (MADV_NOHUGEPAGE); -1 when the
@@ -98,14 +107,14 @@ double first_touch_us(bool huge) {
 bool PageProbe::huge_pays() const { return huge_us >= 0 && small_us >= 0 && huge_us < small_us; }
 
 PageProbe first_touch_probe() {
-  PageProbe probe;
   // Two rounds, alternating, the least of each: one slow fault (a timer tick, a migration)
   // does not decide.
+  PageProbe probe{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   for (int round = 0; round < 2; ++round) {
     const double huge = first_touch_us(true), small = first_touch_us(false);
     if (huge < 0 || small < 0) return {};
-    probe.huge_us = round == 0 ? huge : std::min(probe.huge_us, huge);
-    probe.small_us = round == 0 ? small : std::min(probe.small_us, small);
+    probe.huge_us = std::min(probe.huge_us, huge);
+    probe.small_us = std::min(probe.small_us, small);
   }
   return probe;
 }
@@ -114,9 +123,8 @@ PageProbe page_probe() { return probe_figures; }
 
 void restart_with_huge_pages(char** argv) {
   if (!glibc_with_tunable() || sanitized()) return;
-  const char* choice = std::getenv("MESHQUILT_HUGE_PAGES");
-  if (choice != nullptr && std::strcmp(choice, "0") == 0) return;
-  const bool asked = choice != nullptr && std::strcmp(choice, "1") == 0;
+  if (env_is("MESHQUILT_HUGE_PAGES", "0")) return;
+  const bool asked = env_is("MESHQUILT_HUGE_PAGES", "1");
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (contains(tunables, kTunable)) {  // set already, by us or the user
     const char* passed = std::getenv(kProbeVariable);
@@ -157,19 +165,13 @@ bool huge_pages_on() {
          !contains(tunables, off.c_str());
 }
 
-namespace {
-bool kept = false;
-}  // namespace
-
 bool keep_freed_memory() {
 #if defined(__GLIBC__)
   if (sanitized()) return false;
-  const char* choice = std::getenv("MESHQUILT_KEEP_FREED");
-  if (choice != nullptr && std::strcmp(choice, "0") == 0) return false;
+  if (env_is("MESHQUILT_KEEP_FREED", "0")) return false;
   // On huge pages a fresh block's faults cost little (zeroing at memory speed), and keeping
   // blocks would only raise the peak.
-  const bool asked = choice != nullptr && std::strcmp(choice, "1") == 0;
-  if (!asked && huge_pages_on()) return false;
+  if (!env_is("MESHQUILT_KEEP_FREED", "1") && huge_pages_on()) return false;
   // Both succeed or the defaults stay (mallopt returns 0 on an invalid value only).
   kept = ::mallopt(M_MMAP_MAX, 0) == 1 && ::mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1;
 #endif

@@ -123,7 +123,7 @@ SwatchAnimation::SwatchAnimation(const SurfaceQuilt& quilt, const std::vector<in
     first.push_back(first.back() +
                     static_cast<Eigen::Index>(quilt.elements[static_cast<size_t>(k)].face.size()));
   if (quilt.stitched) find_parts(quilt, kept, source, first);
-  // Long swatch elements (thread_tiling's measure).
+  // Long swatch elements: footprints at least 4 times longer than wide.
   std::vector<char> long_element;
   for (const Element& e : prepared.elements) long_element.push_back(e.long_footprint());
   const bool any_long =
