@@ -220,7 +220,7 @@ int run_info(int argc, char** argv, int first) {
       "each ring-shaped element is interlinked with (linking number of centre loops),\n"
       "where long elements (threads, vines) end, and elements per unit area. A ring\n"
       "whose free hole is narrower than its wire (no hole), whose halves turn more than\n"
-      "45 degrees against each other (folded), or of a ring kind but not ring-shaped is\n"
+      "60 degrees against each other (folded), or of a ring kind but not ring-shaped is\n"
       "degenerate: a miss, linked to nothing. With --swatch, how that compares with the\n"
       "swatch's own structure: each ring against its own kind's interior link count, and\n"
       "the shape (size ratio, aspect) of compact elements against their swatch element.");

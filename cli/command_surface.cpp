@@ -92,6 +92,8 @@ void write_element_figures(JsonWriter& j, const SurfaceQuiltingStats& s,
       .value("layout_versions", em.layout_versions)
       .value("folded_rings", em.folded_rings)
       .value("unbent_rings", em.unbent_rings)
+      .value("late_unbent_rings", em.late_unbent_rings)
+      .value("late_unbending_reverted", em.late_unbending_reverted)
       .value("separated_rings", em.separated_rings)
       .value("separation_reverted", em.separation_reverted)
       .value("separation_left_shell", em.separation_left_shell)

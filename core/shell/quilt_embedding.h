@@ -48,6 +48,11 @@ struct QuiltEmbeddingStats {
   int separated_rings = 0;  // rings moved apart from those they touched
   int folded_rings = 0;     // rings folded over an edge beyond the structure measure's limit
   int unbent_rings = 0;     // of them, hung over it rigidly enough (core/shell/ring_unbending)
+  // Rings still folded after the removal (brought back there as the layout placed them, or
+  // pressed into a fold), hung over their edge then and clear of every kept element; and those
+  // hung then that still met one after the separation, put back folded.
+  int late_unbent_rings = 0;
+  int late_unbending_reverted = 0;
   int separation_reverted = 0;    // moved, then put back: a link would have changed
   int separation_left_shell = 0;  // moved, then put back: it left the shell
   int separation_iterations = 0;

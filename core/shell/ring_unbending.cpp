@@ -101,9 +101,8 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
   blend_towards_flat(placed, flat, options.keep, [&](MatrixX3d& blend, double) {
     std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
     if (!loop || ring_fold(*loop) - reference > options.target_fold) return false;
-    if (self_intersects(blend, F, &fold)) return false;
     // A ring hung straighter over a convex edge dips into the base beside it: lifted out whole
-    // (its links are checked after).
+    // (its links are checked after). A lift is rigid: it makes no self-crossing.
     if (ground && check_element_heights(*ground, blend, whole, check)[0].below > 0) {
       if (lift_out_of_base(*ground, blend, whole, check, {1})[0].below > 0) {
         c.outcome = UnbendOutcome::IntoBase;
@@ -117,6 +116,11 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
         c.outcome = UnbendOutcome::LinksChanged;
         return false;
       }
+    // Last, as the costliest test (a blend whose links change is turned down without it).
+    if (self_intersects(blend, F, &fold)) {
+      c.outcome = UnbendOutcome::SelfCrossing;
+      return false;
+    }
     c.V = std::move(blend);
     c.loop = std::move(*loop);
     c.outcome = UnbendOutcome::Unbent;
@@ -132,13 +136,14 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
                                       const std::vector<char>& skip, const SignedHeight* ground,
                                       const PlacementCheckOptions& check,
                                       const RingUnbendingOptions& options,
-                                      RingUnbendingStats* stats) {
+                                      RingUnbendingStats* stats, const std::vector<char>* only) {
   options.validate();
   const size_t ne = F.size();
   MQ_CHECK(first.size() == ne + 1 && flat.size() == ne && skip.size() == ne && !first.empty() &&
-               first.back() == V.rows(),
+               first.back() == V.rows() && (!only || only->size() == ne),
            InvalidInput, "ring unbending: ", ne, " elements with ", first.size(), " offsets, ",
-           flat.size(), " flat shapes and ", skip.size(), " flags over ", V.rows(), " vertices");
+           flat.size(), " flat shapes, ", skip.size(), " flags and ", only ? only->size() : ne,
+           " candidate flags over ", V.rows(), " vertices");
   const auto rows = [&](size_t k) { return V.middleRows(first[k], first[k + 1] - first[k]); };
   // Every element's centre loop as placed (none: not ring-shaped), and the folded candidates.
   std::vector<Loop> loops(ne);
@@ -155,7 +160,7 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
     const MatrixX3d* shape = flat[k];
     const double fold = ring_fold(*loop);
     // The flat shape's own fold (>= 0) only where the placed one could exceed it by the limit.
-    if (shape && shape->rows() == placed.rows() && fold > kFoldLimit) {
+    if (shape && shape->rows() == placed.rows() && fold > kFoldLimit && (!only || (*only)[k])) {
       const std::optional<Loop> own = loop_of(*shape, *F[k], options.loop_bins);
       reference[k] = own ? ring_fold(*own) : M_PI;
       folded[k] = fold - reference[k] > kFoldLimit;

@@ -50,6 +50,8 @@ struct RingUnbendingStats {
 // against their neighbours as placed, then, in element order, one whose linking with an
 // already unbent neighbour changed is put back: deterministic whatever the thread count.
 //   ground  the base, if given: an unbent ring must keep every vertex above it (check)
+//   only     if given (#elements flags): only these may be unbent (the others are still
+//            neighbours), for a second pass over the rings whose neighbourhood changed
 // Returns per element whether it moved. Throws InvalidInput when the sizes disagree or the
 // options are invalid.
 std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Index>& first,
@@ -58,6 +60,7 @@ std::vector<char> unbend_folded_rings(MatrixX3d& V, const std::vector<Eigen::Ind
                                       const std::vector<char>& skip, const SignedHeight* ground,
                                       const PlacementCheckOptions& check,
                                       const RingUnbendingOptions& options = {},
-                                      RingUnbendingStats* stats = nullptr);
+                                      RingUnbendingStats* stats = nullptr,
+                                      const std::vector<char>* only = nullptr);
 
 }  // namespace mq

@@ -65,7 +65,8 @@ struct HungScene {
     first.push_back(V.rows());
   }
   MatrixX3d element(size_t k) const { return V.middleRows(first[k], first[k + 1] - first[k]); }
-  std::vector<char> unbend(const SignedHeight* ground, RingUnbendingStats* stats) {
+  std::vector<char> unbend(const SignedHeight* ground, RingUnbendingStats* stats,
+                           const std::vector<char>* candidates = nullptr) {
     std::vector<const MatrixX3i*> F;
     std::vector<const MatrixX3d*> flat;
     for (size_t k = 0; k < rings.size(); ++k) {
@@ -75,7 +76,7 @@ struct HungScene {
     PlacementCheckOptions check;
     check.height = 2 * kHungLift;
     return unbend_folded_rings(V, first, F, flat, std::vector<char>(rings.size(), 0), ground, check,
-                               {}, stats);
+                               {}, stats, candidates);
   }
 };
 
@@ -92,8 +93,15 @@ TEST(RingUnbending, ARingFoldedOverAnEdgeHangsOverItWithinTheLimitAndOutOfTheBas
   check.height = 2 * kHungLift;
   ASSERT_EQ(check_element_heights(ground, s.V, s.first, check)[0].below, 0);
 
+  // The pass after the removal names its candidates: a folded ring not among them stays as it
+  // is and is not counted; named, it is unbent.
   RingUnbendingStats stats;
-  const std::vector<char> moved = s.unbend(&ground, &stats);
+  const MatrixX3d placed = s.V;
+  const std::vector<char> none = {0}, named = {1};
+  EXPECT_FALSE(s.unbend(&ground, &stats, &none)[0]);
+  EXPECT_EQ(stats.folded, 0);
+  EXPECT_EQ(s.V, placed);
+  const std::vector<char> moved = s.unbend(&ground, &stats, &named);
   EXPECT_EQ(stats.folded, 1);
   EXPECT_EQ(stats.unbent, 1);
   ASSERT_TRUE(moved[0]);
@@ -181,6 +189,10 @@ TEST(RingUnbending, SizesThatDisagreeAndBadOptionsAreRefused) {
   EXPECT_THROW(unbend_folded_rings(V, {0, V.rows() + 1}, F, flat, {0}, nullptr, check),
                InvalidInput);
   EXPECT_THROW(unbend_folded_rings(V, {0, V.rows()}, F, flat, {0, 0}, nullptr, check),
+               InvalidInput);
+  const std::vector<char> two_candidates = {1, 1};
+  EXPECT_THROW(unbend_folded_rings(V, {0, V.rows()}, F, flat, {0}, nullptr, check, {}, nullptr,
+                                   &two_candidates),
                InvalidInput);
   RingUnbendingOptions bad;
   bad.keep = {1.0};
