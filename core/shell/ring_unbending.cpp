@@ -22,6 +22,21 @@ void RingUnbendingOptions::validate() const {
   for (const double k : keep)
     MQ_CHECK(k >= 0 && k < 1, InvalidInput, "ring unbending: keep must be in [0, 1), got ", k);
   MQ_CHECK(loop_bins >= 8, InvalidInput, "ring unbending: loop_bins must be >= 8, got ", loop_bins);
+  MQ_CHECK(kept_links >= 0 && kept_links <= 1, InvalidInput,
+           "ring unbending: kept_links must be in [0, 1], got ", kept_links);
+}
+
+bool hung_links_hold(const std::vector<int>& placed, const std::vector<int>& hung,
+                     double kept_links) {
+  MQ_CHECK(placed.size() == hung.size(), InvalidInput, "ring unbending: ", placed.size(),
+           " linking numbers as placed against ", hung.size(), " hung");
+  int had = 0, kept = 0;
+  for (size_t j = 0; j < placed.size(); ++j) {
+    if (hung[j] != 0 && placed[j] == 0) return false;
+    had += placed[j] != 0;
+    kept += hung[j] != 0 && placed[j] != 0;
+  }
+  return kept >= kept_links * had;
 }
 
 namespace {
@@ -98,6 +113,9 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
             double reference, UnbendCandidate& c) {
   const std::vector<Eigen::Index> whole = {0, placed.rows()};
   std::pair<int, int> fold{-1, -1};  // the last blend's folded pair, tried first on the next
+  // The least blend that keeps options.kept_links of the links but not all: taken only when no
+  // blend keeps every linking number as it was.
+  std::optional<std::pair<MatrixX3d, Loop>> partly;
   blend_towards_flat(placed, flat, options.keep, [&](MatrixX3d& blend, double) {
     std::optional<Loop> loop = loop_of(blend, F, options.loop_bins);
     if (!loop || ring_fold(*loop) - reference > options.target_fold) return false;
@@ -111,14 +129,21 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
       loop = loop_of(blend, F, options.loop_bins);
       if (!loop) return false;
     }
+    std::vector<int> now(c.near.size());
     for (size_t j = 0; j < c.near.size(); ++j)
-      if (linking_number(*loop, loops[static_cast<size_t>(c.near[j])]) != c.linked[j]) {
-        c.outcome = UnbendOutcome::LinksChanged;
-        return false;
-      }
+      now[j] = linking_number(*loop, loops[static_cast<size_t>(c.near[j])]);
+    const bool all = now == c.linked;
+    if (!all && (partly || !hung_links_hold(c.linked, now, options.kept_links))) {
+      if (!partly) c.outcome = UnbendOutcome::LinksChanged;
+      return false;
+    }
     // Last, as the costliest test (a blend whose links change is turned down without it).
     if (self_intersects(blend, F, &fold)) {
-      c.outcome = UnbendOutcome::SelfCrossing;
+      if (!partly) c.outcome = UnbendOutcome::SelfCrossing;
+      return false;
+    }
+    if (!all) {
+      partly.emplace(std::move(blend), std::move(*loop));
       return false;
     }
     c.V = std::move(blend);
@@ -126,6 +151,11 @@ void unbend(const MatrixX3d& placed, const MatrixX3d& flat, const MatrixX3i& F,
     c.outcome = UnbendOutcome::Unbent;
     return true;
   });
+  if (c.outcome != UnbendOutcome::Unbent && partly) {
+    c.V = std::move(partly->first);
+    c.loop = std::move(partly->second);
+    c.outcome = UnbendOutcome::Unbent;
+  }
 }
 
 }  // namespace

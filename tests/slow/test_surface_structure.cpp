@@ -81,41 +81,42 @@ void expect_chain_mail(const char* name, const Result& r, const Targets& t) {
 
 TEST(SurfaceStructure, SpotDefaultJob) {
   const TriMesh base = read_mesh(std::string(MESHQUILT_SOURCE_DIR) + "/data/spot_6k.obj");
-  // 96.7% linked (96.5% before the rings still folded after the removal were hung over their
-  // edge; 95.6% before small rings around cones kept the layout's version).
+  // 96.7% linked, 96.5% before folded rings were hung over their edge keeping half their links
+  // and after the removal too (95.6% before small rings around cones kept the layout's
+  // version).
   expect_chain_mail("Spot (default job)", quilt_by_default(base, mail(3, 3, 16), 0.08),
                     {0.94, 0.015});
 }
 
 TEST(SurfaceStructure, BunnyAndLink) {
   const TriMesh base = read_mesh(test::shared_data("base/bunny_igl_7k.off"));
-  // 95.45% linked, issue 13's 95% (94.33% before the rings still folded after the removal were
-  // hung over their edge: 11 folded rings in the output, 3 since; 92.0% before small rings
-  // around cones kept the layout's version).
+  // 96.0% linked, issue 13's 95% (94.3% before folded rings were hung over their edge keeping
+  // half their links and after the removal too: 11 folded rings in the output, 2 since; 92.0%
+  // before small rings around cones kept the layout's version).
   const Result r = quilt_by_default(base, mail(2, 4), 0.099);
   expect_chain_mail("bunny + link", r, {0.95, 0.03});
   EXPECT_GE(r.embedding.late_unbent_rings, 1);
-  EXPECT_LE(r.structure.output.interior_degenerate(), 5);
+  EXPECT_LE(r.structure.output.interior_degenerate(), 4);
 }
 
 TEST(SurfaceStructure, ChainMailOnTheCup) {
   const TriMesh base = read_mesh(test::shared_data("base/cup_mug_11k.off"));
-  // 97.8% linked; most of its isolated rings are folded over the lip (a sharp crease), counted
-  // as misses.
-  expect_chain_mail("cup, chain mail", quilt_by_default(base, mail(5, 6), 0.145), {0.96, 0.0125});
+  // 98.9% linked (97.8% while 14 of its rings were folded over the lip, a sharp crease, counted
+  // as misses; they hang over it now).
+  expect_chain_mail("cup, chain mail", quilt_by_default(base, mail(5, 6), 0.145), {0.975, 0.0125});
 }
 
 // The armor job: at --scale 0.13 a ring (0.042 across) is as wide as the knight's arms are in
 // radius, over a 1k-face model with sharp creases and spikes. Measured honestly (issue 23: rings
-// folded over the spikes and creases are misses, not links) it is at 84.3% (68% before issue
+// folded over the spikes and creases are misses, not links) it is at 86.3% (68% before issue
 // 23's layout), short of the issue's 90%: README "Where the targets stand". Its cone metric is
 // uneven (mean squared log scale 0.17): the layout follows it partly (scale_exponent 0.73). The
-// same knight with rings half the size keeps 93.6%.
+// same knight with rings half the size keeps 94.3%.
 TEST(SurfaceStructure, ArmorJobOnTheKnight) {
   const TriMesh base = read_mesh(test::shared_data("base/knight_decimated_1k.off"));
-  expect_chain_mail("armor (knight)", quilt_by_default(base, mail(5, 6), 0.13), {0.81, 0.06});
+  expect_chain_mail("armor (knight)", quilt_by_default(base, mail(5, 6), 0.13), {0.845, 0.06});
   expect_chain_mail("knight, rings half the armor job's", quilt_by_default(base, mail(5, 6), 0.065),
-                    {0.91, 0.03});
+                    {0.925, 0.03});
 }
 
 // Rings a tenth of the radius across: the issue's generated cylinder and sphere.

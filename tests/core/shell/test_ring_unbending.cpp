@@ -180,6 +180,17 @@ TEST(RingUnbending, LinksAreKeptAndTheResultIsTheSameOnAnyThreadCount) {
   EXPECT_EQ(results[0], results[1]);
 }
 
+// A hung ring makes no new link and keeps the share asked of its old ones.
+TEST(RingUnbending, AHungRingKeepsHalfItsLinksAndMakesNone) {
+  EXPECT_TRUE(hung_links_hold({1, -1, 1, 1, 0}, {1, -1, 1, 1, 0}, 1.0));
+  EXPECT_TRUE(hung_links_hold({1, -1, 1, 1, 0}, {1, 1, 0, 0, 0}, 0.5));  // a flipped sign links
+  EXPECT_FALSE(hung_links_hold({1, -1, 1, 1, 0}, {1, 0, 0, 0, 0}, 0.5));
+  EXPECT_FALSE(hung_links_hold({1, -1, 1, 1, 0}, {1, -1, 1, 0, 0}, 1.0));
+  EXPECT_FALSE(hung_links_hold({1, -1, 1, 1, 0}, {1, -1, 1, 1, 1}, 0.5));  // a new link
+  EXPECT_TRUE(hung_links_hold({0, 0}, {0, 0}, 0.5));                       // nothing to keep
+  EXPECT_THROW(hung_links_hold({1}, {1, 0}, 0.5), InvalidInput);
+}
+
 TEST(RingUnbending, SizesThatDisagreeAndBadOptionsAreRefused) {
   const TriMesh torus = test::torus(1.0, kHungWire, 24, 8);
   MatrixX3d V = torus.V;
@@ -200,6 +211,9 @@ TEST(RingUnbending, SizesThatDisagreeAndBadOptionsAreRefused) {
                InvalidInput);
   bad = {};
   bad.target_fold = 0;
+  EXPECT_THROW(bad.validate(), InvalidInput);
+  bad = {};
+  bad.kept_links = 1.5;
   EXPECT_THROW(bad.validate(), InvalidInput);
 }
 
